@@ -1,0 +1,56 @@
+//! Errors the core reports to callers. Every invalid input names its parameter
+//! and the allowed range, so the Python layer can raise a `ValueError` verbatim.
+
+use std::fmt;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Error {
+    /// A parameter is outside its allowed range.
+    InvalidParameter { name: String, message: String },
+    /// The analysis needs an autonomous scene; `effect` is what makes it time dependent.
+    NotAutonomous { effect: String },
+    /// The integrator could not proceed (step size underflow, too many steps, non-finite state).
+    Integration(String),
+}
+
+impl Error {
+    pub fn param(name: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::InvalidParameter {
+            name: name.into(),
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::InvalidParameter { name, message } => write!(f, "{name}: {message}"),
+            Error::NotAutonomous { effect } => write!(
+                f,
+                "this analysis needs an autonomous scene, but the effect '{effect}' makes it time dependent"
+            ),
+            Error::Integration(m) => write!(f, "integration failed: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Checks that `v` is finite and inside `[lo, hi]` (open ends when `*_open`).
+pub fn check_range(name: &str, v: f64, lo: f64, lo_open: bool, hi: f64, hi_open: bool) -> Result<()> {
+    let ok_lo = if lo_open { v > lo } else { v >= lo };
+    let ok_hi = if hi_open { v < hi } else { v <= hi };
+    if !v.is_finite() || !ok_lo || !ok_hi {
+        let l = if lo_open { "(" } else { "[" };
+        let h = if hi_open { ")" } else { "]" };
+        let hs = if hi.is_infinite() { "inf".to_string() } else { format!("{hi}") };
+        return Err(Error::param(
+            name,
+            format!("must be a finite number in {l}{lo}, {hs}{h}, got {v}"),
+        ));
+    }
+    Ok(())
+}

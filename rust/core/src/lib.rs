@@ -1,0 +1,14 @@
+//! ballbal-core: nonlinear dynamics of automatic ball balancers.
+//!
+//! The pure-Rust engine behind the `ballbal` Python package: the planar n-ball
+//! balancer model, an adaptive Dormand–Prince integrator, equilibria with
+//! eigenvalue and Routh–Hurwitz stability, periodic solutions by modified
+//! incremental harmonic balance, Floquet multipliers and parallel scans.
+
+pub mod error;
+pub mod model;
+pub mod ode;
+pub mod simulate;
+
+pub use error::{Error, Result};
+pub use model::{Dynamics, Planar};

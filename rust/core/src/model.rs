@@ -1,0 +1,365 @@
+//! The balancer's equations of motion in the disk-fixed rotating frame.
+//!
+//! Every analysis (time simulation, equilibria, harmonic balance, Floquet) works on
+//! the implicit residual `F(t, q, v, a) = M(q) a + g(q, v)`, with `v = q'`, `a = q''`,
+//! and its three Jacobians `K = dF/dq`, `C = dF/dv`, `M = dF/da`. Harmonic balance
+//! never needs `M^-1`; simulation solves `F(t, q, v, a) = 0` for `a`. A model that adds
+//! physical effects only has to supply this residual and its Jacobians.
+//!
+//! Coordinates: `q = (x, y, b_1, ..., b_n)`; see `shared/spec/model.md` section 2.
+//! Ball rows are divided by `m_i = mu eta_i` so that light balls do not make the
+//! harmonic-balance Jacobian badly scaled.
+
+use crate::error::{check_range, Error, Result};
+
+/// The dynamics interface shared by every analysis.
+pub trait Dynamics: Send + Sync {
+    /// Number of generalised coordinates `d`.
+    fn ndof(&self) -> usize;
+    /// Residual `F(t, q, v, a)` into `out` (length `d`).
+    fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]);
+    /// Row-major `d x d` Jacobians `K = dF/dq`, `C = dF/dv`, `M = dF/da` at `(t, q, v, a)`.
+    fn jacobians(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    );
+    /// Accelerations solving `F(t, q, v, a) = 0`.
+    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]);
+    /// `None` when the equations do not depend on `t`; otherwise the effect responsible.
+    fn time_dependence(&self) -> Option<String> {
+        None
+    }
+}
+
+/// Planar n-ball automatic balancer on an isotropic spring–damper support.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Planar {
+    /// Disk mass over total mass.
+    pub mu: f64,
+    /// Support damping ratio.
+    pub zeta: f64,
+    /// Track damping ratio, one per ball.
+    pub zeta_b: Vec<f64>,
+    /// Track radius over eccentricity.
+    pub delta: f64,
+    /// Spin speed ratio.
+    pub omega_s: f64,
+    /// Balancing capacity, one per ball.
+    pub eta: Vec<f64>,
+}
+
+impl Planar {
+    /// Validates and builds a planar balancer. `zeta_b` may have length 1 (shared by all balls).
+    pub fn new(
+        mu: f64,
+        zeta: f64,
+        zeta_b: &[f64],
+        delta: f64,
+        omega_s: f64,
+        eta: &[f64],
+    ) -> Result<Self> {
+        check_range("mu", mu, 0.0, true, 1.0, true)?;
+        check_range("zeta", zeta, 0.0, false, f64::INFINITY, true)?;
+        check_range("delta", delta, 0.0, true, f64::INFINITY, true)?;
+        check_range("Omega", omega_s, 0.0, false, f64::INFINITY, true)?;
+        if eta.is_empty() {
+            return Err(Error::param(
+                "eta",
+                "needs one value per ball and at least one ball (n >= 1), got n = 0",
+            ));
+        }
+        for (i, &e) in eta.iter().enumerate() {
+            check_range(&format!("eta[{i}]"), e, 0.0, true, f64::INFINITY, true)?;
+        }
+        let zb: Vec<f64> = match zeta_b.len() {
+            1 => vec![zeta_b[0]; eta.len()],
+            n if n == eta.len() => zeta_b.to_vec(),
+            n => {
+                return Err(Error::param(
+                    "zeta_b",
+                    format!("needs 1 value or one per ball ({}), got {n}", eta.len()),
+                ))
+            }
+        };
+        for (i, &z) in zb.iter().enumerate() {
+            let name = if zeta_b.len() == 1 {
+                "zeta_b".to_string()
+            } else {
+                format!("zeta_b[{i}]")
+            };
+            check_range(&name, z, 0.0, false, f64::INFINITY, true)?;
+        }
+        // Disk and balls are part of the total mass M: m_d + sum m_b <= M.
+        let share = mu * (1.0 + eta.iter().sum::<f64>() / delta);
+        if share > 1.0 {
+            return Err(Error::param(
+                "eta",
+                format!(
+                    "disk and balls exceed the total mass: mu * (1 + sum(eta) / delta) must be <= 1, got {share:.4}"
+                ),
+            ));
+        }
+        Ok(Planar {
+            mu,
+            zeta,
+            zeta_b: zb,
+            delta,
+            omega_s,
+            eta: eta.to_vec(),
+        })
+    }
+
+    pub fn n_balls(&self) -> usize {
+        self.eta.len()
+    }
+
+    /// Ball mass parameter `m_i = mu eta_i`.
+    #[inline]
+    pub fn m(&self, i: usize) -> f64 {
+        self.mu * self.eta[i]
+    }
+
+    /// `g(q, v) = F(q, v, 0)`: everything but the inertia terms.
+    pub fn forces(&self, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let (om, z, dl) = (self.omega_s, self.zeta, self.delta);
+        let (x, y, vx, vy) = (q[0], q[1], v[0], v[1]);
+        let k = 1.0 - om * om;
+        let mut fx = 2.0 * z * vx - 2.0 * om * vy + k * x - 2.0 * z * om * y - self.mu * om * om;
+        let mut fy = 2.0 * z * vy + 2.0 * om * vx + k * y + 2.0 * z * om * x;
+        for i in 0..self.n_balls() {
+            let (s, c) = q[2 + i].sin_cos();
+            let mi = self.m(i);
+            let w = om + v[2 + i];
+            fx -= mi * w * w * c;
+            fy -= mi * w * w * s;
+            out[2 + i] = 2.0 * om * (c * vx + s * vy)
+                + 2.0 * self.zeta_b[i] * dl * v[2 + i]
+                + om * om * (x * s - y * c);
+        }
+        out[0] = fx;
+        out[1] = fy;
+    }
+
+    /// Returns a copy with one named parameter changed (used by scans and continuation).
+    pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
+        let mut p = self.clone();
+        match name {
+            "mu" => p.mu = value,
+            "zeta" => p.zeta = value,
+            "zeta_b" => p.zeta_b.iter_mut().for_each(|z| *z = value),
+            "delta" => p.delta = value,
+            "Omega" => p.omega_s = value,
+            "eta" => p.eta.iter_mut().for_each(|e| *e = value),
+            _ => {
+                let slot = if let Some(i) = indexed(name, "eta") {
+                    p.eta.get_mut(i)
+                } else if let Some(i) = indexed(name, "zeta_b") {
+                    p.zeta_b.get_mut(i)
+                } else {
+                    return Err(Error::param(
+                        name,
+                        "is not a parameter of the planar balancer (mu, zeta, zeta_b, delta, Omega, eta, eta[i], zeta_b[i])",
+                    ));
+                };
+                match slot {
+                    Some(s) => *s = value,
+                    None => {
+                        return Err(Error::param(
+                            name,
+                            format!("ball index out of range 0..{}", self.n_balls()),
+                        ))
+                    }
+                }
+            }
+        }
+        Planar::new(p.mu, p.zeta, &p.zeta_b, p.delta, p.omega_s, &p.eta)
+    }
+}
+
+fn indexed(name: &str, base: &str) -> Option<usize> {
+    let rest = name.strip_prefix(base)?.strip_prefix('[')?.strip_suffix(']')?;
+    rest.parse().ok()
+}
+
+impl Dynamics for Planar {
+    fn ndof(&self) -> usize {
+        self.eta.len() + 2
+    }
+
+    fn residual(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+        self.forces(q, v, out);
+        let (ax, ay) = (a[0], a[1]);
+        for i in 0..self.n_balls() {
+            let (s, c) = q[2 + i].sin_cos();
+            let mi = self.m(i);
+            let ab = a[2 + i];
+            out[0] -= mi * s * ab;
+            out[1] += mi * c * ab;
+            out[2 + i] += self.delta * ab - s * ax + c * ay;
+        }
+        out[0] += ax;
+        out[1] += ay;
+    }
+
+    fn jacobians(
+        &self,
+        _t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        let d = self.ndof();
+        k.fill(0.0);
+        c.fill(0.0);
+        m.fill(0.0);
+        let (om, z, dl) = (self.omega_s, self.zeta, self.delta);
+        let stiff = 1.0 - om * om;
+        k[0] = stiff;
+        k[1] = -2.0 * z * om;
+        k[d] = 2.0 * z * om;
+        k[d + 1] = stiff;
+        c[0] = 2.0 * z;
+        c[1] = -2.0 * om;
+        c[d] = 2.0 * om;
+        c[d + 1] = 2.0 * z;
+        m[0] = 1.0;
+        m[d + 1] = 1.0;
+        for i in 0..self.n_balls() {
+            let j = 2 + i;
+            let (s, cs) = q[j].sin_cos();
+            let mi = self.m(i);
+            let w = om + v[j];
+            let ab = a[j];
+            // x row
+            m[j] = -mi * s;
+            c[j] = -2.0 * mi * w * cs;
+            k[j] = -mi * cs * ab + mi * w * w * s;
+            // y row
+            m[d + j] = mi * cs;
+            c[d + j] = -2.0 * mi * w * s;
+            k[d + j] = -mi * s * ab - mi * w * w * cs;
+            // ball row
+            let r = j * d;
+            m[r] = -s;
+            m[r + 1] = cs;
+            m[r + j] = dl;
+            c[r] = 2.0 * om * cs;
+            c[r + 1] = 2.0 * om * s;
+            c[r + j] = 2.0 * self.zeta_b[i] * dl;
+            k[r] = om * om * s;
+            k[r + 1] = -om * om * cs;
+            k[r + j] = -cs * a[0] - s * a[1]
+                + 2.0 * om * (-s * v[0] + cs * v[1])
+                + om * om * (q[0] * cs + q[1] * s);
+        }
+    }
+
+    fn accel(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        // The mass matrix is an arrow: eliminate the ball rows (Schur complement)
+        // and solve the remaining 2 x 2 system, O(n) instead of a dense LU.
+        self.forces(q, v, out);
+        let n = self.n_balls();
+        let dl = self.delta;
+        let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
+        let (mut r1, mut r2) = (-out[0], -out[1]);
+        for i in 0..n {
+            let (s, c) = q[2 + i].sin_cos();
+            let mi = self.m(i);
+            let gb = out[2 + i];
+            a11 -= mi * s * s / dl;
+            a12 += mi * s * c / dl;
+            a22 -= mi * c * c / dl;
+            r1 -= mi * s * gb / dl;
+            r2 += mi * c * gb / dl;
+        }
+        let det = a11 * a22 - a12 * a12;
+        let ax = (r1 * a22 - a12 * r2) / det;
+        let ay = (a11 * r2 - a12 * r1) / det;
+        out[0] = ax;
+        out[1] = ay;
+        for i in 0..n {
+            let (s, c) = q[2 + i].sin_cos();
+            out[2 + i] = (-out[2 + i] + s * ax - c * ay) / dl;
+        }
+    }
+}
+
+/// First-order right-hand side `y' = f(t, y)` with `y = (q, v)`.
+pub fn first_order_rhs<D: Dynamics + ?Sized>(model: &D, t: f64, y: &[f64], dy: &mut [f64]) {
+    let d = model.ndof();
+    let (q, v) = y.split_at(d);
+    dy[..d].copy_from_slice(v);
+    model.accel(t, q, v, &mut dy[d..]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Planar {
+        Planar::new(0.2, 0.05, &[0.07], 50.0, 1.3, &[0.9, 1.1]).unwrap()
+    }
+
+    #[test]
+    fn accel_solves_residual() {
+        let p = sample();
+        let q = [0.3, -0.2, 0.7, -1.9];
+        let v = [0.1, 0.4, -1.2, 0.3];
+        let mut a = [0.0; 4];
+        p.accel(0.0, &q, &v, &mut a);
+        let mut r = [0.0; 4];
+        p.residual(0.0, &q, &v, &a, &mut r);
+        for x in r {
+            assert!(x.abs() < 1e-13, "{r:?}");
+        }
+    }
+
+    #[test]
+    fn jacobians_match_finite_differences() {
+        let p = sample();
+        let q = [0.3, -0.2, 0.7, -1.9];
+        let v = [0.1, 0.4, -1.2, 0.3];
+        let a = [0.5, -0.3, 0.2, 0.9];
+        let d = 4;
+        let (mut k, mut c, mut m) = (vec![0.0; 16], vec![0.0; 16], vec![0.0; 16]);
+        p.jacobians(0.0, &q, &v, &a, &mut k, &mut c, &mut m);
+        let h = 1e-6;
+        for (which, jac) in [(0, &k), (1, &c), (2, &m)] {
+            for col in 0..d {
+                let mut args = [q, v, a];
+                args[which][col] += h;
+                let mut rp = [0.0; 4];
+                p.residual(0.0, &args[0], &args[1], &args[2], &mut rp);
+                args[which][col] -= 2.0 * h;
+                let mut rm = [0.0; 4];
+                p.residual(0.0, &args[0], &args[1], &args[2], &mut rm);
+                for row in 0..d {
+                    let fd = (rp[row] - rm[row]) / (2.0 * h);
+                    let an = jac[row * d + col];
+                    assert!((fd - an).abs() < 1e-7, "jac {which} ({row},{col}): fd {fd} vs {an}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn validation_names_parameters() {
+        let e = Planar::new(0.2, -0.1, &[0.05], 50.0, 1.0, &[1.0]).unwrap_err();
+        assert!(e.to_string().starts_with("zeta:"), "{e}");
+        let e = Planar::new(0.2, 0.1, &[0.05], 50.0, 1.0, &[]).unwrap_err();
+        assert!(e.to_string().contains("n = 0"), "{e}");
+        let e = Planar::new(0.2, 0.1, &[0.05], 50.0, f64::NAN, &[1.0]).unwrap_err();
+        assert!(e.to_string().starts_with("Omega:"), "{e}");
+        let e = Planar::new(0.2, 0.1, &[0.05], 50.0, 1.0, &[1.0, 0.0]).unwrap_err();
+        assert!(e.to_string().starts_with("eta[1]:"), "{e}");
+    }
+}

@@ -1,0 +1,509 @@
+//! Dormand–Prince 5(4) (RK45) with scipy-compatible error control and Hairer's
+//! 4th-order dense output, so results at requested times do not force tiny steps.
+//!
+//! Conventions follow `scipy.integrate.solve_ivp(method="RK45")`: the local error is
+//! measured in the RMS norm of `err_i / (atol_i + rtol * max(|y_i|, |y_new_i|))`, the
+//! step grows by at most 10 and shrinks by at most 5, with safety factor 0.9, and the
+//! first step is chosen by the same heuristic (Hairer, Norsett & Wanner, II.4).
+
+use crate::error::{Error, Result};
+
+const C2: f64 = 1.0 / 5.0;
+const C3: f64 = 3.0 / 10.0;
+const C4: f64 = 4.0 / 5.0;
+const C5: f64 = 8.0 / 9.0;
+const A21: f64 = 1.0 / 5.0;
+const A31: f64 = 3.0 / 40.0;
+const A32: f64 = 9.0 / 40.0;
+const A41: f64 = 44.0 / 45.0;
+const A42: f64 = -56.0 / 15.0;
+const A43: f64 = 32.0 / 9.0;
+const A51: f64 = 19372.0 / 6561.0;
+const A52: f64 = -25360.0 / 2187.0;
+const A53: f64 = 64448.0 / 6561.0;
+const A54: f64 = -212.0 / 729.0;
+const A61: f64 = 9017.0 / 3168.0;
+const A62: f64 = -355.0 / 33.0;
+const A63: f64 = 46732.0 / 5247.0;
+const A64: f64 = 49.0 / 176.0;
+const A65: f64 = -5103.0 / 18656.0;
+const A71: f64 = 35.0 / 384.0;
+const A73: f64 = 500.0 / 1113.0;
+const A74: f64 = 125.0 / 192.0;
+const A75: f64 = -2187.0 / 6784.0;
+const A76: f64 = 11.0 / 84.0;
+const E1: f64 = 71.0 / 57600.0;
+const E3: f64 = -71.0 / 16695.0;
+const E4: f64 = 71.0 / 1920.0;
+const E5: f64 = -17253.0 / 339200.0;
+const E6: f64 = 22.0 / 525.0;
+const E7: f64 = -1.0 / 40.0;
+// Hairer's dense-output coefficients for DOPRI5.
+const D1: f64 = -12715105075.0 / 11282082432.0;
+const D3: f64 = 87487479700.0 / 32700410799.0;
+const D4: f64 = -10690763975.0 / 1880347072.0;
+const D5: f64 = 701980252875.0 / 199316789632.0;
+const D6: f64 = -1453857185.0 / 822651844.0;
+const D7: f64 = 69997945.0 / 29380423.0;
+
+/// Tolerances and limits, named as in scipy.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub rtol: f64,
+    /// One value for all components, or one per component.
+    pub atol: Vec<f64>,
+    /// Initial step; `None` selects it automatically.
+    pub first_step: Option<f64>,
+    pub max_step: f64,
+    pub max_steps: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            rtol: 1e-6,
+            atol: vec![1e-9],
+            first_step: None,
+            max_step: f64::INFINITY,
+            max_steps: 10_000_000,
+        }
+    }
+}
+
+impl Options {
+    pub fn new(rtol: f64, atol: f64) -> Self {
+        Options {
+            rtol,
+            atol: vec![atol],
+            ..Default::default()
+        }
+    }
+
+    pub fn validate(&self, n: usize) -> Result<()> {
+        if !(self.rtol.is_finite() && self.rtol > 0.0) {
+            return Err(Error::param(
+                "rtol",
+                format!("must be a finite number > 0, got {}", self.rtol),
+            ));
+        }
+        if self.atol.len() != 1 && self.atol.len() != n {
+            return Err(Error::param(
+                "atol",
+                format!("needs 1 value or one per state ({n}), got {}", self.atol.len()),
+            ));
+        }
+        if self.atol.iter().any(|a| !(a.is_finite() && *a >= 0.0)) {
+            return Err(Error::param("atol", "must be finite and >= 0"));
+        }
+        if !(self.max_step > 0.0) {
+            return Err(Error::param("max_step", "must be > 0"));
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn atol(&self, i: usize) -> f64 {
+        if self.atol.len() == 1 {
+            self.atol[0]
+        } else {
+            self.atol[i]
+        }
+    }
+}
+
+/// Counters of one integration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Stats {
+    pub accepted: usize,
+    pub rejected: usize,
+    pub rhs_evals: usize,
+}
+
+/// Reusable stage storage for one state dimension.
+pub struct Dopri5 {
+    n: usize,
+    k: [Vec<f64>; 7],
+    y_new: Vec<f64>,
+    tmp: Vec<f64>,
+    err: Vec<f64>,
+    cont: [Vec<f64>; 5],
+}
+
+impl Dopri5 {
+    pub fn new(n: usize) -> Self {
+        let z = || vec![0.0; n];
+        Dopri5 {
+            n,
+            k: [z(), z(), z(), z(), z(), z(), z()],
+            y_new: z(),
+            tmp: z(),
+            err: z(),
+            cont: [z(), z(), z(), z(), z()],
+        }
+    }
+
+    fn rms_scaled(&self, v: &[f64], y: &[f64], opts: &Options) -> f64 {
+        let mut s = 0.0;
+        for i in 0..self.n {
+            let sc = opts.atol(i) + opts.rtol * y[i].abs();
+            let r = v[i] / sc;
+            s += r * r;
+        }
+        (s / self.n as f64).sqrt()
+    }
+
+    fn initial_step<F>(&mut self, f: &mut F, t0: f64, y0: &[f64], dir: f64, opts: &Options) -> f64
+    where
+        F: FnMut(f64, &[f64], &mut [f64]),
+    {
+        // scipy's select_initial_step, order 4 error estimator.
+        let f0 = self.k[0].clone();
+        let d0 = self.rms_scaled(y0, y0, opts);
+        let d1 = self.rms_scaled(&f0, y0, opts);
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+        for i in 0..self.n {
+            self.tmp[i] = y0[i] + dir * h0 * f0[i];
+        }
+        let tmp = self.tmp.clone();
+        f(t0 + dir * h0, &tmp, &mut self.err);
+        for i in 0..self.n {
+            self.err[i] -= f0[i];
+        }
+        let diff = self.err.clone();
+        let d2 = self.rms_scaled(&diff, y0, opts) / h0;
+        let h1 = if d1 <= 1e-15 && d2 <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / 5.0)
+        };
+        (100.0 * h0).min(h1).min(opts.max_step)
+    }
+
+    /// Integrates from `t0` towards `t1` and calls `observe(t_a, t_b, dense)` after every
+    /// accepted step, where `dense.eval(t, out)` interpolates inside `[t_a, t_b]`.
+    /// `observe` returns `false` to stop early. Returns the final time reached and the state.
+    pub fn integrate<F, O>(
+        &mut self,
+        mut f: F,
+        t0: f64,
+        y0: &[f64],
+        t1: f64,
+        opts: &Options,
+        mut observe: O,
+    ) -> Result<(f64, Vec<f64>, Stats)>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]),
+        O: FnMut(f64, f64, &Dense<'_>) -> bool,
+    {
+        assert_eq!(y0.len(), self.n);
+        opts.validate(self.n)?;
+        let mut stats = Stats::default();
+        let mut y = y0.to_vec();
+        let mut t = t0;
+        if t1 == t0 {
+            return Ok((t, y, stats));
+        }
+        let dir = if t1 > t0 { 1.0 } else { -1.0 };
+        f(t, &y, &mut self.k[0]);
+        stats.rhs_evals += 1;
+        let mut h = match opts.first_step {
+            Some(h) => h.abs(),
+            None => {
+                stats.rhs_evals += 1;
+                self.initial_step(&mut f, t0, &y, dir, opts)
+            }
+        };
+        let n = self.n;
+        let mut rejected_last = false;
+        loop {
+            if stats.accepted + stats.rejected >= opts.max_steps {
+                return Err(Error::Integration(format!(
+                    "more than max_steps = {} steps before t = {t1} (reached t = {t})",
+                    opts.max_steps
+                )));
+            }
+            let min_step = 10.0 * (f64::EPSILON * t.abs()).max(f64::MIN_POSITIVE);
+            h = h.min(opts.max_step);
+            if h < min_step {
+                return Err(Error::Integration(format!("step size underflow at t = {t}")));
+            }
+            let mut hs = h * dir;
+            let mut last = false;
+            if dir * (t + hs - t1) >= 0.0 {
+                hs = t1 - t;
+                last = true;
+            }
+            self.stages(&mut f, t, &y, hs);
+            stats.rhs_evals += 6;
+            // Error estimate.
+            for i in 0..n {
+                self.err[i] = hs
+                    * (E1 * self.k[0][i]
+                        + E3 * self.k[2][i]
+                        + E4 * self.k[3][i]
+                        + E5 * self.k[4][i]
+                        + E6 * self.k[5][i]
+                        + E7 * self.k[6][i]);
+            }
+            let mut s = 0.0;
+            let mut finite = true;
+            for i in 0..n {
+                let sc = opts.atol(i) + opts.rtol * y[i].abs().max(self.y_new[i].abs());
+                let r = self.err[i] / sc;
+                finite &= self.y_new[i].is_finite();
+                s += r * r;
+            }
+            let en = (s / n as f64).sqrt();
+            if !finite || !en.is_finite() {
+                // Treat a blow-up inside the step like a huge error: shrink hard.
+                h *= 0.2;
+                stats.rejected += 1;
+                rejected_last = true;
+                continue;
+            }
+            if en <= 1.0 {
+                let mut fac = if en == 0.0 { 10.0 } else { (0.9 * en.powf(-0.2)).min(10.0) };
+                if rejected_last {
+                    fac = fac.min(1.0);
+                }
+                // Dense output coefficients for this step.
+                for i in 0..n {
+                    let ydiff = self.y_new[i] - y[i];
+                    let bspl = hs * self.k[0][i] - ydiff;
+                    self.cont[0][i] = y[i];
+                    self.cont[1][i] = ydiff;
+                    self.cont[2][i] = bspl;
+                    self.cont[3][i] = ydiff - hs * self.k[6][i] - bspl;
+                    self.cont[4][i] = hs
+                        * (D1 * self.k[0][i]
+                            + D3 * self.k[2][i]
+                            + D4 * self.k[3][i]
+                            + D5 * self.k[4][i]
+                            + D6 * self.k[5][i]
+                            + D7 * self.k[6][i]);
+                }
+                let t_new = if last { t1 } else { t + hs };
+                stats.accepted += 1;
+                let dense = Dense {
+                    t0: t,
+                    h: hs,
+                    cont: &self.cont,
+                };
+                let go_on = observe(t, t_new, &dense);
+                t = t_new;
+                y.copy_from_slice(&self.y_new);
+                // FSAL: the last stage is the next step's first.
+                let (a, b) = self.k.split_at_mut(6);
+                a[0].copy_from_slice(&b[0]);
+                rejected_last = false;
+                if last || !go_on {
+                    return Ok((t, y, stats));
+                }
+                h *= fac;
+            } else {
+                h *= (0.9 * en.powf(-0.2)).max(0.2);
+                stats.rejected += 1;
+                rejected_last = true;
+            }
+        }
+    }
+
+    fn stages<F>(&mut self, f: &mut F, t: f64, y: &[f64], h: f64)
+    where
+        F: FnMut(f64, &[f64], &mut [f64]),
+    {
+        let n = self.n;
+        macro_rules! stage {
+            ($dst:expr, $c:expr, $($a:expr => $kk:expr),+) => {{
+                for i in 0..n {
+                    self.tmp[i] = y[i] + h * (0.0 $( + $a * self.k[$kk][i])+);
+                }
+                let (tmp, k) = (&self.tmp, &mut self.k);
+                f(t + $c * h, tmp, &mut k[$dst]);
+            }};
+        }
+        stage!(1, C2, A21 => 0);
+        stage!(2, C3, A31 => 0, A32 => 1);
+        stage!(3, C4, A41 => 0, A42 => 1, A43 => 2);
+        stage!(4, C5, A51 => 0, A52 => 1, A53 => 2, A54 => 3);
+        stage!(5, 1.0, A61 => 0, A62 => 1, A63 => 2, A64 => 3, A65 => 4);
+        for i in 0..n {
+            self.y_new[i] = y[i]
+                + h * (A71 * self.k[0][i]
+                    + A73 * self.k[2][i]
+                    + A74 * self.k[3][i]
+                    + A75 * self.k[4][i]
+                    + A76 * self.k[5][i]);
+        }
+        let (yn, k) = (&self.y_new, &mut self.k);
+        f(t + h, yn, &mut k[6]);
+    }
+}
+
+/// Dense output of one accepted step.
+pub struct Dense<'a> {
+    t0: f64,
+    h: f64,
+    cont: &'a [Vec<f64>; 5],
+}
+
+impl Dense<'_> {
+    pub fn eval(&self, t: f64, out: &mut [f64]) {
+        let th = (t - self.t0) / self.h;
+        let th1 = 1.0 - th;
+        let c = self.cont;
+        for i in 0..out.len() {
+            out[i] = c[0][i] + th * (c[1][i] + th1 * (c[2][i] + th * (c[3][i] + th1 * c[4][i])));
+        }
+    }
+}
+
+/// Integrates and returns the state at each of `t_eval` (strictly monotone, starting at
+/// or after `t0` in the direction of integration).
+pub fn solve_at<F>(
+    f: F,
+    t0: f64,
+    y0: &[f64],
+    t_eval: &[f64],
+    opts: &Options,
+) -> Result<(Vec<Vec<f64>>, Stats)>
+where
+    F: FnMut(f64, &[f64], &mut [f64]),
+{
+    let n = y0.len();
+    if t_eval.is_empty() {
+        return Ok((vec![], Stats::default()));
+    }
+    check_times(t0, t_eval)?;
+    let t1 = *t_eval.last().unwrap();
+    let dir = if t1 >= t0 { 1.0 } else { -1.0 };
+    let mut out: Vec<Vec<f64>> = Vec::with_capacity(t_eval.len());
+    let mut idx = 0;
+    while idx < t_eval.len() && t_eval[idx] == t0 {
+        out.push(y0.to_vec());
+        idx += 1;
+    }
+    let mut solver = Dopri5::new(n);
+    let (_, _, stats) = solver.integrate(f, t0, y0, t1, opts, |ta, tb, dense| {
+        while idx < t_eval.len() && dir * (t_eval[idx] - tb) <= 0.0 {
+            let _ = ta;
+            let mut v = vec![0.0; n];
+            if t_eval[idx] == tb {
+                // Exact end of step: dense output is exact there too, but avoid 0/0 when h tiny.
+                dense.eval(tb, &mut v);
+            } else {
+                dense.eval(t_eval[idx], &mut v);
+            }
+            out.push(v);
+            idx += 1;
+        }
+        true
+    })?;
+    Ok((out, stats))
+}
+
+/// Output times must be finite, strictly monotone, and not before `t0`.
+pub fn check_times(t0: f64, t_eval: &[f64]) -> Result<()> {
+    if !t0.is_finite() {
+        return Err(Error::param("t0", format!("must be finite, got {t0}")));
+    }
+    if let Some(bad) = t_eval.iter().find(|t| !t.is_finite()) {
+        return Err(Error::param("t_eval", format!("must be finite, got {bad}")));
+    }
+    let dir = if t_eval.last().copied().unwrap_or(t0) >= t0 { 1.0 } else { -1.0 };
+    let mut prev = t0;
+    for (i, &t) in t_eval.iter().enumerate() {
+        let ok = if i == 0 { dir * (t - prev) >= 0.0 } else { dir * (t - prev) > 0.0 };
+        if !ok {
+            return Err(Error::param(
+                "t_eval",
+                format!("must be strictly monotone and start at or after t0 = {t0}; entry {i} = {t} breaks the order"),
+            ));
+        }
+        prev = t;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Harmonic oscillator y'' = -y with exact solution (cos t, -sin t).
+    fn osc(_t: f64, y: &[f64], dy: &mut [f64]) {
+        dy[0] = y[1];
+        dy[1] = -y[0];
+    }
+
+    fn err_with_fixed_step(h: f64) -> f64 {
+        // Huge tolerances force every step to be accepted at exactly h.
+        let opts = Options {
+            rtol: 1e10,
+            atol: vec![1e10],
+            first_step: Some(h),
+            max_step: h,
+            max_steps: 1_000_000,
+        };
+        let mut s = Dopri5::new(2);
+        let (t, y, _) = s.integrate(osc, 0.0, &[1.0, 0.0], 2.0, &opts, |_, _, _| true).unwrap();
+        assert!((t - 2.0).abs() < 1e-15);
+        ((y[0] - 2f64.cos()).powi(2) + (y[1] + 2f64.sin()).powi(2)).sqrt()
+    }
+
+    #[test]
+    fn fifth_order_convergence() {
+        let e1 = err_with_fixed_step(0.1);
+        let e2 = err_with_fixed_step(0.05);
+        let order = (e1 / e2).log2();
+        assert!((order - 5.0).abs() < 0.3, "observed order {order}");
+    }
+
+    #[test]
+    fn dense_output_is_fourth_order_accurate() {
+        let opts = Options::new(1e-10, 1e-12);
+        let ts: Vec<f64> = (1..200).map(|i| i as f64 * 0.0501).collect();
+        let (ys, _) = solve_at(osc, 0.0, &[1.0, 0.0], &ts, &opts).unwrap();
+        for (t, y) in ts.iter().zip(&ys) {
+            assert!((y[0] - t.cos()).abs() < 1e-8, "t={t} {} {}", y[0], t.cos());
+        }
+    }
+
+    #[test]
+    fn step_control_meets_tolerance_and_scales() {
+        // Global error follows the tolerance; tighter rtol takes more steps.
+        let mut prev_steps = 0;
+        for rtol in [1e-4, 1e-6, 1e-8, 1e-10] {
+            let opts = Options::new(rtol, rtol * 1e-3);
+            let (ys, st) = solve_at(osc, 0.0, &[1.0, 0.0], &[10.0], &opts).unwrap();
+            let err = (ys[0][0] - 10f64.cos()).abs();
+            assert!(err < 50.0 * rtol, "rtol {rtol}: err {err}");
+            assert!(st.accepted > prev_steps);
+            prev_steps = st.accepted;
+        }
+    }
+
+    #[test]
+    fn backward_integration() {
+        let opts = Options::new(1e-10, 1e-12);
+        let (ys, _) = solve_at(osc, 0.0, &[1.0, 0.0], &[-1.0, -3.0], &opts).unwrap();
+        assert!((ys[1][0] - 3f64.cos()).abs() < 1e-8);
+        assert!((ys[1][1] - 3f64.sin()).abs() < 1e-8);
+    }
+
+    #[test]
+    fn rejects_bad_times() {
+        let opts = Options::default();
+        assert!(solve_at(osc, 0.0, &[1.0, 0.0], &[1.0, 0.5], &opts).is_err());
+        assert!(solve_at(osc, 0.0, &[1.0, 0.0], &[f64::NAN], &opts).is_err());
+    }
+
+    #[test]
+    fn stiff_blowup_reports_error_not_panic() {
+        let opts = Options {
+            max_steps: 1000,
+            ..Options::new(1e-6, 1e-9)
+        };
+        let r = solve_at(|_, y, dy| dy[0] = y[0] * y[0], 0.0, &[1.0], &[2.0], &opts);
+        assert!(r.is_err());
+    }
+}
