@@ -5,7 +5,9 @@
 //! eigenvalue and Routh–Hurwitz stability, periodic solutions by modified
 //! incremental harmonic balance, Floquet multipliers and parallel scans.
 
+pub mod equilibria;
 pub mod error;
+pub mod linalg;
 pub mod model;
 pub mod ode;
 pub mod simulate;

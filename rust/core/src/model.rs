@@ -29,7 +29,9 @@ pub trait Dynamics: Send + Sync {
         c: &mut [f64],
         m: &mut [f64],
     );
-    /// Accelerations solving `F(t, q, v, a) = 0`.
+    /// Solves `M(q) z = rhs` in place (`M = dF/da`).
+    fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]);
+    /// Accelerations solving `F(t, q, v, a) = 0`: `a = -M^-1 F(t, q, v, 0)`.
     fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]);
     /// `None` when the equations do not depend on `t`; otherwise the effect responsible.
     fn time_dependence(&self) -> Option<String> {
@@ -263,33 +265,38 @@ impl Dynamics for Planar {
         }
     }
 
-    fn accel(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+    fn solve_mass(&self, _t: f64, q: &[f64], rhs: &mut [f64]) {
         // The mass matrix is an arrow: eliminate the ball rows (Schur complement)
         // and solve the remaining 2 x 2 system, O(n) instead of a dense LU.
-        self.forces(q, v, out);
         let n = self.n_balls();
         let dl = self.delta;
         let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
-        let (mut r1, mut r2) = (-out[0], -out[1]);
+        let (mut r1, mut r2) = (rhs[0], rhs[1]);
         for i in 0..n {
             let (s, c) = q[2 + i].sin_cos();
             let mi = self.m(i);
-            let gb = out[2 + i];
+            let rb = rhs[2 + i];
             a11 -= mi * s * s / dl;
             a12 += mi * s * c / dl;
             a22 -= mi * c * c / dl;
-            r1 -= mi * s * gb / dl;
-            r2 += mi * c * gb / dl;
+            r1 += mi * s * rb / dl;
+            r2 -= mi * c * rb / dl;
         }
         let det = a11 * a22 - a12 * a12;
         let ax = (r1 * a22 - a12 * r2) / det;
         let ay = (a11 * r2 - a12 * r1) / det;
-        out[0] = ax;
-        out[1] = ay;
+        rhs[0] = ax;
+        rhs[1] = ay;
         for i in 0..n {
             let (s, c) = q[2 + i].sin_cos();
-            out[2 + i] = (-out[2 + i] + s * ax - c * ay) / dl;
+            rhs[2 + i] = (rhs[2 + i] + s * ax - c * ay) / dl;
         }
+    }
+
+    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        self.forces(q, v, out);
+        out.iter_mut().for_each(|g| *g = -*g);
+        self.solve_mass(t, q, out);
     }
 }
 
@@ -320,6 +327,23 @@ mod tests {
         p.residual(0.0, &q, &v, &a, &mut r);
         for x in r {
             assert!(x.abs() < 1e-13, "{r:?}");
+        }
+    }
+
+    #[test]
+    fn solve_mass_inverts_mass_matrix() {
+        let p = sample();
+        let q = [0.3, -0.2, 0.7, -1.9];
+        let (mut k, mut c, mut m) = (vec![0.0; 16], vec![0.0; 16], vec![0.0; 16]);
+        p.jacobians(0.0, &q, &[0.0; 4], &[0.0; 4], &mut k, &mut c, &mut m);
+        let z = [0.4, -1.0, 2.0, 0.25];
+        let mut r = [0.0; 4];
+        for i in 0..4 {
+            r[i] = (0..4).map(|j| m[i * 4 + j] * z[j]).sum();
+        }
+        p.solve_mass(0.0, &q, &mut r);
+        for i in 0..4 {
+            assert!((r[i] - z[i]).abs() < 1e-13);
         }
     }
 

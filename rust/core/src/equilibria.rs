@@ -1,0 +1,447 @@
+//! Equilibria of the balancer (balls at rest relative to the disk) and their stability.
+//!
+//! At rest `F(q, 0, 0) = 0`. For two equal balls the three families have closed forms
+//! (spec section 3; seeds 001 and 003): perfect balance `x = y = 0`,
+//! `b_1 = -b_2 = arccos(-1/(2 eta))`; balls together `b_1 = b_2 = b` with
+//! `A sin b + Omega cos b = -2 eta Omega`, `A = (1 - Omega^2) / (2 zeta)`; balls opposite
+//! `b_2 = b_1 + pi` with `A sin b + Omega cos b = 0`; for the unbalanced ones the disk
+//! centre sits on the balls' line at signed distance `r = -mu Omega sin b / (2 zeta)`.
+//! Any other ball set is solved numerically from many starts.
+
+use crate::linalg::{eigenvalues, state_matrix};
+use crate::model::{Dynamics, Planar};
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    Stable,
+    Unstable,
+    /// Largest real part within the tolerance of zero.
+    Marginal,
+}
+
+impl Verdict {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Verdict::Stable => "stable",
+            Verdict::Unstable => "unstable",
+            Verdict::Marginal => "marginal",
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct Equilibrium {
+    /// "perfect_balance", "together", "opposite" or "unbalanced".
+    pub kind: String,
+    /// `(x, y, b_1, ..., b_n)`, angles wrapped to `(-pi, pi]`.
+    pub q: Vec<f64>,
+    /// Max-norm of `F(q, 0, 0)`.
+    pub residual: f64,
+    /// Eigenvalues of the `2(n+2)` first-order Jacobian, largest real part first.
+    pub eigenvalues: Vec<(f64, f64)>,
+    /// Relative-stability index of seed 001: the largest real part (of the
+    /// non-neutral eigenvalues for a perfect-balance family, n >= 3).
+    pub index: f64,
+    pub verdict: Verdict,
+    /// Eigenvalues excluded as neutral directions of a family of equilibria.
+    pub neutral: usize,
+    /// Routh–Hurwitz verdict (asymptotically stable?) from the characteristic polynomial.
+    pub routh_hurwitz: Option<bool>,
+    /// Characteristic polynomial, monic, highest power first (`a_0 = 1, ..., a_2d`).
+    pub char_poly: Vec<f64>,
+}
+
+/// Tolerance on the largest real part below which the verdict is `Marginal`.
+pub const EIG_TOL: f64 = 1e-9;
+
+pub fn wrap(a: f64) -> f64 {
+    let mut r = (a + PI).rem_euclid(2.0 * PI) - PI;
+    if r <= -PI {
+        r += 2.0 * PI;
+    }
+    r
+}
+
+fn static_residual(p: &Planar, q: &[f64], out: &mut [f64]) {
+    let z = vec![0.0; q.len()];
+    p.residual(0.0, q, &z, &z, out);
+}
+
+/// Analyse a point known (or claimed) to be an equilibrium.
+pub fn analyse(p: &Planar, q: &[f64], kind: &str) -> Equilibrium {
+    let d = p.ndof();
+    let z = vec![0.0; d];
+    let mut r = vec![0.0; d];
+    static_residual(p, q, &mut r);
+    let residual = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    p.jacobians(0.0, q, &z, &z, &mut k, &mut c, &mut m);
+    let mut a = vec![0.0; 4 * d * d];
+    let mut col = vec![0.0; d];
+    state_matrix(p, 0.0, q, &k, &c, &mut col, &mut a);
+    let ev = eigenvalues(&a, 2 * d).unwrap_or_default();
+    // A perfect balance with n >= 3 balls is an (n-2)-parameter family: those
+    // directions have zero eigenvalues and say nothing about attraction.
+    let neutral = if kind == "perfect_balance" && p.n_balls() >= 3 {
+        p.n_balls() - 2
+    } else {
+        0
+    };
+    let mut by_abs: Vec<&(f64, f64)> = ev.iter().collect();
+    by_abs.sort_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)));
+    let judged: Vec<&(f64, f64)> = by_abs.into_iter().skip(neutral).collect();
+    let index = judged.iter().map(|e| e.0).fold(f64::NEG_INFINITY, f64::max);
+    let verdict = if ev.is_empty() || !index.is_finite() {
+        Verdict::Marginal
+    } else if index < -EIG_TOL {
+        Verdict::Stable
+    } else if index > EIG_TOL {
+        Verdict::Unstable
+    } else {
+        Verdict::Marginal
+    };
+    let poly = char_poly(&k, &c, &m, d);
+    let rh = if neutral == 0 { Some(routh_hurwitz(&poly)) } else { None };
+    Equilibrium {
+        kind: kind.to_string(),
+        q: q.iter().enumerate().map(|(i, &v)| if i >= 2 { wrap(v) } else { v }).collect(),
+        residual,
+        eigenvalues: ev,
+        index,
+        verdict,
+        neutral,
+        routh_hurwitz: rh,
+        char_poly: poly,
+    }
+}
+
+fn equal_balls(p: &Planar) -> bool {
+    p.eta.windows(2).all(|w| w[0] == w[1])
+}
+
+fn classify(p: &Planar, q: &[f64]) -> &'static str {
+    if q[0].hypot(q[1]) < 1e-9 {
+        return "perfect_balance";
+    }
+    if p.n_balls() == 2 {
+        let diff = wrap(q[2] - q[3]);
+        if diff.abs() < 1e-7 {
+            return "together";
+        }
+        if (diff.abs() - PI).abs() < 1e-7 {
+            return "opposite";
+        }
+    }
+    "unbalanced"
+}
+
+/// Closed-form equilibria of two equal balls.
+fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, &'static str)> {
+    let eta = p.eta[0];
+    let (om, z, mu) = (p.omega_s, p.zeta, p.mu);
+    let mut out = vec![];
+    if eta >= 0.5 {
+        let b = (-1.0 / (2.0 * eta)).acos();
+        out.push((vec![0.0, 0.0, b, -b], "perfect_balance"));
+    }
+    if om == 0.0 {
+        return out;
+    }
+    // Unbalanced: disk centre on the balls' line, r = -mu Omega sin b / (2 zeta).
+    let place = |b: f64| -> (f64, f64) {
+        let r = if z > 0.0 {
+            -mu * om * b.sin() / (2.0 * z)
+        } else {
+            f64::NAN
+        };
+        (r * b.cos(), r * b.sin())
+    };
+    if z > 0.0 {
+        let a = (1.0 - om * om) / (2.0 * z);
+        let amp = a.hypot(om);
+        let phi = om.atan2(a);
+        // together: amp sin(b + phi) = -2 eta Omega
+        let rhs = -2.0 * eta * om / amp;
+        if rhs.abs() <= 1.0 {
+            let s = rhs.asin();
+            let mut roots = vec![s - phi, PI - s - phi];
+            if (roots[0] - roots[1]).abs() < 1e-12 {
+                roots.pop();
+            }
+            for b in roots {
+                let (x, y) = place(b);
+                out.push((vec![x, y, b, b], "together"));
+            }
+        }
+        // opposite: amp sin(b + phi) = 0; b and b + pi are the same configuration.
+        let b = -phi;
+        let (x, y) = place(b);
+        out.push((vec![x, y, b, b + PI], "opposite"));
+    }
+    out
+}
+
+/// Newton (least squares, so that families of equilibria do not stall it) on `F(q,0,0) = 0`.
+fn newton_static(p: &Planar, q0: &[f64]) -> Option<Vec<f64>> {
+    let d = p.ndof();
+    let z = vec![0.0; d];
+    let mut q = q0.to_vec();
+    let mut r = vec![0.0; d];
+    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    for _ in 0..60 {
+        static_residual(p, &q, &mut r);
+        let rn = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if !rn.is_finite() {
+            return None;
+        }
+        p.jacobians(0.0, &q, &z, &z, &mut k, &mut c, &mut m);
+        let j = DMatrix::from_row_slice(d, d, &k);
+        let svd = j.svd(true, true);
+        let rhs = DVector::from_column_slice(&r);
+        let step = svd.solve(&rhs, 1e-10 * svd.singular_values.max()).ok()?;
+        let sn = step.amax();
+        for i in 0..d {
+            q[i] -= step[i];
+        }
+        if rn < 1e-13 && sn < 1e-11 {
+            return Some(q);
+        }
+    }
+    static_residual(p, &q, &mut r);
+    let rn = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    (rn < 1e-10).then_some(q)
+}
+
+fn same_equilibrium(p: &Planar, a: &[f64], b: &[f64]) -> bool {
+    if (a[0] - b[0]).abs() > 1e-7 || (a[1] - b[1]).abs() > 1e-7 {
+        return false;
+    }
+    let n = p.n_balls();
+    let direct = (0..n).all(|i| wrap(a[2 + i] - b[2 + i]).abs() < 1e-6);
+    if direct {
+        return true;
+    }
+    if equal_balls(p) {
+        // Identical balls: the same physical state up to relabelling.
+        let mut sa: Vec<f64> = a[2..].iter().map(|&v| wrap(v)).collect();
+        let mut sb: Vec<f64> = b[2..].iter().map(|&v| wrap(v)).collect();
+        sa.sort_by(f64::total_cmp);
+        sb.sort_by(f64::total_cmp);
+        return sa.iter().zip(&sb).all(|(u, v)| wrap(u - v).abs() < 1e-6);
+    }
+    false
+}
+
+/// All equilibria found for the balancer, each analysed. Closed forms for two equal
+/// balls; otherwise Newton from a deterministic set of starts.
+pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
+    let n = p.n_balls();
+    let mut found: Vec<(Vec<f64>, String)> = vec![];
+    if n == 2 && equal_balls(p) && p.zeta > 0.0 {
+        for (q, kind) in closed_form_two_equal(p) {
+            found.push((q, kind.to_string()));
+        }
+    } else {
+        for q0 in starts(p) {
+            if let Some(q) = newton_static(p, &q0) {
+                if !found.iter().any(|(f, _)| same_equilibrium(p, f, &q)) {
+                    let kind = classify(p, &q).to_string();
+                    found.push((q, kind));
+                }
+            }
+        }
+    }
+    let order = |k: &str| match k {
+        "perfect_balance" => 0,
+        "together" => 1,
+        "opposite" => 2,
+        _ => 3,
+    };
+    found.sort_by(|a, b| order(&a.1).cmp(&order(&b.1)).then(a.0[0].total_cmp(&b.0[0])));
+    found.iter().map(|(q, k)| analyse(p, q, k)).collect()
+}
+
+fn starts(p: &Planar) -> Vec<Vec<f64>> {
+    let n = p.n_balls();
+    let per = match n {
+        1 => 24,
+        2 => 12,
+        3 => 6,
+        _ => 4,
+    };
+    let total = (per as u64).pow(n as u32).min(600) as usize;
+    let mut out = vec![];
+    for idx in 0..total {
+        let mut q = vec![0.0; n + 2];
+        let mut rem = idx;
+        for i in 0..n {
+            // Offset so that no start sits exactly on a symmetric (singular) point.
+            q[2 + i] = -PI + (rem % per) as f64 * 2.0 * PI / per as f64 + 0.1 + 0.01 * i as f64;
+            rem /= per;
+        }
+        out.push(q);
+    }
+    out
+}
+
+// ---------- characteristic polynomial and Routh–Hurwitz ----------
+
+type Poly = Vec<f64>; // ascending powers
+
+fn pmul(a: &Poly, b: &Poly) -> Poly {
+    if a.is_empty() || b.is_empty() {
+        return vec![];
+    }
+    let mut r = vec![0.0; a.len() + b.len() - 1];
+    for (i, x) in a.iter().enumerate() {
+        for (j, y) in b.iter().enumerate() {
+            r[i + j] += x * y;
+        }
+    }
+    r
+}
+
+fn padd(a: &mut Poly, b: &Poly, sign: f64) {
+    if a.len() < b.len() {
+        a.resize(b.len(), 0.0);
+    }
+    for (i, y) in b.iter().enumerate() {
+        a[i] += sign * y;
+    }
+}
+
+fn pdet(m: &[Poly], rows: &[usize], cols: &[usize], d: usize) -> Poly {
+    if rows.len() == 1 {
+        return m[rows[0] * d + cols[0]].clone();
+    }
+    let r = rows[0];
+    let rest: Vec<usize> = rows[1..].to_vec();
+    let mut acc: Poly = vec![0.0];
+    for (ci, &c) in cols.iter().enumerate() {
+        let e = &m[r * d + c];
+        if e.iter().all(|v| *v == 0.0) {
+            continue;
+        }
+        let sub: Vec<usize> = cols.iter().copied().filter(|&x| x != c).collect();
+        let minor = pdet(m, &rest, &sub, d);
+        let term = pmul(e, &minor);
+        padd(&mut acc, &term, if ci % 2 == 0 { 1.0 } else { -1.0 });
+    }
+    acc
+}
+
+/// `det(s^2 M + s C + K)` by cofactor expansion of the polynomial matrix, made monic,
+/// returned highest power first. Independent of the eigenvalue route.
+pub fn char_poly(k: &[f64], c: &[f64], m: &[f64], d: usize) -> Vec<f64> {
+    let entries: Vec<Poly> = (0..d * d).map(|i| vec![k[i], c[i], m[i]]).collect();
+    let idx: Vec<usize> = (0..d).collect();
+    let mut p = pdet(&entries, &idx, &idx, d);
+    p.resize(2 * d + 1, 0.0);
+    let lead = p[2 * d];
+    p.iter_mut().for_each(|v| *v /= lead);
+    p.reverse();
+    p
+}
+
+/// Routh–Hurwitz: all roots in the open left half-plane iff every entry of the Routh
+/// array's first column is positive (for a monic polynomial). A zero entry means a
+/// root on or symmetric about the imaginary axis: not asymptotically stable.
+pub fn routh_hurwitz(a: &[f64]) -> bool {
+    let deg = a.len() - 1;
+    if a.iter().any(|v| !(*v > 0.0)) {
+        return false;
+    }
+    let width = deg / 2 + 1;
+    let mut prev: Vec<f64> = (0..width).map(|i| a.get(2 * i).copied().unwrap_or(0.0)).collect();
+    let mut cur: Vec<f64> = (0..width).map(|i| a.get(2 * i + 1).copied().unwrap_or(0.0)).collect();
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for _ in 0..deg.saturating_sub(1) {
+        if !(cur[0] > 1e-14 * scale) {
+            return false;
+        }
+        let mut next = vec![0.0; width];
+        for i in 0..width - 1 {
+            next[i] = (cur[0] * prev[i + 1] - prev[0] * cur[i + 1]) / cur[0];
+        }
+        prev = cur;
+        cur = next;
+    }
+    cur[0] > 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two(om: f64, eta: f64) -> Planar {
+        Planar::new(0.2, 0.05, &[0.1], 50.0, om, &[eta, eta]).unwrap()
+    }
+
+    #[test]
+    fn closed_forms_are_equilibria_and_numeric_path_finds_them() {
+        let p = two(1.3, 0.8);
+        let eqs = equilibria(&p);
+        assert_eq!(eqs[0].kind, "perfect_balance");
+        for e in &eqs {
+            assert!(e.residual < 1e-13, "{} residual {}", e.kind, e.residual);
+        }
+        // Numeric multistart on the same balancer (bypassing the closed forms).
+        for q0 in starts(&p) {
+            if let Some(q) = newton_static(&p, &q0) {
+                assert!(
+                    eqs.iter().any(|e| same_equilibrium(&p, &e.q, &q)),
+                    "numeric equilibrium {q:?} missing from closed forms"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn perfect_balance_needs_eta_half() {
+        assert!(equilibria(&two(1.5, 0.49)).iter().all(|e| e.kind != "perfect_balance"));
+        assert!(equilibria(&two(1.5, 0.51)).iter().any(|e| e.kind == "perfect_balance"));
+    }
+
+    #[test]
+    fn routh_hurwitz_simple() {
+        assert!(routh_hurwitz(&[1.0, 3.0, 3.0, 1.0])); // (s+1)^3
+        assert!(!routh_hurwitz(&[1.0, -1.0, 2.0])); // RHP roots
+        assert!(!routh_hurwitz(&[1.0, 0.0, 1.0])); // +-i
+        assert!(!routh_hurwitz(&[1.0, 1.0, 1.0, 1.0])); // (s+1)(s^2+1)
+    }
+
+    #[test]
+    fn routh_hurwitz_agrees_with_eigenvalues_on_grid() {
+        let mut checked = 0;
+        for i in 0..26 {
+            for j in 0..11 {
+                let om = 0.5 + 0.1 * i as f64;
+                let eta = 0.5 + 0.1 * j as f64;
+                let p = two(om, eta);
+                for e in equilibria(&p) {
+                    if e.index.abs() > 1e-6 {
+                        assert_eq!(
+                            e.routh_hurwitz.unwrap(),
+                            e.verdict == Verdict::Stable,
+                            "Omega {om} eta {eta} {}",
+                            e.kind
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 500);
+    }
+
+    #[test]
+    fn three_balls_perfect_balance_family() {
+        let p = Planar::new(0.2, 0.05, &[0.1], 50.0, 1.5, &[0.6, 0.6, 0.6]).unwrap();
+        let eqs = equilibria(&p);
+        let pb = eqs.iter().find(|e| e.kind == "perfect_balance").expect("perfect balance");
+        assert!(pb.residual < 1e-10);
+        assert_eq!(pb.neutral, 1);
+    }
+}

@@ -1,0 +1,104 @@
+//! Thin wrappers over faer (LU, general eigenvalues) and nalgebra (small dense
+//! solves) working on row-major slices, the layout the model fills.
+
+use faer::prelude::*;
+use faer::Mat;
+use crate::model::Dynamics;
+
+/// Eigenvalues `(re, im)` of the row-major `n x n` matrix `a`, sorted by decreasing
+/// real part then imaginary part, or `None` if the QR iteration failed.
+pub fn eigenvalues(a: &[f64], n: usize) -> Option<Vec<(f64, f64)>> {
+    let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+    let ev = m.eigenvalues().ok()?;
+    let mut out: Vec<(f64, f64)> = ev.iter().map(|z| (z.re, z.im)).collect();
+    if out.iter().any(|(r, i)| !r.is_finite() || !i.is_finite()) {
+        return None;
+    }
+    out.sort_by(|a, b| b.0.total_cmp(&a.0).then(b.1.total_cmp(&a.1)));
+    Some(out)
+}
+
+/// Result of a dense LU solve with a cheap conditioning indicator.
+pub struct LuSolve {
+    pub x: Vec<f64>,
+    /// max |u_ii| / min |u_ii| of the LU factor: a lower bound on the condition number.
+    pub pivot_ratio: f64,
+}
+
+/// Solves the row-major `n x n` system `a x = b` by partial-pivoting LU (faer).
+/// Returns `None` when the matrix is numerically singular or the result is not finite.
+pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
+    let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+    let lu = m.partial_piv_lu();
+    let u = lu.U();
+    let (mut umax, mut umin) = (0.0f64, f64::INFINITY);
+    for i in 0..n {
+        let v = u[(i, i)].abs();
+        umax = umax.max(v);
+        umin = umin.min(v);
+    }
+    if !(umin > umax * 1e-15) || !umax.is_finite() {
+        return None;
+    }
+    let rhs = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
+    let sol = lu.solve(&rhs);
+    let x: Vec<f64> = (0..n).map(|i| sol[(i, 0)]).collect();
+    if x.iter().any(|v| !v.is_finite()) {
+        return None;
+    }
+    Some(LuSolve {
+        x,
+        pivot_ratio: umax / umin,
+    })
+}
+
+/// First-order state matrix `A = [[0, I], [-M^-1 K, -M^-1 C]]` (row-major, `2d x 2d`),
+/// using the model's own mass solve; `col` is scratch of length `d`.
+pub fn state_matrix<D: Dynamics + ?Sized>(
+    model: &D,
+    t: f64,
+    q: &[f64],
+    k: &[f64],
+    c: &[f64],
+    col: &mut [f64],
+    out: &mut [f64],
+) {
+    let d = model.ndof();
+    let n2 = 2 * d;
+    for i in 0..d {
+        out[i * n2..(i + 1) * n2].fill(0.0);
+        out[i * n2 + d + i] = 1.0;
+    }
+    for (src, off) in [(k, 0), (c, d)] {
+        for j in 0..d {
+            for i in 0..d {
+                col[i] = -src[i * d + j];
+            }
+            model.solve_mass(t, q, col);
+            for i in 0..d {
+                out[(d + i) * n2 + off + j] = col[i];
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eigenvalues_of_companion() {
+        // x^2 + 2x + 5 -> -1 +- 2i
+        let a = [0.0, 1.0, -5.0, -2.0];
+        let ev = eigenvalues(&a, 2).unwrap();
+        assert!((ev[0].0 + 1.0).abs() < 1e-12 && (ev[0].1 - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lu_solves_and_flags_singular() {
+        let a = [2.0, 1.0, 1.0, 3.0];
+        let s = lu_solve(&a, 2, &[3.0, 5.0]).unwrap();
+        assert!((s.x[0] - 0.8).abs() < 1e-14 && (s.x[1] - 1.4).abs() < 1e-14);
+        assert!(lu_solve(&[1.0, 2.0, 2.0, 4.0], 2, &[1.0, 1.0]).is_none());
+    }
+}
