@@ -6,10 +6,13 @@
 //! incremental harmonic balance, Floquet multipliers and parallel scans.
 
 pub mod equilibria;
+pub mod floquet;
+pub mod hb;
 pub mod error;
 pub mod linalg;
 pub mod model;
 pub mod ode;
+pub mod periodic;
 pub mod simulate;
 
 pub use error::{Error, Result};

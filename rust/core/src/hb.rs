@@ -1,0 +1,671 @@
+//! Periodic solutions by modified incremental harmonic balance (MIHB).
+//!
+//! Each coordinate is a truncated Fourier series in `tau = omega t` plus a secular term
+//! `w_j tau` (`w_j = -1` for a ball that lags the disk by one turn per period, 0 for one
+//! that oscillates). The Galerkin projection of the residual on `1, cos m tau, sin m tau`
+//! is evaluated by alternating frequency–time sampling, and Newton iterates on the
+//! coefficients and `omega` with an analytic Jacobian (chain rule through the model's
+//! `K, C, M`), a faer LU and a backtracking line search. One extra equation fixes the
+//! free time shift: `b_r(0) = 0` for the first rotating ball `r`, otherwise the
+//! `sin tau` coefficient of `x` is zero (spec section 4).
+
+use crate::linalg::lu_solve;
+use crate::model::Dynamics;
+use std::f64::consts::PI;
+
+/// Coefficient layout per coordinate: `[a_0, a_1, b_1, ..., a_N, b_N]`.
+#[derive(Debug, Clone)]
+pub struct Basis {
+    pub n_harm: usize,
+    pub samples: usize,
+    /// Row-major `S x L` tables of the basis and its first two tau-derivatives.
+    phi: Vec<f64>,
+    dphi: Vec<f64>,
+    ddphi: Vec<f64>,
+    /// Galerkin weights `S x L`: basis times 1/S (mean) or 2/S (harmonics).
+    wgt: Vec<f64>,
+    tau: Vec<f64>,
+}
+
+impl Basis {
+    pub fn new(n_harm: usize, samples: usize) -> Self {
+        let l = 2 * n_harm + 1;
+        let s = samples;
+        let mut phi = vec![0.0; s * l];
+        let mut dphi = vec![0.0; s * l];
+        let mut ddphi = vec![0.0; s * l];
+        let mut wgt = vec![0.0; s * l];
+        let mut tau = vec![0.0; s];
+        for i in 0..s {
+            let t = 2.0 * PI * i as f64 / s as f64;
+            tau[i] = t;
+            phi[i * l] = 1.0;
+            wgt[i * l] = 1.0 / s as f64;
+            for m in 1..=n_harm {
+                let mf = m as f64;
+                let (sn, cs) = (mf * t).sin_cos();
+                let (c, sidx) = (i * l + 2 * m - 1, i * l + 2 * m);
+                phi[c] = cs;
+                phi[sidx] = sn;
+                dphi[c] = -mf * sn;
+                dphi[sidx] = mf * cs;
+                ddphi[c] = -mf * mf * cs;
+                ddphi[sidx] = -mf * mf * sn;
+                wgt[c] = 2.0 * cs / s as f64;
+                wgt[sidx] = 2.0 * sn / s as f64;
+            }
+        }
+        Basis {
+            n_harm,
+            samples,
+            phi,
+            dphi,
+            ddphi,
+            wgt,
+            tau,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        2 * self.n_harm + 1
+    }
+}
+
+/// Default number of time samples per period for `N` harmonics: the products and
+/// trigonometric functions in the equations reach well beyond harmonic `N`, and four
+/// samples per retained harmonic and nonlinearity order keep aliasing below truncation.
+pub fn default_samples(n_harm: usize) -> usize {
+    (8 * (n_harm + 1)).max(16)
+}
+
+/// Evaluates one coordinate's series and its tau-derivatives at `tau`.
+pub fn eval_series(c: &[f64], w: f64, tau: f64) -> (f64, f64, f64) {
+    let n = (c.len() - 1) / 2;
+    let (mut q, mut qt, mut qtt) = (c[0] + w * tau, w, 0.0);
+    let (s1, c1) = tau.sin_cos();
+    let (mut sm, mut cm) = (0.0f64, 1.0f64);
+    for m in 1..=n {
+        // cos/sin of m tau by rotation recurrence: no trig call per harmonic.
+        let (ns, nc) = (sm * c1 + cm * s1, cm * c1 - sm * s1);
+        sm = ns;
+        cm = nc;
+        let mf = m as f64;
+        let (a, b) = (c[2 * m - 1], c[2 * m]);
+        q += a * cm + b * sm;
+        qt += mf * (-a * sm + b * cm);
+        qtt -= mf * mf * (a * cm + b * sm);
+    }
+    (q, qt, qtt)
+}
+
+/// Convergence status of a Newton–IHB solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    Converged,
+    /// The residual could not be reduced, grew without bound, or omega left (0, inf).
+    Diverged,
+    /// The Jacobian was numerically singular.
+    Singular,
+    MaxIterations,
+    /// No starting guess could be built (e.g. the simulation found no motion of this type).
+    NoGuess,
+}
+
+impl Status {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Status::Converged => "converged",
+            Status::Diverged => "diverged",
+            Status::Singular => "singular",
+            Status::MaxIterations => "max_iterations",
+            Status::NoGuess => "no_guess",
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct HbOptions {
+    pub n_harm: usize,
+    /// Time samples per period; `None` uses [`default_samples`].
+    pub samples: Option<usize>,
+    /// Max-norm of the harmonic-balance residual required for convergence.
+    pub tol: f64,
+    /// Max-norm of the last Newton step required for convergence.
+    pub step_tol: f64,
+    pub max_iter: usize,
+}
+
+impl Default for HbOptions {
+    fn default() -> Self {
+        HbOptions {
+            n_harm: 3,
+            samples: None,
+            tol: 1e-10,
+            step_tol: 1e-8,
+            max_iter: 50,
+        }
+    }
+}
+
+impl HbOptions {
+    pub fn validate(&self) -> crate::Result<()> {
+        use crate::Error;
+        if self.n_harm < 1 || self.n_harm > 256 {
+            return Err(Error::param("N", format!("must be in [1, 256], got {}", self.n_harm)));
+        }
+        if let Some(s) = self.samples {
+            let min = 2 * self.n_harm + 2;
+            if s < min || s > 1 << 16 {
+                return Err(Error::param(
+                    "samples",
+                    format!("must be in [{min}, 65536] (more than 2N + 1 to resolve N harmonics), got {s}"),
+                ));
+            }
+        }
+        if !(self.tol > 0.0 && self.tol.is_finite()) {
+            return Err(Error::param("tol", format!("must be a finite number > 0, got {}", self.tol)));
+        }
+        if !(self.step_tol > 0.0 && self.step_tol.is_finite()) {
+            return Err(Error::param(
+                "step_tol",
+                format!("must be a finite number > 0, got {}", self.step_tol),
+            ));
+        }
+        if self.max_iter == 0 || self.max_iter > 10_000 {
+            return Err(Error::param("max_iter", format!("must be in [1, 10000], got {}", self.max_iter)));
+        }
+        Ok(())
+    }
+}
+
+/// A harmonic-balance solution (or the last iterate of a failed solve).
+#[derive(Debug, Clone)]
+pub struct HbSolution {
+    pub omega: f64,
+    /// Row-major `d x (2N+1)` coefficients.
+    pub coeffs: Vec<f64>,
+    /// Secular slope per coordinate (`-1` for a rotating ball).
+    pub winding: Vec<f64>,
+    pub n_harm: usize,
+    pub samples: usize,
+    pub residual: f64,
+    pub step: f64,
+    pub iterations: usize,
+    pub status: Status,
+    /// max |u_ii| / min |u_ii| of the last LU: lower bound of the condition number.
+    pub pivot_ratio: f64,
+}
+
+impl HbSolution {
+    pub fn ndof(&self) -> usize {
+        self.winding.len()
+    }
+
+    pub fn coord(&self, j: usize) -> &[f64] {
+        let l = 2 * self.n_harm + 1;
+        &self.coeffs[j * l..(j + 1) * l]
+    }
+
+    /// `q, dq/dtau, d2q/dtau2` at phase `tau`.
+    pub fn eval(&self, tau: f64, q: &mut [f64], qt: &mut [f64], qtt: &mut [f64]) {
+        for j in 0..self.ndof() {
+            let (a, b, c) = eval_series(self.coord(j), self.winding[j], tau);
+            q[j] = a;
+            qt[j] = b;
+            qtt[j] = c;
+        }
+    }
+
+    /// First-order state `(q, q')` at time `t` (in units of 1/w_n).
+    pub fn state(&self, t: f64) -> Vec<f64> {
+        let d = self.ndof();
+        let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+        self.eval(self.omega * t, &mut q, &mut qt, &mut qtt);
+        q.extend(qt.iter().map(|v| v * self.omega));
+        q
+    }
+
+    pub fn period(&self) -> f64 {
+        2.0 * PI / self.omega
+    }
+
+    /// Magnitude of the highest retained harmonic over all coordinates: a truncation indicator.
+    pub fn tail(&self) -> f64 {
+        let n = self.n_harm;
+        (0..self.ndof())
+            .map(|j| {
+                let c = self.coord(j);
+                c[2 * n - 1].hypot(c[2 * n])
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The same solution with `n_harm` harmonics (truncated or zero-padded): a predictor.
+    pub fn resized(&self, n_harm: usize) -> HbSolution {
+        let (lo, ln) = (2 * self.n_harm + 1, 2 * n_harm + 1);
+        let mut coeffs = vec![0.0; self.ndof() * ln];
+        for j in 0..self.ndof() {
+            for p in 0..lo.min(ln) {
+                coeffs[j * ln + p] = self.coeffs[j * lo + p];
+            }
+        }
+        HbSolution {
+            coeffs,
+            n_harm,
+            ..self.clone()
+        }
+    }
+}
+
+/// Workspace and fixed data of one harmonic-balance problem.
+pub struct HbSystem<'a, D: Dynamics + ?Sized> {
+    model: &'a D,
+    d: usize,
+    basis: Basis,
+    winding: Vec<f64>,
+    /// Coordinate used by the phase condition and whether it is a rotating ball.
+    phase_coord: usize,
+    phase_rotating: bool,
+    // sample workspaces
+    q: Vec<f64>,
+    qt: Vec<f64>,
+    qtt: Vec<f64>,
+    f: Vec<f64>,
+    k: Vec<f64>,
+    c: Vec<f64>,
+    m: Vec<f64>,
+    g: Vec<f64>,
+}
+
+impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
+    pub fn new(model: &'a D, winding: &[f64], n_harm: usize, samples: usize) -> Self {
+        let d = model.ndof();
+        assert_eq!(winding.len(), d);
+        let basis = Basis::new(n_harm, samples);
+        let rot = winding.iter().position(|w| *w != 0.0);
+        let s = samples;
+        HbSystem {
+            model,
+            d,
+            basis,
+            winding: winding.to_vec(),
+            phase_coord: rot.unwrap_or(0),
+            phase_rotating: rot.is_some(),
+            q: vec![0.0; s * d],
+            qt: vec![0.0; s * d],
+            qtt: vec![0.0; s * d],
+            f: vec![0.0; s * d],
+            k: vec![0.0; s * d * d],
+            c: vec![0.0; s * d * d],
+            m: vec![0.0; s * d * d],
+            g: vec![0.0; s * (2 * n_harm + 1)],
+        }
+    }
+
+    /// Number of unknowns (coefficients and omega) and equations.
+    pub fn size(&self) -> usize {
+        self.d * self.basis.len() + 1
+    }
+
+    /// Samples the coordinates at every collocation time: `q = Phi c + w tau`.
+    fn sample(&mut self, x: &[f64]) {
+        let (d, l, s) = (self.d, self.basis.len(), self.basis.samples);
+        for i in 0..s {
+            let tau = self.basis.tau[i];
+            let (ph, dph, ddph) = (
+                &self.basis.phi[i * l..(i + 1) * l],
+                &self.basis.dphi[i * l..(i + 1) * l],
+                &self.basis.ddphi[i * l..(i + 1) * l],
+            );
+            for j in 0..d {
+                let cj = &x[j * l..(j + 1) * l];
+                let (mut a, mut b, mut cc) = (self.winding[j] * tau, self.winding[j], 0.0);
+                for p in 0..l {
+                    a += cj[p] * ph[p];
+                    b += cj[p] * dph[p];
+                    cc += cj[p] * ddph[p];
+                }
+                self.q[i * d + j] = a;
+                self.qt[i * d + j] = b;
+                self.qtt[i * d + j] = cc;
+            }
+        }
+    }
+
+    /// Residual `r` (length `size()`), and the Jacobian (row-major) when `jac` is given.
+    pub fn assemble(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut [f64]>) {
+        let (d, l, s) = (self.d, self.basis.len(), self.basis.samples);
+        let om = x[d * l];
+        self.sample(x);
+        let mut v = vec![0.0; d];
+        let mut a = vec![0.0; d];
+        let want_jac = jac.is_some();
+        for i in 0..s {
+            for j in 0..d {
+                v[j] = om * self.qt[i * d + j];
+                a[j] = om * om * self.qtt[i * d + j];
+            }
+            let t = self.basis.tau[i] / om;
+            let q = &self.q[i * d..(i + 1) * d];
+            self.model.residual(t, q, &v, &a, &mut self.f[i * d..(i + 1) * d]);
+            if want_jac {
+                let (kk, cc, mm) = (
+                    &mut self.k[i * d * d..(i + 1) * d * d],
+                    &mut self.c[i * d * d..(i + 1) * d * d],
+                    &mut self.m[i * d * d..(i + 1) * d * d],
+                );
+                self.model.jacobians(t, q, &v, &a, kk, cc, mm);
+            }
+        }
+        // Galerkin projection.
+        r.fill(0.0);
+        for i in 0..s {
+            let w = &self.basis.wgt[i * l..(i + 1) * l];
+            for j in 0..d {
+                let fj = self.f[i * d + j];
+                let row = &mut r[j * l..(j + 1) * l];
+                for p in 0..l {
+                    row[p] += w[p] * fj;
+                }
+            }
+        }
+        // Phase condition.
+        let pc = self.phase_coord;
+        r[d * l] = if self.phase_rotating {
+            x[pc * l] + (1..=self.basis.n_harm).map(|m| x[pc * l + 2 * m - 1]).sum::<f64>()
+        } else {
+            x[pc * l + 2]
+        };
+        let Some(jac) = jac else { return };
+        let n = self.size();
+        jac.fill(0.0);
+        let (om2, g) = (om * om, &mut self.g);
+        for j in 0..d {
+            for k in 0..d {
+                // Skip blocks where the coordinates do not interact at all.
+                let idx = j * d + k;
+                let any = (0..s).any(|i| {
+                    let o = i * d * d + idx;
+                    self.k[o] != 0.0 || self.c[o] != 0.0 || self.m[o] != 0.0
+                });
+                if !any {
+                    continue;
+                }
+                // G = K Phi + omega C Phi' + omega^2 M Phi''  (S x L)
+                for i in 0..s {
+                    let o = i * d * d + idx;
+                    let (kv, cv, mv) = (self.k[o], om * self.c[o], om2 * self.m[o]);
+                    let b = i * l;
+                    for p in 0..l {
+                        g[b + p] = kv * self.basis.phi[b + p] + cv * self.basis.dphi[b + p] + mv * self.basis.ddphi[b + p];
+                    }
+                }
+                // J block = W^T G
+                for i in 0..s {
+                    let w = &self.basis.wgt[i * l..(i + 1) * l];
+                    let gi = &g[i * l..(i + 1) * l];
+                    for rr in 0..l {
+                        let wr = w[rr];
+                        if wr == 0.0 {
+                            continue;
+                        }
+                        let row = &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
+                        for p in 0..l {
+                            row[p] += wr * gi[p];
+                        }
+                    }
+                }
+            }
+        }
+        // d/d omega: C q_tau + 2 omega M q_tautau
+        for i in 0..s {
+            let w = &self.basis.wgt[i * l..(i + 1) * l];
+            for j in 0..d {
+                let mut dfo = 0.0;
+                for k in 0..d {
+                    let o = i * d * d + j * d + k;
+                    dfo += self.c[o] * self.qt[i * d + k] + 2.0 * om * self.m[o] * self.qtt[i * d + k];
+                }
+                for rr in 0..l {
+                    jac[(j * l + rr) * n + d * l] += w[rr] * dfo;
+                }
+            }
+        }
+        let prow = d * l * n;
+        if self.phase_rotating {
+            jac[prow + pc * l] = 1.0;
+            for m in 1..=self.basis.n_harm {
+                jac[prow + pc * l + 2 * m - 1] = 1.0;
+            }
+        } else {
+            jac[prow + pc * l + 2] = 1.0;
+        }
+    }
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| if x.is_nan() { f64::NAN } else { m.max(x.abs()) })
+}
+
+/// Newton–IHB from the starting guess `guess` (its `coeffs`, `omega`, `winding`; resized
+/// to `opts.n_harm` if needed).
+pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptions) -> HbSolution {
+    let g = if guess.n_harm == opts.n_harm {
+        guess.clone()
+    } else {
+        guess.resized(opts.n_harm)
+    };
+    let samples = opts.samples.unwrap_or_else(|| default_samples(opts.n_harm));
+    let mut sys = HbSystem::new(model, &g.winding, opts.n_harm, samples);
+    let n = sys.size();
+    let mut x = g.coeffs.clone();
+    x.push(g.omega);
+    let mut r = vec![0.0; n];
+    let mut rt = vec![0.0; n];
+    let mut jac = vec![0.0; n * n];
+    let mut out = HbSolution {
+        omega: g.omega,
+        coeffs: g.coeffs.clone(),
+        winding: g.winding.clone(),
+        n_harm: opts.n_harm,
+        samples,
+        residual: f64::INFINITY,
+        step: f64::INFINITY,
+        iterations: 0,
+        status: Status::MaxIterations,
+        pivot_ratio: f64::NAN,
+    };
+    let finish = |x: &[f64], out: &mut HbSolution, status: Status, res: f64, step: f64, it: usize| {
+        out.coeffs.copy_from_slice(&x[..n - 1]);
+        out.omega = x[n - 1];
+        out.status = status;
+        out.residual = res;
+        out.step = step;
+        out.iterations = it;
+    };
+    if !(g.omega > 0.0) || x.iter().any(|v| !v.is_finite()) {
+        finish(&x, &mut out, Status::Diverged, f64::INFINITY, f64::INFINITY, 0);
+        return out;
+    }
+    sys.assemble(&x, &mut r, Some(&mut jac));
+    let mut rn = max_abs(&r);
+    let scale0 = max_abs(&x).max(1.0);
+    for it in 1..=opts.max_iter {
+        if !rn.is_finite() {
+            finish(&x, &mut out, Status::Diverged, rn, f64::INFINITY, it - 1);
+            return out;
+        }
+        let neg: Vec<f64> = r.iter().map(|v| -v).collect();
+        let Some(sol) = lu_solve(&jac, n, &neg) else {
+            finish(&x, &mut out, Status::Singular, rn, f64::INFINITY, it - 1);
+            return out;
+        };
+        out.pivot_ratio = sol.pivot_ratio;
+        let dx = sol.x;
+        // Backtracking: accept the first fraction that lowers the residual and keeps omega > 0.
+        let mut lam = 1.0;
+        let mut accepted = false;
+        let mut xt = x.clone();
+        let mut rtn = f64::INFINITY;
+        for _ in 0..12 {
+            for i in 0..n {
+                xt[i] = x[i] + lam * dx[i];
+            }
+            if xt[n - 1] > 0.0 {
+                sys.assemble(&xt, &mut rt, None);
+                rtn = max_abs(&rt);
+                if rtn.is_finite() && rtn < (1.0 - 1e-4 * lam) * rn.max(1e-300) {
+                    accepted = true;
+                    break;
+                }
+                // Already at round-off: the residual cannot fall further, take the step.
+                if rn <= opts.tol && rtn <= opts.tol {
+                    accepted = true;
+                    break;
+                }
+            }
+            lam *= 0.5;
+        }
+        if !accepted {
+            finish(&x, &mut out, Status::Diverged, rn, max_abs(&dx), it);
+            return out;
+        }
+        let step = lam * max_abs(&dx);
+        x.copy_from_slice(&xt);
+        rn = rtn;
+        if max_abs(&x) > 1e8 * scale0 {
+            finish(&x, &mut out, Status::Diverged, rn, step, it);
+            return out;
+        }
+        if rn <= opts.tol && step <= opts.step_tol * max_abs(&x).max(1.0) {
+            finish(&x, &mut out, Status::Converged, rn, step, it);
+            return out;
+        }
+        sys.assemble(&x, &mut r, Some(&mut jac));
+        rn = max_abs(&r);
+        if it == opts.max_iter {
+            finish(&x, &mut out, Status::MaxIterations, rn, step, it);
+        }
+    }
+    out
+}
+
+/// Fourier coefficients of `d` sampled coordinates over one period: `samples[i*d + j]`
+/// at `tau_i = 2 pi i / S`, secular part `w_j tau` removed first.
+pub fn fit_coefficients(samples: &[f64], d: usize, winding: &[f64], n_harm: usize) -> Vec<f64> {
+    let s = samples.len() / d;
+    let l = 2 * n_harm + 1;
+    let basis = Basis::new(n_harm, s);
+    let mut c = vec![0.0; d * l];
+    for i in 0..s {
+        let tau = basis.tau[i];
+        for j in 0..d {
+            let v = samples[i * d + j] - winding[j] * tau;
+            for p in 0..l {
+                c[j * l + p] += basis.wgt[i * l + p] * v;
+            }
+        }
+    }
+    c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Duffing-like single coordinate as a `Dynamics` to check the machinery.
+    /// x'' + 0.1 x' + x + x^3 = 0 has no periodic orbit; use a Van der Pol limit cycle:
+    /// x'' - eps (1 - x^2) x' + x = 0, which for eps -> 0 has amplitude 2 and omega 1.
+    struct Vdp(f64);
+    impl Dynamics for Vdp {
+        fn ndof(&self) -> usize {
+            1
+        }
+        fn residual(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+            out[0] = a[0] - self.0 * (1.0 - q[0] * q[0]) * v[0] + q[0];
+        }
+        fn jacobians(&self, _t: f64, q: &[f64], v: &[f64], _a: &[f64], k: &mut [f64], c: &mut [f64], m: &mut [f64]) {
+            k[0] = 2.0 * self.0 * q[0] * v[0] + 1.0;
+            c[0] = -self.0 * (1.0 - q[0] * q[0]);
+            m[0] = 1.0;
+        }
+        fn solve_mass(&self, _t: f64, _q: &[f64], rhs: &mut [f64]) {
+            let _ = rhs;
+        }
+        fn accel(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+            out[0] = self.0 * (1.0 - q[0] * q[0]) * v[0] - q[0];
+        }
+    }
+
+    #[test]
+    fn van_der_pol_limit_cycle() {
+        // Classic result: omega = 1 - eps^2/16 + O(eps^4), amplitude 2 + O(eps^2).
+        let eps = 0.1;
+        let model = Vdp(eps);
+        let mut coeffs = vec![0.0; 2 * 8 + 1];
+        coeffs[1] = 1.8;
+        let guess = HbSolution {
+            omega: 0.95,
+            coeffs,
+            winding: vec![0.0],
+            n_harm: 8,
+            samples: 0,
+            residual: 0.0,
+            step: 0.0,
+            iterations: 0,
+            status: Status::Converged,
+            pivot_ratio: 0.0,
+        };
+        let opts = HbOptions {
+            n_harm: 8,
+            ..Default::default()
+        };
+        let sol = solve(&model, &guess, &opts);
+        assert_eq!(sol.status, Status::Converged, "{sol:?}");
+        let expect = 1.0 - eps * eps / 16.0 + 17.0 * eps.powi(4) / 3072.0;
+        assert!((sol.omega - expect).abs() < 1e-6, "omega {} vs {}", sol.omega, expect);
+        let amp = sol.coord(0)[1].hypot(sol.coord(0)[2]);
+        assert!((amp - 2.0).abs() < 1e-3, "amplitude {amp}");
+        assert!(sol.iterations < 15);
+    }
+
+    #[test]
+    fn jacobian_matches_finite_differences() {
+        use crate::model::Planar;
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 0.8]).unwrap();
+        let n_harm = 3;
+        let mut sys = HbSystem::new(&p, &[0.0, 0.0, -1.0, 0.0], n_harm, 32);
+        let n = sys.size();
+        let x: Vec<f64> = (0..n).map(|i| 0.1 * ((i * 7 % 11) as f64 - 5.0) / 5.0).collect();
+        let mut x = x;
+        x[n - 1] = 0.3;
+        let mut r = vec![0.0; n];
+        let mut jac = vec![0.0; n * n];
+        sys.assemble(&x, &mut r, Some(&mut jac));
+        let h = 1e-6;
+        for col in 0..n {
+            let mut xp = x.clone();
+            xp[col] += h;
+            let mut rp = vec![0.0; n];
+            sys.assemble(&xp, &mut rp, None);
+            xp[col] -= 2.0 * h;
+            let mut rm = vec![0.0; n];
+            sys.assemble(&xp, &mut rm, None);
+            for row in 0..n {
+                let fd = (rp[row] - rm[row]) / (2.0 * h);
+                assert!((fd - jac[row * n + col]).abs() < 1e-6, "({row},{col}) fd {fd} an {}", jac[row * n + col]);
+            }
+        }
+    }
+
+    #[test]
+    fn series_evaluation_and_fit_round_trip() {
+        let c = [0.3, 1.0, -0.5, 0.2, 0.1];
+        let s = 16;
+        let samples: Vec<f64> = (0..s).map(|i| eval_series(&c, -1.0, 2.0 * PI * i as f64 / s as f64).0).collect();
+        let fit = fit_coefficients(&samples, 1, &[-1.0], 2);
+        for (a, b) in fit.iter().zip(&c) {
+            assert!((a - b).abs() < 1e-13);
+        }
+    }
+}
