@@ -1,3 +1,283 @@
+//! Thin pyo3 binding over `ballbal-core`. Every entry point releases the GIL around the
+//! numerical work and turns core errors into `ValueError`; a Rust panic is caught and
+//! raised as `RuntimeError` so that it never unwinds into Python.
+
+use ballbal_core::equilibria::equilibria as core_equilibria;
+use ballbal_core::floquet::FloquetOptions;
+use ballbal_core::hb::{HbOptions, HbSolution, Status};
+use ballbal_core::ode::Options;
+use ballbal_core::periodic::{closure_error, parse_pattern, pattern_string, periodic as core_periodic, PeriodicOptions};
+use ballbal_core::simulate::simulate as core_simulate;
+use ballbal_core::{Dynamics, Error, Planar};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+fn to_py(e: Error) -> PyErr {
+    match e {
+        Error::InvalidParameter { .. } | Error::NotAutonomous { .. } => PyValueError::new_err(e.to_string()),
+        Error::Integration(_) => PyRuntimeError::new_err(e.to_string()),
+    }
+}
+
+/// Runs `f` without the GIL and with panics contained.
+fn guarded<T: Send, F: FnOnce() -> Result<T, Error> + Send>(py: Python<'_>, f: F) -> PyResult<T> {
+    py.detach(|| catch_unwind(AssertUnwindSafe(f)))
+        .map_err(|p| {
+            let msg = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown".into());
+            PyRuntimeError::new_err(format!("internal error in ballbal core (please report): {msg}"))
+        })?
+        .map_err(to_py)
+}
+
+fn planar(mu: f64, zeta: f64, zeta_b: Vec<f64>, delta: f64, omega: f64, eta: Vec<f64>) -> PyResult<Planar> {
+    Planar::new(mu, zeta, &zeta_b, delta, omega, &eta).map_err(to_py)
+}
+
+fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]> {
+    a.as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{name}: must be a contiguous float64 array")))
+}
+
+/// Integrates from `y0` and returns `(y, accepted_steps, rejected_steps, rhs_evals)`,
+/// `y` of shape `(len(t_eval), 2 (n + 2))`.
+#[pyfunction]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, y0, t0, t_eval, rtol, atol))]
+#[allow(clippy::too_many_arguments)]
+fn simulate<'py>(
+    py: Python<'py>,
+    mu: f64,
+    zeta: f64,
+    zeta_b: Vec<f64>,
+    delta: f64,
+    omega: f64,
+    eta: Vec<f64>,
+    y0: PyReadonlyArray1<'py, f64>,
+    t0: f64,
+    t_eval: PyReadonlyArray1<'py, f64>,
+    rtol: f64,
+    atol: Vec<f64>,
+) -> PyResult<(Bound<'py, PyAny>, usize, usize, usize)> {
+    let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let y0 = slice(&y0, "y0")?.to_vec();
+    let te = slice(&t_eval, "t_eval")?.to_vec();
+    let opts = Options {
+        rtol,
+        atol,
+        ..Default::default()
+    };
+    let traj = guarded(py, || core_simulate(&p, &y0, t0, &te, &opts))?;
+    let cols = y0.len();
+    let flat: Vec<f64> = traj.y.into_iter().flatten().collect();
+    let arr = PyArray1::from_vec(py, flat).reshape([te.len(), cols])?;
+    Ok((arr.into_any(), traj.stats.accepted, traj.stats.rejected, traj.stats.rhs_evals))
+}
+
+/// All equilibria with their stability, as a list of dicts.
+#[pyfunction]
+fn equilibria<'py>(
+    py: Python<'py>,
+    mu: f64,
+    zeta: f64,
+    zeta_b: Vec<f64>,
+    delta: f64,
+    omega: f64,
+    eta: Vec<f64>,
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let eqs = guarded(py, || Ok(core_equilibria(&p)))?;
+    let mut out = vec![];
+    for e in eqs {
+        let d = PyDict::new(py);
+        d.set_item("kind", e.kind)?;
+        d.set_item("q", PyArray1::from_vec(py, e.q))?;
+        d.set_item("residual", e.residual)?;
+        d.set_item("eig_re", PyArray1::from_vec(py, e.eigenvalues.iter().map(|z| z.0).collect()))?;
+        d.set_item("eig_im", PyArray1::from_vec(py, e.eigenvalues.iter().map(|z| z.1).collect()))?;
+        d.set_item("index", e.index)?;
+        d.set_item("stability", e.verdict.as_str())?;
+        d.set_item("neutral", e.neutral)?;
+        d.set_item("routh_hurwitz", e.routh_hurwitz)?;
+        d.set_item("char_poly", PyArray1::from_vec(py, e.char_poly))?;
+        out.push(d);
+    }
+    Ok(out)
+}
+
+fn solution_dict<'py>(py: Python<'py>, r: ballbal_core::periodic::Periodic) -> PyResult<Bound<'py, PyDict>> {
+    let s = r.sol;
+    let d = PyDict::new(py);
+    let ok = s.status == Status::Converged;
+    d.set_item("status", s.status.as_str())?;
+    d.set_item("type", pattern_string(&s.winding))?;
+    d.set_item("omega", if ok { Some(s.omega) } else { None })?;
+    d.set_item("last_omega", s.omega)?;
+    let l = 2 * s.n_harm + 1;
+    let ndof = s.winding.len();
+    d.set_item("coeffs", PyArray1::from_vec(py, s.coeffs).reshape([ndof, l])?)?;
+    d.set_item("winding", PyArray1::from_vec(py, s.winding))?;
+    d.set_item("N", s.n_harm)?;
+    d.set_item("samples", s.samples)?;
+    d.set_item("residual", s.residual)?;
+    d.set_item("step", s.step)?;
+    d.set_item("iterations", s.iterations)?;
+    d.set_item("pivot_ratio", s.pivot_ratio)?;
+    if let Some(f) = r.floquet {
+        d.set_item("mult_re", PyArray1::from_vec(py, f.multipliers.iter().map(|z| z.0).collect()))?;
+        d.set_item("mult_im", PyArray1::from_vec(py, f.multipliers.iter().map(|z| z.1).collect()))?;
+        d.set_item("trivial_error", f.trivial_error)?;
+        d.set_item("max_modulus", f.max_modulus)?;
+        d.set_item("stability", f.stability.as_str())?;
+        d.set_item("floquet_steps", f.steps)?;
+    } else {
+        d.set_item("stability", "undetermined")?;
+    }
+    d.set_item("floquet_error", r.floquet_error)?;
+    Ok(d)
+}
+
+/// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers.
+#[pyfunction]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, pattern, n_harm, samples, tol, step_tol, max_iter,
+                    guess_omega, guess_coeffs, floquet, f_rtol, f_atol, margin, settle, window))]
+#[allow(clippy::too_many_arguments)]
+fn periodic<'py>(
+    py: Python<'py>,
+    mu: f64,
+    zeta: f64,
+    zeta_b: Vec<f64>,
+    delta: f64,
+    omega: f64,
+    eta: Vec<f64>,
+    pattern: &str,
+    n_harm: usize,
+    samples: Option<usize>,
+    tol: f64,
+    step_tol: f64,
+    max_iter: usize,
+    guess_omega: Option<f64>,
+    guess_coeffs: Option<PyReadonlyArray1<'py, f64>>,
+    floquet: bool,
+    f_rtol: f64,
+    f_atol: f64,
+    margin: f64,
+    settle: f64,
+    window: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let rotating = parse_pattern(pattern, p.n_balls()).map_err(to_py)?;
+    let hb = HbOptions {
+        n_harm,
+        samples,
+        tol,
+        step_tol,
+        max_iter,
+    };
+    hb.validate().map_err(to_py)?;
+    let fo = FloquetOptions {
+        rtol: f_rtol,
+        atol: f_atol,
+        margin,
+    };
+    Options::new(f_rtol, f_atol).validate(1).map_err(to_py)?;
+    let d = p.ndof();
+    let guess = match (guess_omega, guess_coeffs) {
+        (Some(w), Some(c)) => {
+            let c = slice(&c, "guess coefficients")?.to_vec();
+            if c.len() % d != 0 || (c.len() / d) % 2 != 1 {
+                return Err(PyValueError::new_err(format!(
+                    "guess coefficients: need shape (n + 2, 2 N + 1) = ({d}, odd), got {} values",
+                    c.len()
+                )));
+            }
+            if !(w.is_finite() && w > 0.0) || c.iter().any(|v| !v.is_finite()) {
+                return Err(PyValueError::new_err("guess: omega must be > 0 and every coefficient finite"));
+            }
+            let mut winding = vec![0.0; d];
+            for (i, &r) in rotating.iter().enumerate() {
+                winding[2 + i] = if r { -1.0 } else { 0.0 };
+            }
+            let nh = (c.len() / d - 1) / 2;
+            Some(HbSolution {
+                omega: w,
+                coeffs: c,
+                winding,
+                n_harm: nh,
+                samples: 0,
+                residual: f64::NAN,
+                step: f64::NAN,
+                iterations: 0,
+                status: Status::NoGuess,
+                pivot_ratio: f64::NAN,
+            })
+        }
+        (None, None) => None,
+        _ => return Err(PyValueError::new_err("guess: give both omega and coefficients, or neither")),
+    };
+    if !(settle > 0.0 && window > 0.0 && settle.is_finite() && window.is_finite()) {
+        return Err(PyValueError::new_err("settle, window: must be finite and > 0"));
+    }
+    let opts = PeriodicOptions {
+        hb,
+        floquet: floquet.then_some(fo),
+        guess: ballbal_core::periodic::GuessOptions {
+            settle,
+            window,
+            ..Default::default()
+        },
+    };
+    let r = guarded(py, || Ok(core_periodic(&p, &rotating, guess.as_ref(), &opts)))?;
+    solution_dict(py, r)
+}
+
+/// The "NI" check: max distance after one simulated period from the orbit's own state.
+#[pyfunction]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, sol_omega, coeffs, winding, rtol, atol))]
+#[allow(clippy::too_many_arguments)]
+fn orbit_closure(
+    py: Python<'_>,
+    mu: f64,
+    zeta: f64,
+    zeta_b: Vec<f64>,
+    delta: f64,
+    omega: f64,
+    eta: Vec<f64>,
+    sol_omega: f64,
+    coeffs: PyReadonlyArray1<'_, f64>,
+    winding: Vec<f64>,
+    rtol: f64,
+    atol: f64,
+) -> PyResult<f64> {
+    let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let c = slice(&coeffs, "coeffs")?.to_vec();
+    let d = winding.len();
+    let sol = HbSolution {
+        omega: sol_omega,
+        n_harm: (c.len() / d - 1) / 2,
+        coeffs: c,
+        winding,
+        samples: 0,
+        residual: f64::NAN,
+        step: f64::NAN,
+        iterations: 0,
+        status: Status::Converged,
+        pivot_ratio: f64::NAN,
+    };
+    guarded(py, || closure_error(&p, &sol, rtol, atol))
+}
+
 #[pymodule]
-fn _native(_m: &Bound<'_, PyModule>) -> PyResult<()> { Ok(()) }
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(equilibria, m)?)?;
+    m.add_function(wrap_pyfunction!(periodic, m)?)?;
+    m.add_function(wrap_pyfunction!(orbit_closure, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

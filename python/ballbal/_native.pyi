@@ -1,0 +1,26 @@
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+def simulate(
+    mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
+    y0: npt.NDArray[np.float64], t0: float, t_eval: npt.NDArray[np.float64], rtol: float,
+    atol: list[float],
+) -> tuple[npt.NDArray[np.float64], int, int, int]: ...
+def equilibria(
+    mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
+) -> list[dict[str, Any]]: ...
+def periodic(
+    mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
+    pattern: str, n_harm: int, samples: int | None, tol: float, step_tol: float, max_iter: int,
+    guess_omega: float | None, guess_coeffs: npt.NDArray[np.float64] | None, floquet: bool,
+    f_rtol: float, f_atol: float, margin: float, settle: float, window: float,
+) -> dict[str, Any]: ...
+def orbit_closure(
+    mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
+    sol_omega: float, coeffs: npt.NDArray[np.float64], winding: list[float], rtol: float,
+    atol: float,
+) -> float: ...

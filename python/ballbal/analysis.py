@@ -1,0 +1,227 @@
+"""Analyses of a balancer: time simulation, equilibria, periodic solutions."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+import polars as pl
+
+from . import _native
+from .model import Balancer
+
+Stability = Literal["stable", "unstable", "undetermined"]
+
+
+def _atol(atol: float | Sequence[float]) -> list[float]:
+    return [float(atol)] if np.isscalar(atol) else [float(a) for a in atol]  # type: ignore[arg-type]
+
+
+def _state_names(n: int) -> list[str]:
+    q = ["x", "y"] + [f"b{i + 1}" for i in range(n)]
+    return q + [f"d{c}" for c in q]
+
+
+def simulate(
+    balancer: Balancer,
+    y0: Sequence[float] | np.ndarray | None = None,
+    t_eval: Sequence[float] | np.ndarray | None = None,
+    *,
+    t_span: tuple[float, float] | None = None,
+    rtol: float = 1e-8,
+    atol: float | Sequence[float] = 1e-10,
+) -> pl.DataFrame:
+    """Integrate the equations of motion with the core's Dormand–Prince 5(4).
+
+    ``y0 = (x, y, b_1..b_n, x', y', b_1'..b_n')`` in the rotating frame (default: the
+    thesis' start, at rest in the ground frame with balls at 0 and pi/2...). Give output
+    times ``t_eval`` (strictly monotone) or ``t_span`` for 1001 evenly spaced outputs.
+    Returns columns ``t``, the state, and ``X, Y``: the disk centre in the fixed frame.
+    """
+    n = balancer.n_balls
+    if y0 is None:
+        y0 = np.zeros(2 * (n + 2))
+        y0[2 : 2 + n] = np.linspace(0.0, np.pi, n, endpoint=False) + 0.3
+        y0[n + 4 :] = -balancer.Omega
+    y0 = np.ascontiguousarray(y0, dtype=np.float64).ravel()
+    if t_eval is None:
+        if t_span is None:
+            raise ValueError("t_eval: give output times, or t_span=(t0, t1)")
+        t_eval = np.linspace(float(t_span[0]), float(t_span[1]), 1001)
+    t = np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+    if t.size == 0:
+        raise ValueError("t_eval: must hold at least one time")
+    t0 = float(t_span[0]) if t_span is not None else float(t[0])
+    y, *_ = _native.simulate(*balancer.native_args(), y0, t0, t, float(rtol), _atol(atol))
+    cols: dict[str, Any] = {"t": t}
+    for name, col in zip(_state_names(n), np.asarray(y).T):
+        cols[name] = col
+    ph = balancer.Omega * t
+    cols["X"] = cols["x"] * np.cos(ph) - cols["y"] * np.sin(ph)
+    cols["Y"] = cols["x"] * np.sin(ph) + cols["y"] * np.cos(ph)
+    return pl.DataFrame(cols)
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """One equilibrium: balls at rest relative to the disk."""
+
+    kind: str
+    q: np.ndarray
+    residual: float
+    eigenvalues: np.ndarray
+    stability_index: float
+    stability: str
+    neutral: int
+    routh_hurwitz: bool | None
+    char_poly: np.ndarray
+
+
+def equilibria(balancer: Balancer) -> list[Equilibrium]:
+    """All equilibria (perfect balance first), with eigenvalues, the relative-stability
+    index (largest real part) and, where defined, the Routh–Hurwitz verdict."""
+    out = []
+    for d in _native.equilibria(*balancer.native_args()):
+        out.append(Equilibrium(
+            kind=d["kind"], q=d["q"], residual=d["residual"],
+            eigenvalues=d["eig_re"] + 1j * d["eig_im"], stability_index=d["index"],
+            stability=d["stability"], neutral=d["neutral"], routh_hurwitz=d["routh_hurwitz"],
+            char_poly=d["char_poly"],
+        ))
+    return out
+
+
+@dataclass(frozen=True)
+class PeriodicSolution:
+    """A periodic solution from harmonic balance (or a failed attempt: see ``status``).
+
+    ``coeffs[j] = [a_0, a_1, b_1, ..., a_N, b_N]`` for coordinate ``j`` of
+    ``(x, y, b_1..b_n)``; ``q_j(tau) = a_0 + sum a_m cos(m tau) + b_m sin(m tau) + w_j tau``,
+    ``tau = omega t``, with ``winding[j] = -1`` for a rotating ball.
+    """
+
+    balancer: Balancer
+    status: str
+    type: str
+    omega: float | None
+    coeffs: np.ndarray
+    winding: np.ndarray
+    N: int
+    samples: int
+    residual: float
+    iterations: int
+    multipliers: np.ndarray | None
+    stability: Stability
+    max_modulus: float | None
+    trivial_error: float | None
+    floquet_steps: int | None
+    condition: float
+    info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def converged(self) -> bool:
+        return self.status == "converged"
+
+    @property
+    def period(self) -> float:
+        if self.omega is None:
+            raise ValueError(f"no period: the solve did not converge (status {self.status})")
+        return 2 * np.pi / self.omega
+
+    def harmonics(self) -> np.ndarray:
+        """Amplitude of each harmonic, shape ``(n + 2, N + 1)``."""
+        c = self.coeffs
+        amp = np.empty((c.shape[0], self.N + 1))
+        amp[:, 0] = np.abs(c[:, 0])
+        amp[:, 1:] = np.hypot(c[:, 1::2], c[:, 2::2])
+        return amp
+
+    def time_history(self, t: Sequence[float] | np.ndarray | None = None) -> pl.DataFrame:
+        """The orbit sampled at times ``t`` (default: 201 points over one period)."""
+        if self.omega is None:
+            raise ValueError(f"no orbit: the solve did not converge (status {self.status})")
+        tt = np.linspace(0, self.period, 201) if t is None else np.asarray(t, dtype=float)
+        tau = self.omega * tt
+        m = np.arange(1, self.N + 1)
+        cos, sin = np.cos(np.outer(tau, m)), np.sin(np.outer(tau, m))
+        cols: dict[str, Any] = {"t": tt}
+        names = _state_names(self.balancer.n_balls)
+        d = len(self.winding)
+        for j in range(d):
+            a, b = self.coeffs[j, 1::2], self.coeffs[j, 2::2]
+            cols[names[j]] = self.coeffs[j, 0] + cos @ a + sin @ b + self.winding[j] * tau
+            cols[names[d + j]] = self.omega * (-(sin * m) @ a + (cos * m) @ b + self.winding[j])
+        return pl.DataFrame(cols)
+
+    def state(self, t: float = 0.0) -> np.ndarray:
+        """First-order state ``(q, q')`` on the orbit at time ``t``."""
+        row = self.time_history([t]).drop("t").row(0)
+        return np.asarray(row)
+
+    def verify(self, rtol: float = 1e-10, atol: float = 1e-12) -> float:
+        """Simulate one period from the orbit's state (the thesis' "NI" check) and return
+        the largest distance from where the orbit says the motion should be."""
+        if self.omega is None:
+            raise ValueError(f"nothing to verify: status {self.status}")
+        return _native.orbit_closure(
+            *self.balancer.native_args(), self.omega, np.ascontiguousarray(self.coeffs.ravel()),
+            [float(w) for w in self.winding], float(rtol), float(atol),
+        )
+
+
+def periodic(
+    balancer: Balancer,
+    pattern: str = "R-R",
+    *,
+    N: int = 3,
+    samples: int | None = None,
+    tol: float = 1e-10,
+    step_tol: float = 1e-8,
+    max_iter: int = 50,
+    guess: PeriodicSolution | tuple[float, np.ndarray] | None = None,
+    floquet: bool = True,
+    rtol: float = 1e-8,
+    atol: float = 1e-10,
+    margin: float = 1e-6,
+    settle: float = 1500.0,
+    window: float = 2500.0,
+) -> PeriodicSolution:
+    """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
+    per ball) by Newton–IHB with ``N`` harmonics, and its Floquet multipliers.
+
+    Without ``guess`` the start comes from a time simulation (``settle`` time units for
+    transients, then up to ``window`` to measure the period). ``guess`` may be a previous
+    solution (any N; it is truncated or padded) or ``(omega, coeffs)``. ``rtol, atol`` are
+    the RK45 tolerances of the monodromy integration; a verdict needs the largest
+    non-trivial modulus further than ``max(margin, trivial_error)`` from 1.
+
+    A solve that fails is returned with its ``status`` (``diverged``, ``singular``,
+    ``max_iterations``, ``no_guess``) and ``omega = None``; it never raises for that.
+    """
+    go: float | None = None
+    gc: np.ndarray | None = None
+    if guess is not None:
+        if isinstance(guess, PeriodicSolution):
+            if guess.omega is None:
+                raise ValueError("guess: a solution that did not converge cannot seed a solve")
+            go, gc = guess.omega, guess.coeffs
+        else:
+            go, gc = float(guess[0]), np.asarray(guess[1], dtype=float)
+        gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
+    d = _native.periodic(
+        *balancer.native_args(), pattern, int(N), samples, float(tol), float(step_tol),
+        int(max_iter), go, gc, bool(floquet), float(rtol), float(atol), float(margin),
+        float(settle), float(window),
+    )
+    mult = d["mult_re"] + 1j * d["mult_im"] if "mult_re" in d else None
+    return PeriodicSolution(
+        balancer=balancer, status=d["status"], type=d["type"], omega=d["omega"],
+        coeffs=d["coeffs"], winding=d["winding"], N=d["N"], samples=d["samples"],
+        residual=d["residual"], iterations=d["iterations"], multipliers=mult,
+        stability=d["stability"], max_modulus=d.get("max_modulus"),
+        trivial_error=d.get("trivial_error"), floquet_steps=d.get("floquet_steps"),
+        condition=d["pivot_ratio"],
+        info={"floquet_error": d["floquet_error"], "last_omega": d["last_omega"]},
+    )

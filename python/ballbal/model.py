@@ -1,0 +1,156 @@
+"""The planar balancer's parameters and conversions to and from lab quantities."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+
+def _tuple(name: str, v: float | Sequence[float]) -> tuple[float, ...]:
+    if isinstance(v, (int, float)):
+        return (float(v),)
+    try:
+        return tuple(float(x) for x in v)
+    except TypeError as e:
+        raise ValueError(f"{name}: must be a number or a sequence of numbers, got {v!r}") from e
+
+
+@dataclass(frozen=True)
+class Balancer:
+    """A planar automatic ball balancer in the thesis' nondimensional parameters.
+
+    ``eta`` has one entry per ball (its length is the number of balls ``n``); ``zeta_b``
+    is one value shared by all balls or one per ball. Parameters are validated by the
+    core on first use; :meth:`validate` checks them eagerly.
+    """
+
+    mu: float = 0.2
+    zeta: float = 0.05
+    zeta_b: float | tuple[float, ...] = 0.05
+    delta: float = 50.0
+    Omega: float = 1.2
+    eta: tuple[float, ...] = field(default=(1.0, 1.0))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "eta", _tuple("eta", self.eta))
+        zb = _tuple("zeta_b", self.zeta_b)
+        object.__setattr__(self, "zeta_b", zb[0] if len(zb) == 1 else zb)
+
+    @property
+    def n_balls(self) -> int:
+        return len(self.eta)
+
+    def native_args(self) -> tuple[float, float, list[float], float, float, list[float]]:
+        zb = [self.zeta_b] if isinstance(self.zeta_b, float) else list(self.zeta_b)
+        return (float(self.mu), float(self.zeta), zb, float(self.delta), float(self.Omega),
+                list(self.eta))
+
+    def replace(self, **changes: Any) -> Balancer:
+        return replace(self, **changes)
+
+    def validate(self) -> Balancer:
+        from . import _native
+
+        _native.equilibria(*self.native_args())
+        return self
+
+    @classmethod
+    def from_lab(
+        cls,
+        *,
+        disk_mass: float,
+        eccentricity: float,
+        ball_masses: Sequence[float],
+        track_radius: float,
+        stiffness: float,
+        damping: float,
+        track_damping: float,
+        spin: float,
+        other_mass: float = 0.0,
+    ) -> Balancer:
+        """Nondimensionalise lab quantities (SI units; ``spin`` in rad/s).
+
+        ``track_damping`` is the viscous coefficient ``c_b`` on a ball's speed relative to
+        the track; ``other_mass`` is the rotor and motor base mass ``M_r``.
+        """
+        vals = {"disk_mass": disk_mass, "eccentricity": eccentricity, "track_radius": track_radius,
+                "stiffness": stiffness}
+        for k, v in vals.items():
+            if not (math.isfinite(v) and v > 0):
+                raise ValueError(f"{k}: must be a finite number > 0, got {v}")
+        for k, v in {"damping": damping, "track_damping": track_damping, "spin": spin,
+                     "other_mass": other_mass}.items():
+            if not (math.isfinite(v) and v >= 0):
+                raise ValueError(f"{k}: must be a finite number >= 0, got {v}")
+        mb = [float(m) for m in ball_masses]
+        if not mb or any(not (math.isfinite(m) and m > 0) for m in mb):
+            raise ValueError("ball_masses: need at least one ball, every mass finite and > 0")
+        total = other_mass + disk_mass + sum(mb)
+        wn = math.sqrt(stiffness / total)
+        zb = tuple(track_damping / (2 * m * wn) for m in mb)
+        return cls(
+            mu=disk_mass / total,
+            zeta=damping / (2 * total * wn),
+            zeta_b=zb[0] if len(set(zb)) == 1 else zb,
+            delta=track_radius / eccentricity,
+            Omega=spin / wn,
+            eta=tuple(m * track_radius / (disk_mass * eccentricity) for m in mb),
+        )
+
+    def to_lab(self, *, disk_mass: float, eccentricity: float, stiffness: float) -> dict[str, Any]:
+        """Lab quantities for a given disk mass, eccentricity and support stiffness."""
+        total = disk_mass / self.mu
+        wn = math.sqrt(stiffness / total)
+        r_t = self.delta * eccentricity
+        mb = [e * disk_mass * eccentricity / r_t for e in self.eta]
+        zb = [self.zeta_b] * len(mb) if isinstance(self.zeta_b, float) else list(self.zeta_b)
+        return {
+            "total_mass": total,
+            "natural_frequency": wn,
+            "spin": self.Omega * wn,
+            "track_radius": r_t,
+            "ball_masses": mb,
+            "other_mass": total - disk_mass - sum(mb),
+            "damping": 2 * self.zeta * total * wn,
+            "track_damping": [2 * z * m * wn for z, m in zip(zb, mb)],
+        }
+
+
+def zeta_from_log_decrement(d: float) -> float:
+    """Damping ratio from a measured logarithmic decrement ``d``."""
+    if not (math.isfinite(d) and d >= 0):
+        raise ValueError(f"d: must be a finite number >= 0, got {d}")
+    return d / math.sqrt(4 * math.pi**2 + d**2)
+
+
+def from_seed003(
+    omega0: float, m0: float, e: float, C0: float = 0.05, D0: float = 0.1, n: int = 2
+) -> Balancer:
+    """A balancer given in seed 003's nondimensionalisation, in the thesis' parameters.
+
+    Seed 003 scales lengths by the track radius (``e = eps / R``), masses by the disk
+    mass (``m0 = m / M``) and time by ``omega_n = sqrt(K / M)`` of the disk alone, with no
+    further rotor mass; ``C0 = C / (2 sqrt(K M))`` and ``D0 = D / (m R^2 omega_n)``. The total
+    mass is ``M (1 + n m0)``, hence ``Omega = omega0 sqrt(1 + n m0)``, ``eta = m0 / e``,
+    ``mu = 1 / (1 + n m0)``, ``delta = 1 / e``, ``zeta = C0 / sqrt(1 + n m0)`` and
+    ``zeta_b = D0 sqrt(1 + n m0) / 2``. Its pitchfork point ``(0.5773, 1)`` with ``e = 2``
+    is ``(Omega, eta) = (1, 0.5)``.
+    """
+    for k, v in {"omega0": omega0, "m0": m0, "e": e, "C0": C0, "D0": D0}.items():
+        if not (math.isfinite(v) and v >= 0):
+            raise ValueError(f"{k}: must be a finite number >= 0, got {v}")
+    if m0 <= 0 or e <= 0:
+        raise ValueError(f"m0, e: must be > 0, got m0={m0}, e={e}")
+    if n < 1:
+        raise ValueError(f"n: must be >= 1, got {n}")
+    s = math.sqrt(1.0 + n * m0)
+    return Balancer(
+        mu=1.0 / (1.0 + n * m0),
+        zeta=C0 / s,
+        zeta_b=D0 * s / 2.0,
+        delta=1.0 / e,
+        Omega=omega0 * s,
+        eta=(m0 / e,) * n,
+    )
