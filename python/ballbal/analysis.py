@@ -30,14 +30,16 @@ def simulate(
     t_eval: Sequence[float] | np.ndarray | None = None,
     *,
     t_span: tuple[float, float] | None = None,
+    t0: float | None = None,
     rtol: float = 1e-8,
     atol: float | Sequence[float] = 1e-10,
 ) -> pl.DataFrame:
     """Integrate the equations of motion with the core's Dormand–Prince 5(4).
 
     ``y0 = (x, y, b_1..b_n, x', y', b_1'..b_n')`` in the rotating frame (default: the
-    thesis' start, at rest in the ground frame with balls at 0 and pi/2...). Give output
-    times ``t_eval`` (strictly monotone) or ``t_span`` for 1001 evenly spaced outputs.
+    thesis' start: at rest in the ground frame, balls spread over half the track). The
+    state is given at ``t0`` (default ``t_span[0]``, else 0). Give output times ``t_eval``
+    (strictly monotone, not before ``t0``) or ``t_span`` for 1001 evenly spaced outputs.
     Returns columns ``t``, the state, and ``X, Y``: the disk centre in the fixed frame.
     """
     n = balancer.n_balls
@@ -53,8 +55,9 @@ def simulate(
     t = np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
     if t.size == 0:
         raise ValueError("t_eval: must hold at least one time")
-    t0 = float(t_span[0]) if t_span is not None else float(t[0])
-    y, *_ = _native.simulate(*balancer.native_args(), y0, t0, t, float(rtol), _atol(atol))
+    if t0 is None:
+        t0 = float(t_span[0]) if t_span is not None else 0.0
+    y, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol), _atol(atol))
     cols: dict[str, Any] = {"t": t}
     for name, col in zip(_state_names(n), np.asarray(y).T):
         cols[name] = col

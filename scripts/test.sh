@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# The project's test command: Rust unit tests, then the wheel built from source and
+# installed into a fresh virtual environment, and pytest run against that install
+# (from outside the source tree, so `import ballbal` cannot pick up python/ballbal).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+py=${PYTHON:-python3}
+export CARGO_TERM_COLOR=never
+
+echo "== cargo test (core, no Python)"
+cargo test --release -p ballbal-core
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+echo "== build wheel"
+"$py" -m venv "$work/build-env"
+"$work/build-env/bin/pip" install -q --upgrade pip "maturin>=1.5,<2"
+"$work/build-env/bin/maturin" build --release --out "$work/dist" -q
+wheel=$(ls "$work"/dist/ballbal-*.whl)
+
+echo "== install $(basename "$wheel") into a clean venv"
+"$py" -m venv "$work/venv"
+"$work/venv/bin/pip" install -q --upgrade pip
+"$work/venv/bin/pip" install -q "$wheel[test,plot]"
+
+echo "== pytest against the installed package"
+cp -r tests "$work/tests"
+cd "$work"
+"$work/venv/bin/python" -m pytest -q -p no:cacheprovider tests "$@"
