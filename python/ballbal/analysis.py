@@ -152,10 +152,13 @@ class PeriodicSolution:
         cols: dict[str, Any] = {"t": tt}
         names = _state_names(self.balancer.n_balls)
         d = len(self.winding)
+        a, b = self.coeffs[:, 1::2], self.coeffs[:, 2::2]
+        q = self.coeffs[:, 0] + cos @ a.T + sin @ b.T + np.outer(tau, self.winding)
+        dq = self.omega * (-(sin * m) @ a.T + (cos * m) @ b.T + self.winding)
         for j in range(d):
-            a, b = self.coeffs[j, 1::2], self.coeffs[j, 2::2]
-            cols[names[j]] = self.coeffs[j, 0] + cos @ a + sin @ b + self.winding[j] * tau
-            cols[names[d + j]] = self.omega * (-(sin * m) @ a + (cos * m) @ b + self.winding[j])
+            cols[names[j]] = q[:, j]
+        for j in range(d):
+            cols[names[d + j]] = dq[:, j]
         return pl.DataFrame(cols)
 
     def state(self, t: float = 0.0) -> np.ndarray:
