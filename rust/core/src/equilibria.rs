@@ -79,7 +79,7 @@ pub fn analyse(p: &Planar, q: &[f64], kind: &str) -> Equilibrium {
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
     p.jacobians(0.0, q, &z, &z, &mut k, &mut c, &mut m);
     let mut a = vec![0.0; 4 * d * d];
-    let mut col = vec![0.0; d];
+    let mut col = vec![0.0; 2 * d * d];
     state_matrix(p, 0.0, q, &k, &c, &mut col, &mut a);
     let ev = eigenvalues(&a, 2 * d).unwrap_or_default();
     // A perfect balance with n >= 3 balls is an (n-2)-parameter family: those
@@ -103,10 +103,17 @@ pub fn analyse(p: &Planar, q: &[f64], kind: &str) -> Equilibrium {
         Verdict::Marginal
     };
     let poly = char_poly(&k, &c, &m, d);
-    let rh = if neutral == 0 { Some(routh_hurwitz(&poly)) } else { None };
+    let rh = if neutral == 0 {
+        Some(routh_hurwitz(&poly))
+    } else {
+        None
+    };
     Equilibrium {
         kind: kind.to_string(),
-        q: q.iter().enumerate().map(|(i, &v)| if i >= 2 { wrap(v) } else { v }).collect(),
+        q: q.iter()
+            .enumerate()
+            .map(|(i, &v)| if i >= 2 { wrap(v) } else { v })
+            .collect(),
         residual,
         eigenvalues: ev,
         index,
@@ -259,7 +266,11 @@ pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
         "opposite" => 2,
         _ => 3,
     };
-    found.sort_by(|a, b| order(&a.1).cmp(&order(&b.1)).then(a.0[0].total_cmp(&b.0[0])));
+    found.sort_by(|a, b| {
+        order(&a.1)
+            .cmp(&order(&b.1))
+            .then(a.0[0].total_cmp(&b.0[0]))
+    });
     found.iter().map(|(q, k)| analyse(p, q, k)).collect()
 }
 
@@ -354,8 +365,12 @@ pub fn routh_hurwitz(a: &[f64]) -> bool {
         return false;
     }
     let width = deg / 2 + 1;
-    let mut prev: Vec<f64> = (0..width).map(|i| a.get(2 * i).copied().unwrap_or(0.0)).collect();
-    let mut cur: Vec<f64> = (0..width).map(|i| a.get(2 * i + 1).copied().unwrap_or(0.0)).collect();
+    let mut prev: Vec<f64> = (0..width)
+        .map(|i| a.get(2 * i).copied().unwrap_or(0.0))
+        .collect();
+    let mut cur: Vec<f64> = (0..width)
+        .map(|i| a.get(2 * i + 1).copied().unwrap_or(0.0))
+        .collect();
     let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for _ in 0..deg.saturating_sub(1) {
         if !(cur[0] > 1e-14 * scale) {
@@ -400,8 +415,12 @@ mod tests {
 
     #[test]
     fn perfect_balance_needs_eta_half() {
-        assert!(equilibria(&two(1.5, 0.49)).iter().all(|e| e.kind != "perfect_balance"));
-        assert!(equilibria(&two(1.5, 0.51)).iter().any(|e| e.kind == "perfect_balance"));
+        assert!(equilibria(&two(1.5, 0.49))
+            .iter()
+            .all(|e| e.kind != "perfect_balance"));
+        assert!(equilibria(&two(1.5, 0.51))
+            .iter()
+            .any(|e| e.kind == "perfect_balance"));
     }
 
     #[test]
@@ -440,7 +459,10 @@ mod tests {
     fn three_balls_perfect_balance_family() {
         let p = Planar::new(0.2, 0.05, &[0.1], 50.0, 1.5, &[0.6, 0.6, 0.6]).unwrap();
         let eqs = equilibria(&p);
-        let pb = eqs.iter().find(|e| e.kind == "perfect_balance").expect("perfect balance");
+        let pb = eqs
+            .iter()
+            .find(|e| e.kind == "perfect_balance")
+            .expect("perfect balance");
         assert!(pb.residual < 1e-10);
         assert_eq!(pb.neutral, 1);
     }

@@ -40,13 +40,24 @@ impl std::error::Error for Error {}
 pub type Result<T> = std::result::Result<T, Error>;
 
 /// Checks that `v` is finite and inside `[lo, hi]` (open ends when `*_open`).
-pub fn check_range(name: &str, v: f64, lo: f64, lo_open: bool, hi: f64, hi_open: bool) -> Result<()> {
+pub fn check_range(
+    name: &str,
+    v: f64,
+    lo: f64,
+    lo_open: bool,
+    hi: f64,
+    hi_open: bool,
+) -> Result<()> {
     let ok_lo = if lo_open { v > lo } else { v >= lo };
     let ok_hi = if hi_open { v < hi } else { v <= hi };
     if !v.is_finite() || !ok_lo || !ok_hi {
         let l = if lo_open { "(" } else { "[" };
         let h = if hi_open { ")" } else { "]" };
-        let hs = if hi.is_infinite() { "inf".to_string() } else { format!("{hi}") };
+        let hs = if hi.is_infinite() {
+            "inf".to_string()
+        } else {
+            format!("{hi}")
+        };
         return Err(Error::param(
             name,
             format!("must be a finite number in {l}{lo}, {hs}{h}, got {v}"),

@@ -81,7 +81,7 @@ pub fn monodromy<D: Dynamics + ?Sized>(
     let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
     let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
-    let mut col = vec![0.0; d];
+    let mut col = vec![0.0; 2 * d * d];
     let mut amat = vec![0.0; n2 * n2];
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| {
         sol.eval(om * t, &mut q, &mut qt, &mut qtt);
@@ -114,11 +114,16 @@ pub fn monodromy<D: Dynamics + ?Sized>(
 }
 
 /// Floquet multipliers and the stability verdict of a harmonic-balance solution.
-pub fn floquet<D: Dynamics + ?Sized>(model: &D, sol: &HbSolution, opts: &FloquetOptions) -> Result<Floquet> {
+pub fn floquet<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    opts: &FloquetOptions,
+) -> Result<Floquet> {
     let (phi, steps, evals) = monodromy(model, sol, opts)?;
     let n2 = 2 * model.ndof();
-    let mut ev = eigenvalues(&phi, n2)
-        .ok_or_else(|| crate::Error::Integration("eigenvalues of the monodromy matrix did not converge".into()))?;
+    let mut ev = eigenvalues(&phi, n2).ok_or_else(|| {
+        crate::Error::Integration("eigenvalues of the monodromy matrix did not converge".into())
+    })?;
     ev.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
     let (trivial, trivial_error) = ev
         .iter()

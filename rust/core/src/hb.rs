@@ -151,7 +151,10 @@ impl HbOptions {
     pub fn validate(&self) -> crate::Result<()> {
         use crate::Error;
         if self.n_harm < 1 || self.n_harm > 256 {
-            return Err(Error::param("N", format!("must be in [1, 256], got {}", self.n_harm)));
+            return Err(Error::param(
+                "N",
+                format!("must be in [1, 256], got {}", self.n_harm),
+            ));
         }
         if let Some(s) = self.samples {
             let min = 2 * self.n_harm + 2;
@@ -163,7 +166,10 @@ impl HbOptions {
             }
         }
         if !(self.tol > 0.0 && self.tol.is_finite()) {
-            return Err(Error::param("tol", format!("must be a finite number > 0, got {}", self.tol)));
+            return Err(Error::param(
+                "tol",
+                format!("must be a finite number > 0, got {}", self.tol),
+            ));
         }
         if !(self.step_tol > 0.0 && self.step_tol.is_finite()) {
             return Err(Error::param(
@@ -172,7 +178,10 @@ impl HbOptions {
             ));
         }
         if self.max_iter == 0 || self.max_iter > 10_000 {
-            return Err(Error::param("max_iter", format!("must be in [1, 10000], got {}", self.max_iter)));
+            return Err(Error::param(
+                "max_iter",
+                format!("must be in [1, 10000], got {}", self.max_iter),
+            ));
         }
         Ok(())
     }
@@ -347,7 +356,8 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             }
             let t = self.basis.tau[i] / om;
             let q = &self.q[i * d..(i + 1) * d];
-            self.model.residual(t, q, &v, &a, &mut self.f[i * d..(i + 1) * d]);
+            self.model
+                .residual(t, q, &v, &a, &mut self.f[i * d..(i + 1) * d]);
             if want_jac {
                 let (kk, cc, mm) = (
                     &mut self.k[i * d * d..(i + 1) * d * d],
@@ -372,7 +382,10 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         // Phase condition.
         let pc = self.phase_coord;
         r[d * l] = if self.phase_rotating {
-            x[pc * l] + (1..=self.basis.n_harm).map(|m| x[pc * l + 2 * m - 1]).sum::<f64>()
+            x[pc * l]
+                + (1..=self.basis.n_harm)
+                    .map(|m| x[pc * l + 2 * m - 1])
+                    .sum::<f64>()
         } else {
             x[pc * l + 2]
         };
@@ -397,7 +410,9 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                     let (kv, cv, mv) = (self.k[o], om * self.c[o], om2 * self.m[o]);
                     let b = i * l;
                     for p in 0..l {
-                        g[b + p] = kv * self.basis.phi[b + p] + cv * self.basis.dphi[b + p] + mv * self.basis.ddphi[b + p];
+                        g[b + p] = kv * self.basis.phi[b + p]
+                            + cv * self.basis.dphi[b + p]
+                            + mv * self.basis.ddphi[b + p];
                     }
                 }
                 // J block = W^T G
@@ -409,7 +424,8 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                         if wr == 0.0 {
                             continue;
                         }
-                        let row = &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
+                        let row =
+                            &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
                         for p in 0..l {
                             row[p] += wr * gi[p];
                         }
@@ -424,7 +440,8 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                 let mut dfo = 0.0;
                 for k in 0..d {
                     let o = i * d * d + j * d + k;
-                    dfo += self.c[o] * self.qt[i * d + k] + 2.0 * om * self.m[o] * self.qtt[i * d + k];
+                    dfo +=
+                        self.c[o] * self.qt[i * d + k] + 2.0 * om * self.m[o] * self.qtt[i * d + k];
                 }
                 for rr in 0..l {
                     jac[(j * l + rr) * n + d * l] += w[rr] * dfo;
@@ -443,8 +460,15 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
     }
 }
 
+fn l2(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
 fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| if x.is_nan() { f64::NAN } else { m.max(x.abs()) })
+    v.iter().fold(
+        0.0f64,
+        |m, x| if x.is_nan() { f64::NAN } else { m.max(x.abs()) },
+    )
 }
 
 /// Newton–IHB from the starting guess `guess` (its `coeffs`, `omega`, `winding`; resized
@@ -475,16 +499,24 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         status: Status::MaxIterations,
         pivot_ratio: f64::NAN,
     };
-    let finish = |x: &[f64], out: &mut HbSolution, status: Status, res: f64, step: f64, it: usize| {
-        out.coeffs.copy_from_slice(&x[..n - 1]);
-        out.omega = x[n - 1];
-        out.status = status;
-        out.residual = res;
-        out.step = step;
-        out.iterations = it;
-    };
+    let finish =
+        |x: &[f64], out: &mut HbSolution, status: Status, res: f64, step: f64, it: usize| {
+            out.coeffs.copy_from_slice(&x[..n - 1]);
+            out.omega = x[n - 1];
+            out.status = status;
+            out.residual = res;
+            out.step = step;
+            out.iterations = it;
+        };
     if !(g.omega > 0.0) || x.iter().any(|v| !v.is_finite()) {
-        finish(&x, &mut out, Status::Diverged, f64::INFINITY, f64::INFINITY, 0);
+        finish(
+            &x,
+            &mut out,
+            Status::Diverged,
+            f64::INFINITY,
+            f64::INFINITY,
+            0,
+        );
         return out;
     }
     sys.assemble(&x, &mut r, Some(&mut jac));
@@ -502,19 +534,22 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         };
         out.pivot_ratio = sol.pivot_ratio;
         let dx = sol.x;
-        // Backtracking: accept the first fraction that lowers the residual and keeps omega > 0.
+        // Backtracking on ||R||_2, for which the Newton direction is a descent direction
+        // (the max-norm need not fall even when the step is good).
+        let merit = l2(&r);
         let mut lam = 1.0;
         let mut accepted = false;
         let mut xt = x.clone();
         let mut rtn = f64::INFINITY;
-        for _ in 0..12 {
+        for _ in 0..16 {
             for i in 0..n {
                 xt[i] = x[i] + lam * dx[i];
             }
             if xt[n - 1] > 0.0 {
                 sys.assemble(&xt, &mut rt, None);
                 rtn = max_abs(&rt);
-                if rtn.is_finite() && rtn < (1.0 - 1e-4 * lam) * rn.max(1e-300) {
+                let mt = l2(&rt);
+                if mt.is_finite() && mt < (1.0 - 1e-4 * lam) * merit.max(1e-300) {
                     accepted = true;
                     break;
                 }
@@ -584,7 +619,16 @@ mod tests {
         fn residual(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
             out[0] = a[0] - self.0 * (1.0 - q[0] * q[0]) * v[0] + q[0];
         }
-        fn jacobians(&self, _t: f64, q: &[f64], v: &[f64], _a: &[f64], k: &mut [f64], c: &mut [f64], m: &mut [f64]) {
+        fn jacobians(
+            &self,
+            _t: f64,
+            q: &[f64],
+            v: &[f64],
+            _a: &[f64],
+            k: &mut [f64],
+            c: &mut [f64],
+            m: &mut [f64],
+        ) {
             k[0] = 2.0 * self.0 * q[0] * v[0] + 1.0;
             c[0] = -self.0 * (1.0 - q[0] * q[0]);
             m[0] = 1.0;
@@ -623,7 +667,12 @@ mod tests {
         let sol = solve(&model, &guess, &opts);
         assert_eq!(sol.status, Status::Converged, "{sol:?}");
         let expect = 1.0 - eps * eps / 16.0 + 17.0 * eps.powi(4) / 3072.0;
-        assert!((sol.omega - expect).abs() < 1e-6, "omega {} vs {}", sol.omega, expect);
+        assert!(
+            (sol.omega - expect).abs() < 1e-6,
+            "omega {} vs {}",
+            sol.omega,
+            expect
+        );
         let amp = sol.coord(0)[1].hypot(sol.coord(0)[2]);
         assert!((amp - 2.0).abs() < 1e-3, "amplitude {amp}");
         assert!(sol.iterations < 15);
@@ -636,7 +685,9 @@ mod tests {
         let n_harm = 3;
         let mut sys = HbSystem::new(&p, &[0.0, 0.0, -1.0, 0.0], n_harm, 32);
         let n = sys.size();
-        let x: Vec<f64> = (0..n).map(|i| 0.1 * ((i * 7 % 11) as f64 - 5.0) / 5.0).collect();
+        let x: Vec<f64> = (0..n)
+            .map(|i| 0.1 * ((i * 7 % 11) as f64 - 5.0) / 5.0)
+            .collect();
         let mut x = x;
         x[n - 1] = 0.3;
         let mut r = vec![0.0; n];
@@ -653,7 +704,11 @@ mod tests {
             sys.assemble(&xp, &mut rm, None);
             for row in 0..n {
                 let fd = (rp[row] - rm[row]) / (2.0 * h);
-                assert!((fd - jac[row * n + col]).abs() < 1e-6, "({row},{col}) fd {fd} an {}", jac[row * n + col]);
+                assert!(
+                    (fd - jac[row * n + col]).abs() < 1e-6,
+                    "({row},{col}) fd {fd} an {}",
+                    jac[row * n + col]
+                );
             }
         }
     }
@@ -662,7 +717,9 @@ mod tests {
     fn series_evaluation_and_fit_round_trip() {
         let c = [0.3, 1.0, -0.5, 0.2, 0.1];
         let s = 16;
-        let samples: Vec<f64> = (0..s).map(|i| eval_series(&c, -1.0, 2.0 * PI * i as f64 / s as f64).0).collect();
+        let samples: Vec<f64> = (0..s)
+            .map(|i| eval_series(&c, -1.0, 2.0 * PI * i as f64 / s as f64).0)
+            .collect();
         let fit = fit_coefficients(&samples, 1, &[-1.0], 2);
         for (a, b) in fit.iter().zip(&c) {
             assert!((a - b).abs() < 1e-13);

@@ -6,9 +6,9 @@
 //! incremental harmonic balance, Floquet multipliers and parallel scans.
 
 pub mod equilibria;
+pub mod error;
 pub mod floquet;
 pub mod hb;
-pub mod error;
 pub mod linalg;
 pub mod model;
 pub mod ode;

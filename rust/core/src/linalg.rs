@@ -1,9 +1,9 @@
 //! Thin wrappers over faer (LU, general eigenvalues) and nalgebra (small dense
 //! solves) working on row-major slices, the layout the model fills.
 
+use crate::model::Dynamics;
 use faer::prelude::*;
 use faer::Mat;
-use crate::model::Dynamics;
 
 /// Eigenvalues `(re, im)` of the row-major `n x n` matrix `a`, sorted by decreasing
 /// real part then imaginary part, or `None` if the QR iteration failed.
@@ -53,14 +53,14 @@ pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
 }
 
 /// First-order state matrix `A = [[0, I], [-M^-1 K, -M^-1 C]]` (row-major, `2d x 2d`),
-/// using the model's own mass solve; `col` is scratch of length `d`.
+/// using the model's own mass solve; `cols` is scratch of length `2 d^2`.
 pub fn state_matrix<D: Dynamics + ?Sized>(
     model: &D,
     t: f64,
     q: &[f64],
     k: &[f64],
     c: &[f64],
-    col: &mut [f64],
+    cols: &mut [f64],
     out: &mut [f64],
 ) {
     let d = model.ndof();
@@ -69,15 +69,18 @@ pub fn state_matrix<D: Dynamics + ?Sized>(
         out[i * n2..(i + 1) * n2].fill(0.0);
         out[i * n2 + d + i] = 1.0;
     }
+    // Columns of -K then -C, solved against M together.
     for (src, off) in [(k, 0), (c, d)] {
         for j in 0..d {
             for i in 0..d {
-                col[i] = -src[i * d + j];
+                cols[(off + j) * d + i] = -src[i * d + j];
             }
-            model.solve_mass(t, q, col);
-            for i in 0..d {
-                out[(d + i) * n2 + off + j] = col[i];
-            }
+        }
+    }
+    model.solve_mass_columns(t, q, cols);
+    for j in 0..n2 {
+        for i in 0..d {
+            out[(d + i) * n2 + j] = cols[j * d + i];
         }
     }
 }

@@ -31,6 +31,14 @@ pub trait Dynamics: Send + Sync {
     );
     /// Solves `M(q) z = rhs` in place (`M = dF/da`).
     fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]);
+    /// Solves `M(q) Z = B` in place for `B` stored as consecutive columns of length `d`.
+    /// Models override it to factor `M` once for all columns.
+    fn solve_mass_columns(&self, t: f64, q: &[f64], cols: &mut [f64]) {
+        let d = self.ndof();
+        for c in cols.chunks_mut(d) {
+            self.solve_mass(t, q, c);
+        }
+    }
     /// Accelerations solving `F(t, q, v, a) = 0`: `a = -M^-1 F(t, q, v, 0)`.
     fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]);
     /// `None` when the equations do not depend on `t`; otherwise the effect responsible.
@@ -185,7 +193,10 @@ impl Planar {
 }
 
 fn indexed(name: &str, base: &str) -> Option<usize> {
-    let rest = name.strip_prefix(base)?.strip_prefix('[')?.strip_suffix(']')?;
+    let rest = name
+        .strip_prefix(base)?
+        .strip_prefix('[')?
+        .strip_suffix(']')?;
     rest.parse().ok()
 }
 
@@ -293,6 +304,49 @@ impl Dynamics for Planar {
         }
     }
 
+    fn solve_mass_columns(&self, _t: f64, q: &[f64], cols: &mut [f64]) {
+        // Same elimination as solve_mass, with the trigonometry and the 2 x 2 factor
+        // computed once: the Floquet right-hand side solves 2d columns per evaluation.
+        let n = self.n_balls();
+        let d = n + 2;
+        let dl = self.delta;
+        let mut sc = [(0.0f64, 0.0f64); 16];
+        let mut sc_heap: Vec<(f64, f64)>;
+        let sc: &mut [(f64, f64)] = if n <= 16 {
+            &mut sc[..n]
+        } else {
+            sc_heap = vec![(0.0, 0.0); n];
+            &mut sc_heap
+        };
+        let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
+        for i in 0..n {
+            let (s, c) = q[2 + i].sin_cos();
+            sc[i] = (s, c);
+            let mi = self.m(i);
+            a11 -= mi * s * s / dl;
+            a12 += mi * s * c / dl;
+            a22 -= mi * c * c / dl;
+        }
+        let det = a11 * a22 - a12 * a12;
+        for col in cols.chunks_mut(d) {
+            let (mut r1, mut r2) = (col[0], col[1]);
+            for i in 0..n {
+                let (s, c) = sc[i];
+                let w = self.m(i) * col[2 + i] / dl;
+                r1 += s * w;
+                r2 -= c * w;
+            }
+            let ax = (r1 * a22 - a12 * r2) / det;
+            let ay = (a11 * r2 - a12 * r1) / det;
+            col[0] = ax;
+            col[1] = ay;
+            for i in 0..n {
+                let (s, c) = sc[i];
+                col[2 + i] = (col[2 + i] + s * ax - c * ay) / dl;
+            }
+        }
+    }
+
     fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
         self.forces(q, v, out);
         out.iter_mut().for_each(|g| *g = -*g);
@@ -341,9 +395,14 @@ mod tests {
         for i in 0..4 {
             r[i] = (0..4).map(|j| m[i * 4 + j] * z[j]).sum();
         }
+        let mut two = [r, r].concat();
         p.solve_mass(0.0, &q, &mut r);
         for i in 0..4 {
             assert!((r[i] - z[i]).abs() < 1e-13);
+        }
+        p.solve_mass_columns(0.0, &q, &mut two);
+        for i in 0..8 {
+            assert!((two[i] - z[i % 4]).abs() < 1e-13);
         }
     }
 
@@ -369,7 +428,10 @@ mod tests {
                 for row in 0..d {
                     let fd = (rp[row] - rm[row]) / (2.0 * h);
                     let an = jac[row * d + col];
-                    assert!((fd - an).abs() < 1e-7, "jac {which} ({row},{col}): fd {fd} vs {an}");
+                    assert!(
+                        (fd - an).abs() < 1e-7,
+                        "jac {which} ({row},{col}): fd {fd} vs {an}"
+                    );
                 }
             }
         }

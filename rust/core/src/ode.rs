@@ -89,7 +89,10 @@ impl Options {
         if self.atol.len() != 1 && self.atol.len() != n {
             return Err(Error::param(
                 "atol",
-                format!("needs 1 value or one per state ({n}), got {}", self.atol.len()),
+                format!(
+                    "needs 1 value or one per state ({n}), got {}",
+                    self.atol.len()
+                ),
             ));
         }
         if self.atol.iter().any(|a| !(a.is_finite() && *a >= 0.0)) {
@@ -160,7 +163,11 @@ impl Dopri5 {
         let f0 = self.k[0].clone();
         let d0 = self.rms_scaled(y0, y0, opts);
         let d1 = self.rms_scaled(&f0, y0, opts);
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        };
         for i in 0..self.n {
             self.tmp[i] = y0[i] + dir * h0 * f0[i];
         }
@@ -225,7 +232,9 @@ impl Dopri5 {
             let min_step = 10.0 * (f64::EPSILON * t.abs()).max(f64::MIN_POSITIVE);
             h = h.min(opts.max_step);
             if h < min_step {
-                return Err(Error::Integration(format!("step size underflow at t = {t}")));
+                return Err(Error::Integration(format!(
+                    "step size underflow at t = {t}"
+                )));
             }
             let mut hs = h * dir;
             let mut last = false;
@@ -262,7 +271,11 @@ impl Dopri5 {
                 continue;
             }
             if en <= 1.0 {
-                let mut fac = if en == 0.0 { 10.0 } else { (0.9 * en.powf(-0.2)).min(10.0) };
+                let mut fac = if en == 0.0 {
+                    10.0
+                } else {
+                    (0.9 * en.powf(-0.2)).min(10.0)
+                };
                 if rejected_last {
                     fac = fac.min(1.0);
                 }
@@ -410,10 +423,18 @@ pub fn check_times(t0: f64, t_eval: &[f64]) -> Result<()> {
     if let Some(bad) = t_eval.iter().find(|t| !t.is_finite()) {
         return Err(Error::param("t_eval", format!("must be finite, got {bad}")));
     }
-    let dir = if t_eval.last().copied().unwrap_or(t0) >= t0 { 1.0 } else { -1.0 };
+    let dir = if t_eval.last().copied().unwrap_or(t0) >= t0 {
+        1.0
+    } else {
+        -1.0
+    };
     let mut prev = t0;
     for (i, &t) in t_eval.iter().enumerate() {
-        let ok = if i == 0 { dir * (t - prev) >= 0.0 } else { dir * (t - prev) > 0.0 };
+        let ok = if i == 0 {
+            dir * (t - prev) >= 0.0
+        } else {
+            dir * (t - prev) > 0.0
+        };
         if !ok {
             return Err(Error::param(
                 "t_eval",
@@ -445,7 +466,9 @@ mod tests {
             max_steps: 1_000_000,
         };
         let mut s = Dopri5::new(2);
-        let (t, y, _) = s.integrate(osc, 0.0, &[1.0, 0.0], 2.0, &opts, |_, _, _| true).unwrap();
+        let (t, y, _) = s
+            .integrate(osc, 0.0, &[1.0, 0.0], 2.0, &opts, |_, _, _| true)
+            .unwrap();
         assert!((t - 2.0).abs() < 1e-15);
         ((y[0] - 2f64.cos()).powi(2) + (y[1] + 2f64.sin()).powi(2)).sqrt()
     }

@@ -63,11 +63,19 @@ pub fn initial_states(p: &Planar) -> Vec<Vec<f64>> {
     let mut configs: Vec<Vec<f64>> = vec![
         vec![0.0; n],
         vec![PI / 2.0; n],
-        (0..n).map(|i| 2.0 * PI * i as f64 / n as f64 + 0.3).collect(),
-        (0..n).map(|i| if i % 2 == 0 { 2.0 } else { -2.0 }).collect(),
-        (0..n).map(|i| if i % 2 == 0 { 1.0 } else { -1.0 }).collect(),
+        (0..n)
+            .map(|i| 2.0 * PI * i as f64 / n as f64 + 0.3)
+            .collect(),
+        (0..n)
+            .map(|i| if i % 2 == 0 { 2.0 } else { -2.0 })
+            .collect(),
+        (0..n)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect(),
         (0..n).map(|i| 0.7 + 1.9 * i as f64).collect(),
-        (0..n).map(|i| if i % 2 == 0 { 2.8 } else { -2.8 }).collect(),
+        (0..n)
+            .map(|i| if i % 2 == 0 { 2.8 } else { -2.8 })
+            .collect(),
         (0..n).map(|i| -1.2 + 2.9 * i as f64).collect(),
     ];
     configs.dedup();
@@ -100,7 +108,9 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     let opts = Options::new(g.rtol, g.atol);
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
     let mut solver = Dopri5::new(2 * d);
-    let (_, ys, _) = solver.integrate(rhs, 0.0, y0, g.settle, &opts, |_, _, _| true).ok()?;
+    let (_, ys, _) = solver
+        .integrate(rhs, 0.0, y0, g.settle, &opts, |_, _, _| true)
+        .ok()?;
     // Observe: record the phase signal's crossings.
     let r = rotating.iter().position(|&b| b);
     let dt = 0.05;
@@ -125,7 +135,10 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
                 dense.eval(t, &mut tmp);
                 match r {
                     Some(r) => {
-                        let (a, b) = ((y_prev[2 + r] / (2.0 * PI)).floor(), (tmp[2 + r] / (2.0 * PI)).floor());
+                        let (a, b) = (
+                            (y_prev[2 + r] / (2.0 * PI)).floor(),
+                            (tmp[2 + r] / (2.0 * PI)).floor(),
+                        );
                         if a != b {
                             // Linear interpolation of the level crossing.
                             let level = 2.0 * PI * a.max(b);
@@ -171,7 +184,10 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
         // Upward crossings of x through its mean.
         let half = xs.len() / 2;
         let mean = xs[half..].iter().map(|p| p.1).sum::<f64>() / (xs.len() - half) as f64;
-        let amp = xs[half..].iter().map(|p| (p.1 - mean).abs()).fold(0.0, f64::max);
+        let amp = xs[half..]
+            .iter()
+            .map(|p| (p.1 - mean).abs())
+            .fold(0.0, f64::max);
         if amp < 1e-6 {
             return None; // at rest: an equilibrium, not a periodic motion
         }
@@ -272,7 +288,12 @@ pub struct Periodic {
 
 /// Solves from `guess`, or from a simulated guess of the requested pattern, and runs
 /// the Floquet analysis on a converged solution.
-pub fn periodic(p: &Planar, rotating: &[bool], guess: Option<&HbSolution>, opts: &PeriodicOptions) -> Periodic {
+pub fn periodic(
+    p: &Planar,
+    rotating: &[bool],
+    guess: Option<&HbSolution>,
+    opts: &PeriodicOptions,
+) -> Periodic {
     let sol = match guess {
         Some(g) => solve(p, g, &opts.hb),
         None => {
@@ -334,7 +355,12 @@ pub fn no_guess(p: &Planar, rotating: &[bool], n_harm: usize) -> HbSolution {
 /// The thesis' "NI" check: simulate from the solution's state for one period and return
 /// the max-norm distance to where the orbit says it should be (angles advanced by whole
 /// turns).
-pub fn closure_error<D: Dynamics + ?Sized>(model: &D, sol: &HbSolution, rtol: f64, atol: f64) -> crate::Result<f64> {
+pub fn closure_error<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    rtol: f64,
+    atol: f64,
+) -> crate::Result<f64> {
     let y0 = sol.state(0.0);
     let t = sol.period();
     let (ys, _) = solve_at(
@@ -347,7 +373,11 @@ pub fn closure_error<D: Dynamics + ?Sized>(model: &D, sol: &HbSolution, rtol: f6
     let d = model.ndof();
     let mut err = 0.0f64;
     for j in 0..2 * d {
-        let target = if j < d { y0[j] + 2.0 * PI * sol.winding[j] } else { y0[j] };
+        let target = if j < d {
+            y0[j] + 2.0 * PI * sol.winding[j]
+        } else {
+            y0[j]
+        };
         err = err.max((ys[0][j] - target).abs());
     }
     Ok(err)
@@ -365,17 +395,28 @@ mod tests {
     fn thesis_rr_standard_case() {
         let p = thesis(1.2, 1.0);
         let opts = PeriodicOptions {
-            hb: HbOptions { n_harm: 8, ..Default::default() },
+            hb: HbOptions {
+                n_harm: 8,
+                ..Default::default()
+            },
             floquet: Some(FloquetOptions::default()),
             ..Default::default()
         };
         let r = periodic(&p, &[true, true], None, &opts);
         assert_eq!(r.sol.status, Status::Converged, "{:?}", r.sol);
         // Independent shooting value in the spec.
-        assert!((r.sol.omega - 0.25141).abs() < 2e-5, "omega {}", r.sol.omega);
+        assert!(
+            (r.sol.omega - 0.25141).abs() < 2e-5,
+            "omega {}",
+            r.sol.omega
+        );
         let f = r.floquet.unwrap();
         assert!(f.trivial_error < 1e-6, "trivial {}", f.trivial_error);
-        assert!((f.max_modulus - 0.8637).abs() < 1e-4, "max modulus {}", f.max_modulus);
+        assert!(
+            (f.max_modulus - 0.8637).abs() < 1e-4,
+            "max modulus {}",
+            f.max_modulus
+        );
         let closure = closure_error(&p, &r.sol, 1e-11, 1e-13).unwrap();
         assert!(closure < 1e-5, "closure {closure}");
     }

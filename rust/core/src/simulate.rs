@@ -23,13 +23,25 @@ pub fn simulate<D: Dynamics + ?Sized>(
     if y0.len() != n {
         return Err(Error::param(
             "y0",
-            format!("needs 2 (n + 2) = {n} values (x, y, b_1..b_n and their rates), got {}", y0.len()),
+            format!(
+                "needs 2 (n + 2) = {n} values (x, y, b_1..b_n and their rates), got {}",
+                y0.len()
+            ),
         ));
     }
     if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
-        return Err(Error::param("y0", format!("entry {i} is not finite ({})", y0[i])));
+        return Err(Error::param(
+            "y0",
+            format!("entry {i} is not finite ({})", y0[i]),
+        ));
     }
-    let (y, stats) = solve_at(|t, y, dy| first_order_rhs(model, t, y, dy), t0, y0, t_eval, opts)?;
+    let (y, stats) = solve_at(
+        |t, y, dy| first_order_rhs(model, t, y, dy),
+        t0,
+        y0,
+        t_eval,
+        opts,
+    )?;
     Ok(Trajectory {
         t: t_eval.to_vec(),
         y,

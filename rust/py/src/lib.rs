@@ -6,7 +6,9 @@ use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::floquet::FloquetOptions;
 use ballbal_core::hb::{HbOptions, HbSolution, Status};
 use ballbal_core::ode::Options;
-use ballbal_core::periodic::{closure_error, parse_pattern, pattern_string, periodic as core_periodic, PeriodicOptions};
+use ballbal_core::periodic::{
+    closure_error, parse_pattern, pattern_string, periodic as core_periodic, PeriodicOptions,
+};
 use ballbal_core::simulate::simulate as core_simulate;
 use ballbal_core::{Dynamics, Error, Planar};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
@@ -17,7 +19,9 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 fn to_py(e: Error) -> PyErr {
     match e {
-        Error::InvalidParameter { .. } | Error::NotAutonomous { .. } => PyValueError::new_err(e.to_string()),
+        Error::InvalidParameter { .. } | Error::NotAutonomous { .. } => {
+            PyValueError::new_err(e.to_string())
+        }
         Error::Integration(_) => PyRuntimeError::new_err(e.to_string()),
     }
 }
@@ -31,12 +35,21 @@ fn guarded<T: Send, F: FnOnce() -> Result<T, Error> + Send>(py: Python<'_>, f: F
                 .cloned()
                 .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
                 .unwrap_or_else(|| "unknown".into());
-            PyRuntimeError::new_err(format!("internal error in ballbal core (please report): {msg}"))
+            PyRuntimeError::new_err(format!(
+                "internal error in ballbal core (please report): {msg}"
+            ))
         })?
         .map_err(to_py)
 }
 
-fn planar(mu: f64, zeta: f64, zeta_b: Vec<f64>, delta: f64, omega: f64, eta: Vec<f64>) -> PyResult<Planar> {
+fn planar(
+    mu: f64,
+    zeta: f64,
+    zeta_b: Vec<f64>,
+    delta: f64,
+    omega: f64,
+    eta: Vec<f64>,
+) -> PyResult<Planar> {
     Planar::new(mu, zeta, &zeta_b, delta, omega, &eta).map_err(to_py)
 }
 
@@ -76,7 +89,12 @@ fn simulate<'py>(
     let cols = y0.len();
     let flat: Vec<f64> = traj.y.into_iter().flatten().collect();
     let arr = PyArray1::from_vec(py, flat).reshape([te.len(), cols])?;
-    Ok((arr.into_any(), traj.stats.accepted, traj.stats.rejected, traj.stats.rhs_evals))
+    Ok((
+        arr.into_any(),
+        traj.stats.accepted,
+        traj.stats.rejected,
+        traj.stats.rhs_evals,
+    ))
 }
 
 /// All equilibria with their stability, as a list of dicts.
@@ -98,8 +116,14 @@ fn equilibria<'py>(
         d.set_item("kind", e.kind)?;
         d.set_item("q", PyArray1::from_vec(py, e.q))?;
         d.set_item("residual", e.residual)?;
-        d.set_item("eig_re", PyArray1::from_vec(py, e.eigenvalues.iter().map(|z| z.0).collect()))?;
-        d.set_item("eig_im", PyArray1::from_vec(py, e.eigenvalues.iter().map(|z| z.1).collect()))?;
+        d.set_item(
+            "eig_re",
+            PyArray1::from_vec(py, e.eigenvalues.iter().map(|z| z.0).collect()),
+        )?;
+        d.set_item(
+            "eig_im",
+            PyArray1::from_vec(py, e.eigenvalues.iter().map(|z| z.1).collect()),
+        )?;
         d.set_item("index", e.index)?;
         d.set_item("stability", e.verdict.as_str())?;
         d.set_item("neutral", e.neutral)?;
@@ -110,7 +134,10 @@ fn equilibria<'py>(
     Ok(out)
 }
 
-fn solution_dict<'py>(py: Python<'py>, r: ballbal_core::periodic::Periodic) -> PyResult<Bound<'py, PyDict>> {
+fn solution_dict<'py>(
+    py: Python<'py>,
+    r: ballbal_core::periodic::Periodic,
+) -> PyResult<Bound<'py, PyDict>> {
     let s = r.sol;
     let d = PyDict::new(py);
     let ok = s.status == Status::Converged;
@@ -120,7 +147,10 @@ fn solution_dict<'py>(py: Python<'py>, r: ballbal_core::periodic::Periodic) -> P
     d.set_item("last_omega", s.omega)?;
     let l = 2 * s.n_harm + 1;
     let ndof = s.winding.len();
-    d.set_item("coeffs", PyArray1::from_vec(py, s.coeffs).reshape([ndof, l])?)?;
+    d.set_item(
+        "coeffs",
+        PyArray1::from_vec(py, s.coeffs).reshape([ndof, l])?,
+    )?;
     d.set_item("winding", PyArray1::from_vec(py, s.winding))?;
     d.set_item("N", s.n_harm)?;
     d.set_item("samples", s.samples)?;
@@ -129,8 +159,14 @@ fn solution_dict<'py>(py: Python<'py>, r: ballbal_core::periodic::Periodic) -> P
     d.set_item("iterations", s.iterations)?;
     d.set_item("pivot_ratio", s.pivot_ratio)?;
     if let Some(f) = r.floquet {
-        d.set_item("mult_re", PyArray1::from_vec(py, f.multipliers.iter().map(|z| z.0).collect()))?;
-        d.set_item("mult_im", PyArray1::from_vec(py, f.multipliers.iter().map(|z| z.1).collect()))?;
+        d.set_item(
+            "mult_re",
+            PyArray1::from_vec(py, f.multipliers.iter().map(|z| z.0).collect()),
+        )?;
+        d.set_item(
+            "mult_im",
+            PyArray1::from_vec(py, f.multipliers.iter().map(|z| z.1).collect()),
+        )?;
         d.set_item("trivial_error", f.trivial_error)?;
         d.set_item("max_modulus", f.max_modulus)?;
         d.set_item("stability", f.stability.as_str())?;
@@ -197,7 +233,9 @@ fn periodic<'py>(
                 )));
             }
             if !(w.is_finite() && w > 0.0) || c.iter().any(|v| !v.is_finite()) {
-                return Err(PyValueError::new_err("guess: omega must be > 0 and every coefficient finite"));
+                return Err(PyValueError::new_err(
+                    "guess: omega must be > 0 and every coefficient finite",
+                ));
             }
             let mut winding = vec![0.0; d];
             for (i, &r) in rotating.iter().enumerate() {
@@ -218,10 +256,16 @@ fn periodic<'py>(
             })
         }
         (None, None) => None,
-        _ => return Err(PyValueError::new_err("guess: give both omega and coefficients, or neither")),
+        _ => {
+            return Err(PyValueError::new_err(
+                "guess: give both omega and coefficients, or neither",
+            ))
+        }
     };
     if !(settle > 0.0 && window > 0.0 && settle.is_finite() && window.is_finite()) {
-        return Err(PyValueError::new_err("settle, window: must be finite and > 0"));
+        return Err(PyValueError::new_err(
+            "settle, window: must be finite and > 0",
+        ));
     }
     let opts = PeriodicOptions {
         hb,
@@ -232,7 +276,9 @@ fn periodic<'py>(
             ..Default::default()
         },
     };
-    let r = guarded(py, || Ok(core_periodic(&p, &rotating, guess.as_ref(), &opts)))?;
+    let r = guarded(py, || {
+        Ok(core_periodic(&p, &rotating, guess.as_ref(), &opts))
+    })?;
     solution_dict(py, r)
 }
 
