@@ -34,7 +34,8 @@ def main() -> None:
     T = 1000.0
     t_eval = np.linspace(0, T, 2001)
     print(f"two-ball simulation over {T:g} time units, 2001 outputs")
-    print(f"{'rtol':>8} {'ballbal [ms]':>13} {'scipy RK45 [ms]':>16} {'ratio':>8} {'max |diff|':>11}")
+    print(f"{'rtol':>8} {'ballbal [ms]':>13} {'scipy RK45 [ms]':>16} {'ratio':>8} "
+          f"{'max |diff|':>11}")
     for rtol in (1e-6, 1e-8):
         atol = rtol * 1e-3
         t_us, df = best_of(lambda: ballbal.simulate(b, y0, t_eval, rtol=rtol, atol=atol), 5)

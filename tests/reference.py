@@ -22,7 +22,8 @@ def rhs(b, t, s):
     M[2:, 2:] = np.diag(m * dl)
     w2 = (Om + vb) ** 2
     g = np.empty(n + 2)
-    g[0] = 2 * z * vx - 2 * Om * vy + (1 - Om**2) * x - 2 * z * Om * y - np.sum(m * w2 * C) - b.mu * Om**2
+    g[0] = (2 * z * vx - 2 * Om * vy + (1 - Om**2) * x - 2 * z * Om * y - np.sum(m * w2 * C)
+            - b.mu * Om**2)
     g[1] = 2 * z * vy + 2 * Om * vx + (1 - Om**2) * y + 2 * z * Om * x - np.sum(m * w2 * S)
     g[2:] = m * (2 * Om * (C * vx + S * vy) + 2 * zb * dl * vb + Om**2 * (x * S - y * C))
     return np.concatenate([v, np.linalg.solve(M, -g)])

@@ -6,9 +6,10 @@ finite differences of the flow over one period."""
 from __future__ import annotations
 
 import numpy as np
-from reference import rhs
 from scipy.integrate import solve_ivp
 from scipy.optimize import fsolve
+
+from reference import rhs
 
 
 def flow(b, y0, T, rtol=1e-11, atol=1e-13):

@@ -50,8 +50,9 @@ def test_unbalanced_equilibria_match_seed003_closed_forms(omega0, m0, e):
     for q in tog:
         phi = q[2]
         assert abs(np.sin(phi + phi0) - arg) < 1e-12
-        x = (k * omega0**2 * (2 * m0 * np.cos(phi) + e) + 4 * m0 * omega0**3 * C0 * np.sin(phi)) / den / e
-        y = (2 * k * m0 * omega0**2 * np.sin(phi) - 2 * omega0**3 * C0 * (2 * m0 * np.cos(phi) + e)) / den / e
+        c2 = 2 * m0 * np.cos(phi) + e
+        x = (k * omega0**2 * c2 + 4 * m0 * omega0**3 * C0 * np.sin(phi)) / den / e
+        y = (2 * k * m0 * omega0**2 * np.sin(phi) - 2 * omega0**3 * C0 * c2) / den / e
         assert np.allclose(q[:2], [x, y], atol=1e-12)
     assert abs(_wrap(tog[0][2] - tog[1][2])) > 1e-3
 

@@ -1,8 +1,9 @@
 import numpy as np
 import pytest
-from shooting import monodromy_multipliers, shoot
 
 import ballbal
+
+from shooting import monodromy_multipliers, shoot
 
 THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 PUBLISHED_N3 = [1.0000, 0.8641, 0.2859, 0.2859, 0.2346, 0.2346, 0.1185, 0.0951]

@@ -1,9 +1,10 @@
 import numpy as np
 import pytest
-from reference import jacobi_integral, rhs
 from scipy.integrate import solve_ivp
 
 import ballbal
+
+from reference import jacobi_integral, rhs
 
 
 def test_installed_not_source_tree():

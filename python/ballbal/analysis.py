@@ -59,7 +59,7 @@ def simulate(
         t0 = float(t_span[0]) if t_span is not None else 0.0
     y, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol), _atol(atol))
     cols: dict[str, Any] = {"t": t}
-    for name, col in zip(_state_names(n), np.asarray(y).T):
+    for name, col in zip(_state_names(n), np.asarray(y).T, strict=True):
         cols[name] = col
     ph = balancer.Omega * t
     cols["X"] = cols["x"] * np.cos(ph) - cols["y"] * np.sin(ph)

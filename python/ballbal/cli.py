@@ -31,7 +31,9 @@ def _params(p: argparse.ArgumentParser) -> None:
 def _print_equilibria(b: Balancer) -> None:
     print(f"Equilibria at Omega={b.Omega}, eta={list(b.eta)}:")
     for e in equilibria(b):
-        rh = "" if e.routh_hurwitz is None else f", Routh-Hurwitz {'stable' if e.routh_hurwitz else 'not stable'}"
+        rh = ""
+        if e.routh_hurwitz is not None:
+            rh = f", Routh-Hurwitz {'stable' if e.routh_hurwitz else 'not stable'}"
         q = ", ".join(f"{v:+.4f}" for v in e.q)
         print(f"  {e.kind:16s} q=({q})  {e.stability} (index {e.stability_index:+.4g}{rh})")
 

@@ -114,7 +114,7 @@ class Balancer:
             "ball_masses": mb,
             "other_mass": total - disk_mass - sum(mb),
             "damping": 2 * self.zeta * total * wn,
-            "track_damping": [2 * z * m * wn for z, m in zip(zb, mb)],
+            "track_damping": [2 * z * m * wn for z, m in zip(zb, mb, strict=True)],
         }
 
 

@@ -66,7 +66,8 @@ impl Basis {
         }
     }
 
-    pub fn len(&self) -> usize {
+    /// Coefficients per coordinate, `2N + 1`.
+    pub fn width(&self) -> usize {
         2 * self.n_harm + 1
     }
 }
@@ -313,12 +314,12 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
 
     /// Number of unknowns (coefficients and omega) and equations.
     pub fn size(&self) -> usize {
-        self.d * self.basis.len() + 1
+        self.d * self.basis.width() + 1
     }
 
     /// Samples the coordinates at every collocation time: `q = Phi c + w tau`.
     fn sample(&mut self, x: &[f64]) {
-        let (d, l, s) = (self.d, self.basis.len(), self.basis.samples);
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         for i in 0..s {
             let tau = self.basis.tau[i];
             let (ph, dph, ddph) = (
@@ -343,7 +344,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
 
     /// Residual `r` (length `size()`), and the Jacobian (row-major) when `jac` is given.
     pub fn assemble(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut [f64]>) {
-        let (d, l, s) = (self.d, self.basis.len(), self.basis.samples);
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         let om = x[d * l];
         self.sample(x);
         let mut v = vec![0.0; d];

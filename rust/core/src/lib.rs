@@ -5,6 +5,9 @@
 //! eigenvalue and Routh–Hurwitz stability, periodic solutions by modified
 //! incremental harmonic balance, Floquet multipliers and parallel scans.
 
+// `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod equilibria;
 pub mod error;
 pub mod floquet;

@@ -19,6 +19,7 @@ pub trait Dynamics: Send + Sync {
     /// Residual `F(t, q, v, a)` into `out` (length `d`).
     fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]);
     /// Row-major `d x d` Jacobians `K = dF/dq`, `C = dF/dv`, `M = dF/da` at `(t, q, v, a)`.
+    #[allow(clippy::too_many_arguments)]
     fn jacobians(
         &self,
         t: f64,

@@ -6,6 +6,9 @@
 //! step grows by at most 10 and shrinks by at most 5, with safety factor 0.9, and the
 //! first step is chosen by the same heuristic (Hairer, Norsett & Wanner, II.4).
 
+// Stage loops index several arrays in lockstep; iterators would obscure the tableau.
+#![allow(clippy::needless_range_loop)]
+
 use crate::error::{Error, Result};
 
 const C2: f64 = 1.0 / 5.0;
