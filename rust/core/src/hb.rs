@@ -81,9 +81,14 @@ pub fn default_samples(n_harm: usize) -> usize {
 
 /// Evaluates one coordinate's series and its tau-derivatives at `tau`.
 pub fn eval_series(c: &[f64], w: f64, tau: f64) -> (f64, f64, f64) {
+    eval_series_sc(c, w, tau, tau.sin_cos())
+}
+
+/// As [`eval_series`] with `sin tau, cos tau` supplied, so that several coordinates at
+/// one phase share a single trigonometric call.
+pub fn eval_series_sc(c: &[f64], w: f64, tau: f64, (s1, c1): (f64, f64)) -> (f64, f64, f64) {
     let n = (c.len() - 1) / 2;
     let (mut q, mut qt, mut qtt) = (c[0] + w * tau, w, 0.0);
-    let (s1, c1) = tau.sin_cos();
     let (mut sm, mut cm) = (0.0f64, 1.0f64);
     for m in 1..=n {
         // cos/sin of m tau by rotation recurrence: no trig call per harmonic.
@@ -218,8 +223,9 @@ impl HbSolution {
 
     /// `q, dq/dtau, d2q/dtau2` at phase `tau`.
     pub fn eval(&self, tau: f64, q: &mut [f64], qt: &mut [f64], qtt: &mut [f64]) {
+        let sc = tau.sin_cos();
         for j in 0..self.ndof() {
-            let (a, b, c) = eval_series(self.coord(j), self.winding[j], tau);
+            let (a, b, c) = eval_series_sc(self.coord(j), self.winding[j], tau, sc);
             q[j] = a;
             qt[j] = b;
             qtt[j] = c;

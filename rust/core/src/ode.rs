@@ -132,7 +132,6 @@ pub struct Dopri5 {
     y_new: Vec<f64>,
     tmp: Vec<f64>,
     err: Vec<f64>,
-    cont: [Vec<f64>; 5],
 }
 
 impl Dopri5 {
@@ -144,7 +143,6 @@ impl Dopri5 {
             y_new: z(),
             tmp: z(),
             err: z(),
-            cont: [z(), z(), z(), z(), z()],
         }
     }
 
@@ -282,28 +280,15 @@ impl Dopri5 {
                 if rejected_last {
                     fac = fac.min(1.0);
                 }
-                // Dense output coefficients for this step.
-                for i in 0..n {
-                    let ydiff = self.y_new[i] - y[i];
-                    let bspl = hs * self.k[0][i] - ydiff;
-                    self.cont[0][i] = y[i];
-                    self.cont[1][i] = ydiff;
-                    self.cont[2][i] = bspl;
-                    self.cont[3][i] = ydiff - hs * self.k[6][i] - bspl;
-                    self.cont[4][i] = hs
-                        * (D1 * self.k[0][i]
-                            + D3 * self.k[2][i]
-                            + D4 * self.k[3][i]
-                            + D5 * self.k[4][i]
-                            + D6 * self.k[5][i]
-                            + D7 * self.k[6][i]);
-                }
                 let t_new = if last { t1 } else { t + hs };
                 stats.accepted += 1;
+                // Dense output is formed only when the observer interpolates.
                 let dense = Dense {
                     t0: t,
                     h: hs,
-                    cont: &self.cont,
+                    y: &y,
+                    y_new: &self.y_new,
+                    k: &self.k,
                 };
                 let go_on = observe(t, t_new, &dense);
                 t = t_new;
@@ -356,20 +341,32 @@ impl Dopri5 {
     }
 }
 
-/// Dense output of one accepted step.
+/// Dense output of one accepted step (Hairer's continuous extension of DOPRI5).
 pub struct Dense<'a> {
     t0: f64,
     h: f64,
-    cont: &'a [Vec<f64>; 5],
+    y: &'a [f64],
+    y_new: &'a [f64],
+    k: &'a [Vec<f64>; 7],
 }
 
 impl Dense<'_> {
     pub fn eval(&self, t: f64, out: &mut [f64]) {
         let th = (t - self.t0) / self.h;
         let th1 = 1.0 - th;
-        let c = self.cont;
+        let (h, k) = (self.h, self.k);
         for i in 0..out.len() {
-            out[i] = c[0][i] + th * (c[1][i] + th1 * (c[2][i] + th * (c[3][i] + th1 * c[4][i])));
+            let ydiff = self.y_new[i] - self.y[i];
+            let bspl = h * k[0][i] - ydiff;
+            let c3 = ydiff - h * k[6][i] - bspl;
+            let c4 = h
+                * (D1 * k[0][i]
+                    + D3 * k[2][i]
+                    + D4 * k[3][i]
+                    + D5 * k[4][i]
+                    + D6 * k[5][i]
+                    + D7 * k[6][i]);
+            out[i] = self.y[i] + th * (ydiff + th1 * (bspl + th * (c3 + th1 * c4)));
         }
     }
 }
