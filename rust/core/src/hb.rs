@@ -212,6 +212,28 @@ pub struct HbSolution {
 }
 
 impl HbSolution {
+    /// An unsolved starting point (a guess, or an attempt that never started).
+    pub fn start(
+        omega: f64,
+        coeffs: Vec<f64>,
+        winding: Vec<f64>,
+        n_harm: usize,
+        status: Status,
+    ) -> Self {
+        HbSolution {
+            omega,
+            coeffs,
+            winding,
+            n_harm,
+            samples: 0,
+            residual: f64::NAN,
+            step: f64::NAN,
+            iterations: 0,
+            status,
+            pivot_ratio: f64::NAN,
+        }
+    }
+
     pub fn ndof(&self) -> usize {
         self.winding.len()
     }

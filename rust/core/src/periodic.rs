@@ -256,18 +256,13 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
         }
     }
     let coeffs = fit_coefficients(&samples, d, &winding, n_harm);
-    Some(HbSolution {
-        omega: 2.0 * PI / period,
+    Some(HbSolution::start(
+        2.0 * PI / period,
         coeffs,
         winding,
         n_harm,
-        samples: 0,
-        residual: f64::NAN,
-        step: f64::NAN,
-        iterations: 0,
-        status: Status::NoGuess,
-        pivot_ratio: f64::NAN,
-    })
+        Status::NoGuess,
+    ))
 }
 
 #[derive(Debug, Clone, Default)]
@@ -338,18 +333,13 @@ pub fn no_guess(p: &Planar, rotating: &[bool], n_harm: usize) -> HbSolution {
     for (i, &r) in rotating.iter().enumerate() {
         winding[2 + i] = if r { -1.0 } else { 0.0 };
     }
-    HbSolution {
-        omega: f64::NAN,
-        coeffs: vec![f64::NAN; d * (2 * n_harm + 1)],
+    HbSolution::start(
+        f64::NAN,
+        vec![f64::NAN; d * (2 * n_harm + 1)],
         winding,
         n_harm,
-        samples: 0,
-        residual: f64::NAN,
-        step: f64::NAN,
-        iterations: 0,
-        status: Status::NoGuess,
-        pivot_ratio: f64::NAN,
-    }
+        Status::NoGuess,
+    )
 }
 
 /// The thesis' "NI" check: simulate from the solution's state for one period and return

@@ -242,18 +242,7 @@ fn periodic<'py>(
                 winding[2 + i] = if r { -1.0 } else { 0.0 };
             }
             let nh = (c.len() / d - 1) / 2;
-            Some(HbSolution {
-                omega: w,
-                coeffs: c,
-                winding,
-                n_harm: nh,
-                samples: 0,
-                residual: f64::NAN,
-                step: f64::NAN,
-                iterations: 0,
-                status: Status::NoGuess,
-                pivot_ratio: f64::NAN,
-            })
+            Some(HbSolution::start(w, c, winding, nh, Status::NoGuess))
         }
         (None, None) => None,
         _ => {
@@ -303,18 +292,13 @@ fn orbit_closure(
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let c = slice(&coeffs, "coeffs")?.to_vec();
     let d = winding.len();
-    let sol = HbSolution {
-        omega: sol_omega,
-        n_harm: (c.len() / d - 1) / 2,
-        coeffs: c,
-        winding,
-        samples: 0,
-        residual: f64::NAN,
-        step: f64::NAN,
-        iterations: 0,
-        status: Status::Converged,
-        pivot_ratio: f64::NAN,
-    };
+    if d == 0 || c.len() % d != 0 || (c.len() / d) % 2 != 1 {
+        return Err(PyValueError::new_err(
+            "coeffs: need (n + 2) x (2 N + 1) values",
+        ));
+    }
+    let n_harm = (c.len() / d - 1) / 2;
+    let sol = HbSolution::start(sol_omega, c, winding, n_harm, Status::Converged);
     guarded(py, || closure_error(&p, &sol, rtol, atol))
 }
 
