@@ -8,7 +8,7 @@
 
 use crate::error::Result;
 use crate::hb::HbSolution;
-use crate::linalg::{eigenvalues, state_matrix};
+use crate::linalg::eigenvalues;
 use crate::model::Dynamics;
 use crate::ode::{Dopri5, Options};
 
@@ -81,8 +81,7 @@ pub fn monodromy<D: Dynamics + ?Sized>(
     let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
     let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
-    let mut col = vec![0.0; 2 * d * d];
-    let mut amat = vec![0.0; n2 * n2];
+    let mut cols = vec![0.0; 2 * d * d];
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| {
         sol.eval(om * t, &mut q, &mut qt, &mut qtt);
         for j in 0..d {
@@ -90,19 +89,24 @@ pub fn monodromy<D: Dynamics + ?Sized>(
             a[j] = om * om * qtt[j];
         }
         model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
-        state_matrix(model, t, &q, &k, &c, &mut col, &mut amat);
+        // Bottom half of A = [-M^-1 K, -M^-1 C], as 2d columns of length d.
+        for j in 0..d {
+            for i in 0..d {
+                cols[j * d + i] = -k[i * d + j];
+                cols[(d + j) * d + i] = -c[i * d + j];
+            }
+        }
+        model.solve_mass_columns(t, &q, &mut cols);
         // dPhi = A Phi; the top half of A is [0 I], so those rows just copy.
         dy[..d * n2].copy_from_slice(&y[d * n2..]);
-        for i in d..n2 {
-            let arow = &amat[i * n2..(i + 1) * n2];
-            let out = &mut dy[i * n2..(i + 1) * n2];
+        for i in 0..d {
+            let out = &mut dy[(d + i) * n2..(d + i + 1) * n2];
             out.fill(0.0);
-            for (kk, &aik) in arow.iter().enumerate() {
-                if aik != 0.0 {
-                    let yrow = &y[kk * n2..(kk + 1) * n2];
-                    for jj in 0..n2 {
-                        out[jj] += aik * yrow[jj];
-                    }
+            for kk in 0..n2 {
+                let aik = cols[kk * d + i];
+                let yrow = &y[kk * n2..(kk + 1) * n2];
+                for (o, yv) in out.iter_mut().zip(yrow) {
+                    *o += aik * yv;
                 }
             }
         }

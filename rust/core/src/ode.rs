@@ -314,30 +314,36 @@ impl Dopri5 {
         F: FnMut(f64, &[f64], &mut [f64]),
     {
         let n = self.n;
-        macro_rules! stage {
-            ($dst:expr, $c:expr, $($a:expr => $kk:expr),+) => {{
-                for i in 0..n {
-                    self.tmp[i] = y[i] + h * (0.0 $( + $a * self.k[$kk][i])+);
-                }
-                let (tmp, k) = (&self.tmp, &mut self.k);
-                f(t + $c * h, tmp, &mut k[$dst]);
-            }};
-        }
-        stage!(1, C2, A21 => 0);
-        stage!(2, C3, A31 => 0, A32 => 1);
-        stage!(3, C4, A41 => 0, A42 => 1, A43 => 2);
-        stage!(4, C5, A51 => 0, A52 => 1, A53 => 2, A54 => 3);
-        stage!(5, 1.0, A61 => 0, A62 => 1, A63 => 2, A64 => 3, A65 => 4);
+        let [k0, k1, k2, k3, k4, k5, k6] = &mut self.k;
+        let tmp = &mut self.tmp[..n];
+        let y = &y[..n];
         for i in 0..n {
-            self.y_new[i] = y[i]
-                + h * (A71 * self.k[0][i]
-                    + A73 * self.k[2][i]
-                    + A74 * self.k[3][i]
-                    + A75 * self.k[4][i]
-                    + A76 * self.k[5][i]);
+            tmp[i] = y[i] + h * (A21 * k0[i]);
         }
-        let (yn, k) = (&self.y_new, &mut self.k);
-        f(t + h, yn, &mut k[6]);
+        f(t + C2 * h, tmp, k1);
+        for i in 0..n {
+            tmp[i] = y[i] + h * (A31 * k0[i] + A32 * k1[i]);
+        }
+        f(t + C3 * h, tmp, k2);
+        for i in 0..n {
+            tmp[i] = y[i] + h * (A41 * k0[i] + A42 * k1[i] + A43 * k2[i]);
+        }
+        f(t + C4 * h, tmp, k3);
+        for i in 0..n {
+            tmp[i] = y[i] + h * (A51 * k0[i] + A52 * k1[i] + A53 * k2[i] + A54 * k3[i]);
+        }
+        f(t + C5 * h, tmp, k4);
+        for i in 0..n {
+            tmp[i] =
+                y[i] + h * (A61 * k0[i] + A62 * k1[i] + A63 * k2[i] + A64 * k3[i] + A65 * k4[i]);
+        }
+        f(t + h, tmp, k5);
+        let yn = &mut self.y_new[..n];
+        for i in 0..n {
+            yn[i] =
+                y[i] + h * (A71 * k0[i] + A73 * k2[i] + A74 * k3[i] + A75 * k4[i] + A76 * k5[i]);
+        }
+        f(t + h, yn, k6);
     }
 }
 
