@@ -9,6 +9,7 @@ from .analysis import (
     simulate,
 )
 from .model import Balancer, from_seed003, zeta_from_log_decrement
+from .scan import scan
 
 __all__ = [
     "Balancer",
@@ -18,6 +19,7 @@ __all__ = [
     "equilibria",
     "from_seed003",
     "periodic",
+    "scan",
     "simulate",
     "zeta_from_log_decrement",
 ]

@@ -24,3 +24,10 @@ def orbit_closure(
     sol_omega: float, coeffs: npt.NDArray[np.float64], winding: list[float], rtol: float,
     atol: float,
 ) -> float: ...
+def scan(
+    mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
+    names: tuple[str, str], values0: list[float], values1: list[float], patterns: list[str],
+    n_harm: int, samples: int | None, tol: float, step_tol: float, max_iter: int,
+    floquet: bool, f_rtol: float, f_atol: float, margin: float, settle: float, window: float,
+    threads: int,
+) -> dict[str, Any]: ...

@@ -16,6 +16,7 @@ pub mod linalg;
 pub mod model;
 pub mod ode;
 pub mod periodic;
+pub mod scan;
 pub mod simulate;
 
 pub use error::{Error, Result};

@@ -302,12 +302,190 @@ fn orbit_closure(
     guarded(py, || closure_error(&p, &sol, rtol, atol))
 }
 
+/// Parallel two-parameter scan; returns a dict of flat columns (one entry per row).
+#[pyfunction]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, names, values0, values1, patterns,
+                    n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin,
+                    settle, window, threads))]
+#[allow(clippy::too_many_arguments)]
+fn scan<'py>(
+    py: Python<'py>,
+    mu: f64,
+    zeta: f64,
+    zeta_b: Vec<f64>,
+    delta: f64,
+    omega: f64,
+    eta: Vec<f64>,
+    names: (String, String),
+    values0: Vec<f64>,
+    values1: Vec<f64>,
+    patterns: Vec<String>,
+    n_harm: usize,
+    samples: Option<usize>,
+    tol: f64,
+    step_tol: f64,
+    max_iter: usize,
+    floquet: bool,
+    f_rtol: f64,
+    f_atol: f64,
+    margin: f64,
+    settle: f64,
+    window: f64,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    use ballbal_core::scan::{scan as core_scan, ScanSpec};
+    let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let rots = patterns
+        .iter()
+        .map(|s| parse_pattern(s, p.n_balls()))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(to_py)?;
+    if rots.is_empty() {
+        return Err(PyValueError::new_err(
+            "patterns: give at least one solution type",
+        ));
+    }
+    let hb = HbOptions {
+        n_harm,
+        samples,
+        tol,
+        step_tol,
+        max_iter,
+    };
+    hb.validate().map_err(to_py)?;
+    Options::new(f_rtol, f_atol).validate(1).map_err(to_py)?;
+    let opts = PeriodicOptions {
+        hb,
+        floquet: floquet.then_some(FloquetOptions {
+            rtol: f_rtol,
+            atol: f_atol,
+            margin,
+        }),
+        guess: ballbal_core::periodic::GuessOptions {
+            settle,
+            window,
+            ..Default::default()
+        },
+    };
+    let rows = guarded(py, || {
+        core_scan(&ScanSpec {
+            base: &p,
+            names: [&names.0, &names.1],
+            values: [&values0, &values1],
+            patterns: &rots,
+            opts,
+            threads,
+        })
+    })?;
+    let d = PyDict::new(py);
+    let n = rows.len();
+    let c = |name: &str, v: Vec<f64>| d.set_item(name, PyArray1::from_vec(py, v));
+    c(&names.0, rows.iter().map(|r| values0[r.i]).collect())?;
+    c(&names.1, rows.iter().map(|r| values1[r.j]).collect())?;
+    fn conv(r: &ballbal_core::scan::ScanRow) -> Option<&ballbal_core::periodic::Periodic> {
+        r.result
+            .as_ref()
+            .filter(|x| x.sol.status == Status::Converged)
+    }
+    let nan = f64::NAN;
+    c(
+        "omega",
+        rows.iter()
+            .map(|r| conv(r).map_or(nan, |x| x.sol.omega))
+            .collect(),
+    )?;
+    c(
+        "residual",
+        rows.iter()
+            .map(|r| conv(r).map_or(nan, |x| x.sol.residual))
+            .collect(),
+    )?;
+    c(
+        "iterations",
+        rows.iter()
+            .map(|r| conv(r).map_or(nan, |x| x.sol.iterations as f64))
+            .collect(),
+    )?;
+    c("seconds", rows.iter().map(|r| r.seconds).collect())?;
+    c(
+        "max_modulus",
+        rows.iter()
+            .map(|r| {
+                conv(r)
+                    .and_then(|x| x.floquet.as_ref())
+                    .map_or(nan, |f| f.max_modulus)
+            })
+            .collect(),
+    )?;
+    c(
+        "trivial_error",
+        rows.iter()
+            .map(|r| {
+                conv(r)
+                    .and_then(|x| x.floquet.as_ref())
+                    .map_or(nan, |f| f.trivial_error)
+            })
+            .collect(),
+    )?;
+    let mults: Vec<(Vec<f64>, Vec<f64>)> = rows
+        .iter()
+        .map(|r| match conv(r).and_then(|x| x.floquet.as_ref()) {
+            Some(f) => (
+                f.multipliers.iter().map(|z| z.0).collect(),
+                f.multipliers.iter().map(|z| z.1).collect(),
+            ),
+            None => (vec![], vec![]),
+        })
+        .collect();
+    d.set_item(
+        "mult_re",
+        mults.iter().map(|m| m.0.clone()).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "mult_im",
+        mults.iter().map(|m| m.1.clone()).collect::<Vec<_>>(),
+    )?;
+    let strs = |f: &dyn Fn(&ballbal_core::scan::ScanRow) -> String| {
+        rows.iter().map(f).collect::<Vec<String>>()
+    };
+    d.set_item("type", strs(&|r| patterns[r.pattern].clone()))?;
+    d.set_item(
+        "status",
+        strs(&|r| match &r.result {
+            Some(x) => x.sol.status.as_str().to_string(),
+            None => "no_solution".to_string(),
+        }),
+    )?;
+    d.set_item(
+        "stability",
+        strs(&|r| {
+            conv(r)
+                .and_then(|x| x.floquet.as_ref())
+                .map_or("undetermined", |f| f.stability.as_str())
+                .to_string()
+        }),
+    )?;
+    d.set_item("origin", strs(&|r| r.origin.to_string()))?;
+    d.set_item(
+        "pb_exists",
+        rows.iter().map(|r| r.pb_exists).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "pb_stable",
+        rows.iter().map(|r| r.pb_stable).collect::<Vec<_>>(),
+    )?;
+    d.set_item("N", n_harm)?;
+    d.set_item("rows", n)?;
+    Ok(d)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(equilibria, m)?)?;
     m.add_function(wrap_pyfunction!(periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbit_closure, m)?)?;
+    m.add_function(wrap_pyfunction!(scan, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
