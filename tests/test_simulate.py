@@ -1,3 +1,5 @@
+import re
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -83,9 +85,9 @@ def test_fixed_frame_position():
 )
 def test_bad_parameters_raise_value_error_naming_them(kwargs, name):
     b = ballbal.Balancer(**kwargs)
-    with pytest.raises(ValueError, match=rf"^{name.replace('[', '[[]')}"):
+    with pytest.raises(ValueError, match="^" + re.escape(name) + ":"):
         ballbal.simulate(b, t_span=(0, 1))
-    with pytest.raises(ValueError, match=rf"^{name.replace('[', '[[]')}"):
+    with pytest.raises(ValueError, match="^" + re.escape(name) + ":"):
         ballbal.equilibria(b)
 
 
