@@ -111,6 +111,11 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     let (_, ys, _) = solver
         .integrate(rhs, 0.0, y0, g.settle, &opts, |_, _, _| true)
         .ok()?;
+    // Already at rest relative to the disk: the start fell into an equilibrium, and a
+    // periodic motion cannot appear from rest in an autonomous system.
+    if ys[d..].iter().all(|v| v.abs() < 1e-9) {
+        return None;
+    }
     // Observe: record the phase signal's crossings.
     let r = rotating.iter().position(|&b| b);
     let dt = 0.05;
