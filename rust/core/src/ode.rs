@@ -403,16 +403,10 @@ where
         idx += 1;
     }
     let mut solver = Dopri5::new(n);
-    let (_, _, stats) = solver.integrate(f, t0, y0, t1, opts, |ta, tb, dense| {
+    let (_, _, stats) = solver.integrate(f, t0, y0, t1, opts, |_, tb, dense| {
         while idx < t_eval.len() && dir * (t_eval[idx] - tb) <= 0.0 {
-            let _ = ta;
             let mut v = vec![0.0; n];
-            if t_eval[idx] == tb {
-                // Exact end of step: dense output is exact there too, but avoid 0/0 when h tiny.
-                dense.eval(tb, &mut v);
-            } else {
-                dense.eval(t_eval[idx], &mut v);
-            }
+            dense.eval(t_eval[idx], &mut v);
             out.push(v);
             idx += 1;
         }

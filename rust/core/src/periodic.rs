@@ -122,7 +122,7 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     let mut t_prev = g.settle;
     let mut y_prev = ys.clone();
     let mut crossings: Vec<f64> = vec![];
-    let mut start_b: Vec<f64> = ys[2..d].to_vec();
+    let start_b: Vec<f64> = ys[2..d].to_vec();
     let mut end_b = start_b.clone();
     let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
     let mut tmp = vec![0.0; 2 * d];
@@ -221,7 +221,6 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
         }
         found?
     };
-    let _ = start_b.iter_mut();
     // Re-simulate one period at collocation times for the fit.
     let s = crate::hb::default_samples(n_harm) * 2;
     let t0 = t_c - period;
