@@ -178,6 +178,50 @@ fn solution_dict<'py>(
     Ok(d)
 }
 
+/// Solver options shared by `periodic` and `scan`, validated before any work starts.
+#[allow(clippy::too_many_arguments)]
+fn periodic_options(
+    n_harm: usize,
+    samples: Option<usize>,
+    tol: f64,
+    step_tol: f64,
+    max_iter: usize,
+    floquet: bool,
+    f_rtol: f64,
+    f_atol: f64,
+    margin: f64,
+    settle: f64,
+    window: f64,
+) -> PyResult<PeriodicOptions> {
+    let hb = HbOptions {
+        n_harm,
+        samples,
+        tol,
+        step_tol,
+        max_iter,
+    };
+    hb.validate().map_err(to_py)?;
+    Options::new(f_rtol, f_atol).validate(1).map_err(to_py)?;
+    if !(settle > 0.0 && window > 0.0 && settle.is_finite() && window.is_finite()) {
+        return Err(PyValueError::new_err(
+            "settle, window: must be finite and > 0",
+        ));
+    }
+    Ok(PeriodicOptions {
+        hb,
+        floquet: floquet.then_some(FloquetOptions {
+            rtol: f_rtol,
+            atol: f_atol,
+            margin,
+        }),
+        guess: ballbal_core::periodic::GuessOptions {
+            settle,
+            window,
+            ..Default::default()
+        },
+    })
+}
+
 /// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers.
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, pattern, n_harm, samples, tol, step_tol, max_iter,
@@ -208,20 +252,9 @@ fn periodic<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let rotating = parse_pattern(pattern, p.n_balls()).map_err(to_py)?;
-    let hb = HbOptions {
-        n_harm,
-        samples,
-        tol,
-        step_tol,
-        max_iter,
-    };
-    hb.validate().map_err(to_py)?;
-    let fo = FloquetOptions {
-        rtol: f_rtol,
-        atol: f_atol,
-        margin,
-    };
-    Options::new(f_rtol, f_atol).validate(1).map_err(to_py)?;
+    let opts = periodic_options(
+        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, settle, window,
+    )?;
     let d = p.ndof();
     let guess = match (guess_omega, guess_coeffs) {
         (Some(w), Some(c)) => {
@@ -250,20 +283,6 @@ fn periodic<'py>(
                 "guess: give both omega and coefficients, or neither",
             ))
         }
-    };
-    if !(settle > 0.0 && window > 0.0 && settle.is_finite() && window.is_finite()) {
-        return Err(PyValueError::new_err(
-            "settle, window: must be finite and > 0",
-        ));
-    }
-    let opts = PeriodicOptions {
-        hb,
-        floquet: floquet.then_some(fo),
-        guess: ballbal_core::periodic::GuessOptions {
-            settle,
-            window,
-            ..Default::default()
-        },
     };
     let r = guarded(py, || {
         Ok(core_periodic(&p, &rotating, guess.as_ref(), &opts))
@@ -345,28 +364,9 @@ fn scan<'py>(
             "patterns: give at least one solution type",
         ));
     }
-    let hb = HbOptions {
-        n_harm,
-        samples,
-        tol,
-        step_tol,
-        max_iter,
-    };
-    hb.validate().map_err(to_py)?;
-    Options::new(f_rtol, f_atol).validate(1).map_err(to_py)?;
-    let opts = PeriodicOptions {
-        hb,
-        floquet: floquet.then_some(FloquetOptions {
-            rtol: f_rtol,
-            atol: f_atol,
-            margin,
-        }),
-        guess: ballbal_core::periodic::GuessOptions {
-            settle,
-            window,
-            ..Default::default()
-        },
-    };
+    let opts = periodic_options(
+        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, settle, window,
+    )?;
     let rows = guarded(py, || {
         core_scan(&ScanSpec {
             base: &p,
@@ -387,45 +387,23 @@ fn scan<'py>(
             .as_ref()
             .filter(|x| x.sol.status == Status::Converged)
     }
-    let nan = f64::NAN;
-    c(
-        "omega",
+    // A float column of converged rows, NaN elsewhere (Python turns NaN into null).
+    let per_row = |f: &dyn Fn(&ballbal_core::periodic::Periodic) -> Option<f64>| -> Vec<f64> {
         rows.iter()
-            .map(|r| conv(r).map_or(nan, |x| x.sol.omega))
-            .collect(),
-    )?;
-    c(
-        "residual",
-        rows.iter()
-            .map(|r| conv(r).map_or(nan, |x| x.sol.residual))
-            .collect(),
-    )?;
-    c(
-        "iterations",
-        rows.iter()
-            .map(|r| conv(r).map_or(nan, |x| x.sol.iterations as f64))
-            .collect(),
-    )?;
+            .map(|r| conv(r).and_then(f).unwrap_or(f64::NAN))
+            .collect()
+    };
+    c("omega", per_row(&|x| Some(x.sol.omega)))?;
+    c("residual", per_row(&|x| Some(x.sol.residual)))?;
+    c("iterations", per_row(&|x| Some(x.sol.iterations as f64)))?;
     c("seconds", rows.iter().map(|r| r.seconds).collect())?;
     c(
         "max_modulus",
-        rows.iter()
-            .map(|r| {
-                conv(r)
-                    .and_then(|x| x.floquet.as_ref())
-                    .map_or(nan, |f| f.max_modulus)
-            })
-            .collect(),
+        per_row(&|x| x.floquet.as_ref().map(|f| f.max_modulus)),
     )?;
     c(
         "trivial_error",
-        rows.iter()
-            .map(|r| {
-                conv(r)
-                    .and_then(|x| x.floquet.as_ref())
-                    .map_or(nan, |f| f.trivial_error)
-            })
-            .collect(),
+        per_row(&|x| x.floquet.as_ref().map(|f| f.trivial_error)),
     )?;
     let mults: Vec<(Vec<f64>, Vec<f64>)> = rows
         .iter()
