@@ -11,6 +11,8 @@ pub enum Error {
     NotAutonomous { effect: String },
     /// The integrator could not proceed (step size underflow, too many steps, non-finite state).
     Integration(String),
+    /// The caller asked the work to stop (e.g. Ctrl-C); finished parts were handed over.
+    Cancelled,
 }
 
 impl Error {
@@ -31,6 +33,7 @@ impl fmt::Display for Error {
                 "this analysis needs an autonomous scene, but the effect '{effect}' makes it time dependent"
             ),
             Error::Integration(m) => write!(f, "integration failed: {m}"),
+            Error::Cancelled => write!(f, "cancelled"),
         }
     }
 }

@@ -37,6 +37,10 @@ pub struct FloquetOptions {
     /// Least margin around modulus 1 for a definite verdict; the trivial multiplier's
     /// error widens it, since it measures how accurate the whole computation is.
     pub margin: f64,
+    /// Step budget of the monodromy integration: a very long period (omega near 0, where
+    /// a rotating branch ends) would otherwise run for minutes; past it the analysis
+    /// fails with a message and the verdict is undetermined.
+    pub max_steps: usize,
 }
 
 impl Default for FloquetOptions {
@@ -45,6 +49,7 @@ impl Default for FloquetOptions {
             rtol: 1e-8,
             atol: 1e-10,
             margin: 1e-6,
+            max_steps: 200_000,
         }
     }
 }
@@ -111,7 +116,10 @@ pub fn monodromy<D: Dynamics + ?Sized>(
             }
         }
     };
-    let ode_opts = Options::new(opts.rtol, opts.atol);
+    let ode_opts = Options {
+        max_steps: opts.max_steps,
+        ..Options::new(opts.rtol, opts.atol)
+    };
     let mut solver = Dopri5::new(n2 * n2);
     let (_, phi, stats) = solver.integrate(rhs, 0.0, &y0, period, &ode_opts, |_, _, _| true)?;
     Ok((phi, stats.accepted, stats.rhs_evals))

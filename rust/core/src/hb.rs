@@ -278,6 +278,19 @@ impl HbSolution {
             .fold(0.0, f64::max)
     }
 
+    /// [`Self::tail`] relative to the support's first-harmonic amplitude (at least 1): a
+    /// series whose last harmonic is as large as its motion has not resolved the orbit
+    /// (such "solutions" appear where a rotating branch creeps towards omega = 0).
+    pub fn tail_ratio(&self) -> f64 {
+        let amp = (0..2)
+            .map(|j| {
+                let c = self.coord(j);
+                c[1].hypot(c[2])
+            })
+            .fold(1.0, f64::max);
+        self.tail() / amp
+    }
+
     /// The same solution with `n_harm` harmonics (truncated or zero-padded): a predictor.
     pub fn resized(&self, n_harm: usize) -> HbSolution {
         let (lo, ln) = (2 * self.n_harm + 1, 2 * n_harm + 1);

@@ -93,13 +93,15 @@ pub fn initial_states(p: &Planar) -> Vec<Vec<f64>> {
     out
 }
 
-/// Tries to turn one simulated attractor into a harmonic-balance starting guess with
-/// the requested rotation pattern. `None` if the motion settles to rest, is of another
-/// type, or shows no clear period.
+/// Tries to turn one simulated attractor into a harmonic-balance starting guess.
+/// With `rotating = Some(pattern)` only that rotation pattern is accepted; with `None`
+/// the pattern is read off the attractor (balls that make at least 1.5 net turns during
+/// the observation rotate) and is carried by the guess's `winding`. `None` if the motion
+/// settles to rest, is of another type, or shows no clear period.
 pub fn guess_from_state<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
-    rotating: &[bool],
+    rotating: Option<&[bool]>,
     n_harm: usize,
     g: &GuessOptions,
 ) -> Option<HbSolution> {
@@ -108,20 +110,26 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     let opts = Options::new(g.rtol, g.atol);
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
     let mut solver = Dopri5::new(2 * d);
+    // A start that comes to rest relative to the disk has fallen into an equilibrium (a
+    // periodic motion cannot appear from rest in an autonomous system): stop there
+    // rather than settle for the whole time.
+    let mut at_rest = false;
+    let mut probe = vec![0.0; 2 * d];
     let (_, ys, _) = solver
-        .integrate(rhs, 0.0, y0, g.settle, &opts, |_, _, _| true)
+        .integrate(rhs, 0.0, y0, g.settle, &opts, |_, tb, dense| {
+            dense.eval(tb, &mut probe);
+            at_rest = tb > 50.0 && probe[d..].iter().all(|v| v.abs() < 1e-7);
+            !at_rest
+        })
         .ok()?;
-    // Already at rest relative to the disk: the start fell into an equilibrium, and a
-    // periodic motion cannot appear from rest in an autonomous system.
-    if ys[d..].iter().all(|v| v.abs() < 1e-9) {
+    if at_rest || ys[d..].iter().all(|v| v.abs() < 1e-9) {
         return None;
     }
-    // Observe: record the phase signal's crossings.
-    let r = rotating.iter().position(|&b| b);
+    // Observe: record every ball's crossings of whole turns, and x for oscillations.
     let dt = 0.05;
     let mut t_prev = g.settle;
     let mut y_prev = ys.clone();
-    let mut crossings: Vec<f64> = vec![];
+    let mut crossings: Vec<Vec<f64>> = vec![vec![]; n];
     let start_b: Vec<f64> = ys[2..d].to_vec();
     let mut end_b = start_b.clone();
     let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
@@ -138,27 +146,26 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
             let mut t = t_prev + dt;
             while t <= tb {
                 dense.eval(t, &mut tmp);
-                match r {
-                    Some(r) => {
-                        let (a, b) = (
-                            (y_prev[2 + r] / (2.0 * PI)).floor(),
-                            (tmp[2 + r] / (2.0 * PI)).floor(),
-                        );
-                        if a != b {
-                            // Linear interpolation of the level crossing.
-                            let level = 2.0 * PI * a.max(b);
-                            let f = (level - y_prev[2 + r]) / (tmp[2 + r] - y_prev[2 + r]);
-                            crossings.push(t - dt + f * dt);
-                        }
+                for (i, c) in crossings.iter_mut().enumerate() {
+                    let (a, b) = (
+                        (y_prev[2 + i] / (2.0 * PI)).floor(),
+                        (tmp[2 + i] / (2.0 * PI)).floor(),
+                    );
+                    if a != b {
+                        // Linear interpolation of the level crossing.
+                        let level = 2.0 * PI * a.max(b);
+                        let f = (level - y_prev[2 + i]) / (tmp[2 + i] - y_prev[2 + i]);
+                        c.push(t - dt + f * dt);
                     }
-                    None => xs.push((t, tmp[0], tmp[d])),
                 }
+                xs.push((t, tmp[0], tmp[d]));
                 y_prev.copy_from_slice(&tmp);
                 t_prev = t;
                 t += dt;
             }
             end_b.copy_from_slice(&y_prev[2..d]);
-            !(r.is_some() && crossings.len() >= need)
+            // Enough turns of some ball to measure a period: a rotating motion.
+            crossings.iter().all(|c| c.len() < need)
         },
     );
     res.ok()?;
@@ -166,15 +173,17 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     if span <= 0.0 {
         return None;
     }
-    // Which balls rotate: mean relative rate against the requested pattern.
-    let rates: Vec<f64> = (0..n).map(|i| (end_b[i] - start_b[i]) / span).collect();
-    let min_rate = 2.0 * PI / g.window * 1.5;
-    for i in 0..n {
-        if (rates[i].abs() > min_rate) != rotating[i] {
+    let detected: Vec<bool> = (0..n)
+        .map(|i| (end_b[i] - start_b[i]).abs() >= 1.5 * 2.0 * PI)
+        .collect();
+    if let Some(want) = rotating {
+        if want != detected.as_slice() {
             return None;
         }
     }
-    let (t_c, period) = if r.is_some() {
+    let r = detected.iter().position(|&b| b);
+    let (t_c, period) = if let Some(r) = r {
+        let crossings = &crossings[r];
         if crossings.len() < 3 {
             return None;
         }
@@ -298,7 +307,9 @@ pub fn periodic(
         None => {
             let mut best: Option<HbSolution> = None;
             for y0 in initial_states(p) {
-                if let Some(g) = guess_from_state(p, &y0, rotating, opts.hb.n_harm, &opts.guess) {
+                if let Some(g) =
+                    guess_from_state(p, &y0, Some(rotating), opts.hb.n_harm, &opts.guess)
+                {
                     let s = solve(p, &g, &opts.hb);
                     if s.status == Status::Converged {
                         best = Some(s);
