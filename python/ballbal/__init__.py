@@ -9,17 +9,22 @@ from .analysis import (
     simulate,
 )
 from .model import Balancer, from_seed003, zeta_from_log_decrement
-from .scan import scan
+from .scan import ScanInterrupted, read_scan, scan, scan_meta
+from .scene import load_scene
 
 __all__ = [
     "Balancer",
     "Equilibrium",
+    "ScanInterrupted",
     "PeriodicSolution",
     "__version__",
     "equilibria",
     "from_seed003",
+    "load_scene",
     "periodic",
+    "read_scan",
     "scan",
+    "scan_meta",
     "simulate",
     "zeta_from_log_decrement",
 ]

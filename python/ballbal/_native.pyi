@@ -1,3 +1,4 @@
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -17,7 +18,8 @@ def periodic(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     pattern: str, n_harm: int, samples: int | None, tol: float, step_tol: float, max_iter: int,
     guess_omega: float | None, guess_coeffs: npt.NDArray[np.float64] | None, floquet: bool,
-    f_rtol: float, f_atol: float, margin: float, settle: float, window: float,
+    f_rtol: float, f_atol: float, margin: float, max_steps: int, settle: float, window: float,
+    guess_rtol: float,
 ) -> dict[str, Any]: ...
 def orbit_closure(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
@@ -26,8 +28,10 @@ def orbit_closure(
 ) -> float: ...
 def scan(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
-    names: tuple[str, str], values0: list[float], values1: list[float], patterns: list[str],
-    n_harm: int, samples: int | None, tol: float, step_tol: float, max_iter: int,
-    floquet: bool, f_rtol: float, f_atol: float, margin: float, settle: float, window: float,
-    threads: int,
-) -> dict[str, Any]: ...
+    names: list[str], values: list[list[float]], patterns: list[str], n_harm: int,
+    samples: int | None, tol: float, step_tol: float, max_iter: int, floquet: bool,
+    f_rtol: float, f_atol: float, margin: float, max_steps: int, settle: float, window: float,
+    guess_rtol: float, seeds: int, starts: int, chunk: int, max_tail: float, threads: int,
+    chunks: list[int], on_chunk: Callable[[int, dict[str, Any]], None],
+) -> None: ...
+def default_chunk(lens: list[int]) -> int: ...

@@ -191,6 +191,7 @@ def periodic(
     rtol: float = 1e-8,
     atol: float = 1e-10,
     margin: float = 1e-6,
+    max_steps: int = 200_000,
     settle: float = 1500.0,
     window: float = 2500.0,
 ) -> PeriodicSolution:
@@ -200,8 +201,10 @@ def periodic(
     Without ``guess`` the start comes from a time simulation (``settle`` time units for
     transients, then up to ``window`` to measure the period). ``guess`` may be a previous
     solution (any N; it is truncated or padded) or ``(omega, coeffs)``. ``rtol, atol`` are
-    the RK45 tolerances of the monodromy integration; a verdict needs the largest
-    non-trivial modulus further than ``max(margin, trivial_error)`` from 1.
+    the RK45 tolerances of the monodromy integration, ``max_steps`` its step budget (a
+    longer integration ends in ``floquet_error`` and an undetermined verdict); a verdict
+    needs the largest non-trivial modulus further than ``max(margin, trivial_error)``
+    from 1.
 
     A solve that fails is returned with its ``status`` (``diverged``, ``singular``,
     ``max_iterations``, ``no_guess``) and ``omega = None``; it never raises for that.
@@ -219,7 +222,7 @@ def periodic(
     d = _native.periodic(
         *balancer.native_args(), pattern, int(N), samples, float(tol), float(step_tol),
         int(max_iter), go, gc, bool(floquet), float(rtol), float(atol), float(margin),
-        float(settle), float(window),
+        int(max_steps), float(settle), float(window), 1e-9,
     )
     mult = d["mult_re"] + 1j * d["mult_im"] if "mult_re" in d else None
     return PeriodicSolution(

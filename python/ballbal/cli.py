@@ -1,5 +1,8 @@
 """Command line: ``ballbal run`` solves the thesis' standard case; ``ballbal periodic``
-and ``ballbal equilibria`` take parameters."""
+and ``ballbal equilibria`` take parameters; ``ballbal scan SCENE.toml --Omega 1:2:0.1
+--eta 0.4:1.5:0.1 -o out.parquet`` maps a parameter plane (Ctrl-C keeps the finished
+chunks, running the same command again resumes) and ``ballbal plot out.parquet`` draws
+the map."""
 
 from __future__ import annotations
 
@@ -11,6 +14,8 @@ import numpy as np
 
 from .analysis import equilibria, periodic
 from .model import Balancer
+from .scan import SCANNABLE, read_scan, scan, scan_meta
+from .scene import load_scene
 
 
 def _balancer(a: argparse.Namespace) -> Balancer:
@@ -51,6 +56,47 @@ def _print_periodic(b: Balancer, pattern: str, N: int) -> None:
           f"{s.residual:.1e}; orbit closure by simulation {s.verify():.1e}; {dt * 1e3:.1f} ms")
 
 
+def _scan(a: argparse.Namespace) -> int:
+    b = load_scene(a.scene) if a.scene else Balancer()
+    grid: dict[str, str] = {n: getattr(a, n) for n in SCANNABLE if getattr(a, n) is not None}
+    for g in a.grid:
+        name, sep, spec = g.partition("=")
+        if not sep:
+            raise ValueError(f"grid: give NAME=START:STOP:STEP, got {g!r}")
+        grid[name.strip()] = spec
+    t = time.perf_counter()
+    df = scan(b, grid=grid, patterns=a.types, N=a.N, threads=a.threads, chunk=a.chunk,
+              out=a.out, progress=not a.no_progress)
+    found = df.filter(df["status"] == "converged")
+    stable = found.filter(found["stability"] == "stable")
+    print(f"ballbal scan: {df.height} rows, {found.height} solutions ({stable.height} stable) "
+          f"in {time.perf_counter() - t:.1f} s -> {a.out}")
+    return 0
+
+
+def _plot(a: argparse.Namespace) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .plot import scan_map
+
+    df = read_scan(a.scan_dir)
+    names = list(scan_meta(a.scan_dir)["grid"])
+    if len(names) < 2:
+        raise ValueError("scan_dir: a map needs a scan over two parameters")
+    types = [a.type] if a.type else sorted(df["type"].unique().to_list())
+    fig, axes = plt.subplots(1, len(types), figsize=(5.5 * len(types), 4.5), squeeze=False)
+    for ax, ty in zip(axes[0], types, strict=True):
+        scan_map(df, x=names[0], y=names[1], type=ty, ax=ax)
+    fig.tight_layout()
+    out = a.out or str(a.scan_dir).rstrip("/") + ".png"
+    fig.savefig(out, dpi=120)
+    print(f"ballbal plot: {out}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="ballbal", description=__doc__)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -61,6 +107,22 @@ def main(argv: list[str] | None = None) -> int:
     pp.add_argument("--N", type=int, default=3)
     pe = sub.add_parser("equilibria", help="all equilibria with stability")
     _params(pe)
+    ps = sub.add_parser("scan", help="scan a parameter grid; one Parquet row per solution")
+    ps.add_argument("scene", nargs="?", help="scene TOML (default: the thesis' standard case)")
+    for name in SCANNABLE:
+        ps.add_argument(f"--{name}", metavar="START:STOP:STEP")
+    ps.add_argument("--grid", action="append", default=[], metavar="NAME=START:STOP:STEP",
+                    help="any scannable parameter, e.g. 'eta[0]=0.5:1.5:0.1'")
+    ps.add_argument("--types", nargs="+", default=["R-R"], help="e.g. R-R O-O R-O")
+    ps.add_argument("--N", type=int, default=3)
+    ps.add_argument("--threads", type=int, default=None)
+    ps.add_argument("--chunk", type=int, default=None)
+    ps.add_argument("-o", "--out", required=True, help="output directory (Parquet chunks)")
+    ps.add_argument("--no-progress", action="store_true")
+    pl_ = sub.add_parser("plot", help="plot a scan written by 'ballbal scan'")
+    pl_.add_argument("scan_dir")
+    pl_.add_argument("--type", default=None, help="solution type (default: each one found)")
+    pl_.add_argument("-o", "--out", default=None, help="image file (default: <scan_dir>.png)")
     a = ap.parse_args(argv)
     try:
         if a.cmd == "run":
@@ -70,6 +132,10 @@ def main(argv: list[str] | None = None) -> int:
             print("Periodic solutions (balls merged, rotating):")
             for N in (3, 8):
                 _print_periodic(b, "R-R", N)
+        elif a.cmd == "scan":
+            return _scan(a)
+        elif a.cmd == "plot":
+            return _plot(a)
         elif a.cmd == "periodic":
             _print_periodic(_balancer(a), a.pattern, a.N)
         else:

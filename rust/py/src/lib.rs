@@ -23,23 +23,26 @@ fn to_py(e: Error) -> PyErr {
             PyValueError::new_err(e.to_string())
         }
         Error::Integration(_) => PyRuntimeError::new_err(e.to_string()),
+        Error::Cancelled => pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled"),
     }
 }
 
 /// Runs `f` without the GIL and with panics contained.
 fn guarded<T: Send, F: FnOnce() -> Result<T, Error> + Send>(py: Python<'_>, f: F) -> PyResult<T> {
     py.detach(|| catch_unwind(AssertUnwindSafe(f)))
-        .map_err(|p| {
-            let msg = p
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_else(|| "unknown".into());
-            PyRuntimeError::new_err(format!(
-                "internal error in ballbal core (please report): {msg}"
-            ))
-        })?
+        .map_err(panic_error)?
         .map_err(to_py)
+}
+
+fn panic_error(p: Box<dyn std::any::Any + Send>) -> PyErr {
+    let msg = p
+        .downcast_ref::<String>()
+        .cloned()
+        .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+        .unwrap_or_else(|| "unknown".into());
+    PyRuntimeError::new_err(format!(
+        "internal error in ballbal core (please report): {msg}"
+    ))
 }
 
 fn planar(
@@ -190,8 +193,10 @@ fn periodic_options(
     f_rtol: f64,
     f_atol: f64,
     margin: f64,
+    max_steps: usize,
     settle: f64,
     window: f64,
+    guess_rtol: f64,
 ) -> PyResult<PeriodicOptions> {
     let hb = HbOptions {
         n_harm,
@@ -202,6 +207,12 @@ fn periodic_options(
     };
     hb.validate().map_err(to_py)?;
     Options::new(f_rtol, f_atol).validate(1).map_err(to_py)?;
+    if max_steps == 0 {
+        return Err(PyValueError::new_err("max_steps: must be >= 1"));
+    }
+    Options::new(guess_rtol, guess_rtol * 1e-2)
+        .validate(1)
+        .map_err(|_| PyValueError::new_err(format!("guess_rtol: must be a finite number > 0, got {guess_rtol}")))?;
     if !(settle > 0.0 && window > 0.0 && settle.is_finite() && window.is_finite()) {
         return Err(PyValueError::new_err(
             "settle, window: must be finite and > 0",
@@ -213,11 +224,13 @@ fn periodic_options(
             rtol: f_rtol,
             atol: f_atol,
             margin,
+            max_steps,
         }),
         guess: ballbal_core::periodic::GuessOptions {
             settle,
             window,
-            ..Default::default()
+            rtol: guess_rtol,
+            atol: guess_rtol * 1e-2,
         },
     })
 }
@@ -225,7 +238,8 @@ fn periodic_options(
 /// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers.
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, pattern, n_harm, samples, tol, step_tol, max_iter,
-                    guess_omega, guess_coeffs, floquet, f_rtol, f_atol, margin, settle, window))]
+                    guess_omega, guess_coeffs, floquet, f_rtol, f_atol, margin, max_steps, settle,
+                    window, guess_rtol))]
 #[allow(clippy::too_many_arguments)]
 fn periodic<'py>(
     py: Python<'py>,
@@ -247,13 +261,16 @@ fn periodic<'py>(
     f_rtol: f64,
     f_atol: f64,
     margin: f64,
+    max_steps: usize,
     settle: f64,
     window: f64,
+    guess_rtol: f64,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let rotating = parse_pattern(pattern, p.n_balls()).map_err(to_py)?;
     let opts = periodic_options(
-        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, settle, window,
+        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, max_steps,
+        settle, window, guess_rtol,
     )?;
     let d = p.ndof();
     let guess = match (guess_omega, guess_coeffs) {
@@ -321,23 +338,26 @@ fn orbit_closure(
     guarded(py, || closure_error(&p, &sol, rtol, atol))
 }
 
-/// Parallel two-parameter scan; returns a dict of flat columns (one entry per row).
+/// Parallel scan of a parameter grid, chunk by chunk. `on_chunk(index, columns)` is
+/// called (with the GIL, in this thread) for every finished chunk as soon as it is done;
+/// Ctrl-C cancels the remaining work, hands over the chunks that still finish, and then
+/// raises `KeyboardInterrupt`.
 #[pyfunction]
-#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, names, values0, values1, patterns,
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, names, values, patterns,
                     n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin,
-                    settle, window, threads))]
+                    max_steps, settle, window, guess_rtol, seeds, starts, chunk, max_tail,
+                    threads, chunks, on_chunk))]
 #[allow(clippy::too_many_arguments)]
-fn scan<'py>(
-    py: Python<'py>,
+fn scan(
+    py: Python<'_>,
     mu: f64,
     zeta: f64,
     zeta_b: Vec<f64>,
     delta: f64,
     omega: f64,
     eta: Vec<f64>,
-    names: (String, String),
-    values0: Vec<f64>,
-    values1: Vec<f64>,
+    names: Vec<String>,
+    values: Vec<Vec<f64>>,
     patterns: Vec<String>,
     n_harm: usize,
     samples: Option<usize>,
@@ -348,113 +368,193 @@ fn scan<'py>(
     f_rtol: f64,
     f_atol: f64,
     margin: f64,
+    max_steps: usize,
     settle: f64,
     window: f64,
+    guess_rtol: f64,
+    seeds: usize,
+    starts: usize,
+    chunk: usize,
+    max_tail: f64,
     threads: usize,
-) -> PyResult<Bound<'py, PyDict>> {
-    use ballbal_core::scan::{scan as core_scan, ScanSpec};
+    chunks: Vec<usize>,
+    on_chunk: Bound<'_, PyAny>,
+) -> PyResult<()> {
+    use ballbal_core::scan::{scan_chunks, ScanRow, ScanSpec};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::mpsc;
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let rots = patterns
         .iter()
         .map(|s| parse_pattern(s, p.n_balls()))
         .collect::<Result<Vec<_>, _>>()
         .map_err(to_py)?;
-    if rots.is_empty() {
-        return Err(PyValueError::new_err(
-            "patterns: give at least one solution type",
-        ));
-    }
-    let opts = periodic_options(
-        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, settle, window,
+    let mut opts = periodic_options(
+        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, max_steps,
+        settle, window, guess_rtol,
     )?;
-    let rows = guarded(py, || {
-        core_scan(&ScanSpec {
-            base: &p,
-            names: [&names.0, &names.1],
-            values: [&values0, &values1],
-            patterns: &rots,
-            opts,
-            threads,
-        })
-    })?;
+    opts.guess.atol = guess_rtol * 1e-3;
+    let spec = ScanSpec {
+        base: &p,
+        names: names.clone(),
+        values: values.clone(),
+        patterns: rots,
+        opts,
+        seeds,
+        starts,
+        chunk,
+        threads,
+        max_tail,
+    };
+    spec.validate().map_err(to_py)?;
+    let cancel = AtomicBool::new(false);
+    let (tx, rx) = mpsc::channel::<(usize, Vec<ScanRow>)>();
+    // `detach` needs a `Sync` capture; the receiver is only used from this thread.
+    let rx = std::sync::Mutex::new(rx);
+    let mut pending: Option<PyErr> = None;
+    let worker = std::thread::scope(|s| {
+        let spec = &spec;
+        let cancel = &cancel;
+        let handle = s.spawn(move || {
+            catch_unwind(AssertUnwindSafe(|| {
+                scan_chunks(spec, &chunks, cancel, &|c, rows| {
+                    let _ = tx.send((c, rows));
+                })
+            }))
+        });
+        loop {
+            let msg = py.detach(|| {
+                rx.lock()
+                    .expect("receiver lock")
+                    .recv_timeout(std::time::Duration::from_millis(100))
+            });
+            match msg {
+                Ok((c, rows)) => {
+                    let r = scan_columns(py, &names, &values, &patterns, n_harm, &rows)
+                        .and_then(|d| on_chunk.call1((c, d)).map(|_| ()));
+                    if let Err(e) = r {
+                        if pending.is_none() {
+                            cancel.store(true, Ordering::Relaxed);
+                            pending = Some(e);
+                        }
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if pending.is_none() {
+                        if let Err(e) = py.check_signals() {
+                            cancel.store(true, Ordering::Relaxed);
+                            pending = Some(e);
+                        }
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+        }
+        handle.join()
+    });
+    if let Some(e) = pending {
+        return Err(e);
+    }
+    match worker {
+        Ok(Ok(Ok(()))) => Ok(()),
+        Ok(Ok(Err(e))) => Err(to_py(e)),
+        Ok(Err(p)) | Err(p) => Err(panic_error(p)),
+    }
+}
+
+/// One chunk's rows as a dict of equally long lists (None where a value does not apply).
+fn scan_columns<'py>(
+    py: Python<'py>,
+    names: &[String],
+    values: &[Vec<f64>],
+    patterns: &[String],
+    n_harm: usize,
+    rows: &[ballbal_core::scan::ScanRow],
+) -> PyResult<Bound<'py, PyDict>> {
+    use ballbal_core::periodic::Periodic;
     let d = PyDict::new(py);
-    let n = rows.len();
-    let c = |name: &str, v: Vec<f64>| d.set_item(name, PyArray1::from_vec(py, v));
-    c(&names.0, rows.iter().map(|r| values0[r.i]).collect())?;
-    c(&names.1, rows.iter().map(|r| values1[r.j]).collect())?;
-    fn conv(r: &ballbal_core::scan::ScanRow) -> Option<&ballbal_core::periodic::Periodic> {
-        r.result
-            .as_ref()
-            .filter(|x| x.sol.status == Status::Converged)
+    for (k, name) in names.iter().enumerate() {
+        d.set_item(
+            name,
+            rows.iter().map(|r| values[k][r.index[k]]).collect::<Vec<_>>(),
+        )?;
     }
-    // A float column of converged rows, NaN elsewhere (Python turns NaN into null).
-    let per_row = |f: &dyn Fn(&ballbal_core::periodic::Periodic) -> Option<f64>| -> Vec<f64> {
-        rows.iter()
-            .map(|r| conv(r).and_then(f).unwrap_or(f64::NAN))
-            .collect()
+    let conv = |r: &ballbal_core::scan::ScanRow| -> Option<Periodic> { r.result.clone() };
+    let sols: Vec<Option<Periodic>> = rows.iter().map(conv).collect();
+    let f = |g: &dyn Fn(&Periodic) -> Option<f64>| -> Vec<Option<f64>> {
+        sols.iter().map(|s| s.as_ref().and_then(g)).collect()
     };
-    c("omega", per_row(&|x| Some(x.sol.omega)))?;
-    c("residual", per_row(&|x| Some(x.sol.residual)))?;
-    c("iterations", per_row(&|x| Some(x.sol.iterations as f64)))?;
-    c("seconds", rows.iter().map(|r| r.seconds).collect())?;
-    c(
-        "max_modulus",
-        per_row(&|x| x.floquet.as_ref().map(|f| f.max_modulus)),
-    )?;
-    c(
-        "trivial_error",
-        per_row(&|x| x.floquet.as_ref().map(|f| f.trivial_error)),
-    )?;
-    let mults: Vec<(Vec<f64>, Vec<f64>)> = rows
-        .iter()
-        .map(|r| match conv(r).and_then(|x| x.floquet.as_ref()) {
-            Some(f) => (
-                f.multipliers.iter().map(|z| z.0).collect(),
-                f.multipliers.iter().map(|z| z.1).collect(),
-            ),
-            None => (vec![], vec![]),
-        })
-        .collect();
-    d.set_item(
-        "mult_re",
-        mults.iter().map(|m| m.0.clone()).collect::<Vec<_>>(),
-    )?;
-    d.set_item(
-        "mult_im",
-        mults.iter().map(|m| m.1.clone()).collect::<Vec<_>>(),
-    )?;
-    let strs = |f: &dyn Fn(&ballbal_core::scan::ScanRow) -> String| {
-        rows.iter().map(f).collect::<Vec<String>>()
-    };
-    d.set_item("type", strs(&|r| patterns[r.pattern].clone()))?;
+    d.set_item("type", rows.iter().map(|r| patterns[r.pattern].clone()).collect::<Vec<_>>())?;
+    d.set_item("solution", rows.iter().map(|r| r.solution).collect::<Vec<_>>())?;
     d.set_item(
         "status",
-        strs(&|r| match &r.result {
-            Some(x) => x.sol.status.as_str().to_string(),
-            None => "no_solution".to_string(),
-        }),
+        sols.iter()
+            .map(|s| if s.is_some() { "converged" } else { "not_found" })
+            .collect::<Vec<_>>(),
     )?;
+    d.set_item("omega", f(&|x| Some(x.sol.omega)))?;
     d.set_item(
         "stability",
-        strs(&|r| {
-            conv(r)
-                .and_then(|x| x.floquet.as_ref())
-                .map_or("undetermined", |f| f.stability.as_str())
-                .to_string()
-        }),
+        sols.iter()
+            .map(|s| {
+                s.as_ref().map(|x| {
+                    x.floquet
+                        .as_ref()
+                        .map_or("undetermined", |fl| fl.stability.as_str())
+                })
+            })
+            .collect::<Vec<_>>(),
     )?;
-    d.set_item("origin", strs(&|r| r.origin.to_string()))?;
+    d.set_item("max_modulus", f(&|x| x.floquet.as_ref().map(|fl| fl.max_modulus)))?;
+    d.set_item("trivial_error", f(&|x| x.floquet.as_ref().map(|fl| fl.trivial_error)))?;
+    let mults = |part: fn(&(f64, f64)) -> f64| -> Vec<Option<Vec<f64>>> {
+        sols.iter()
+            .map(|s| {
+                s.as_ref()
+                    .and_then(|x| x.floquet.as_ref())
+                    .map(|fl| fl.multipliers.iter().map(part).collect())
+            })
+            .collect()
+    };
+    d.set_item("mult_re", mults(|z| z.0))?;
+    d.set_item("mult_im", mults(|z| z.1))?;
+    d.set_item("residual", f(&|x| Some(x.sol.residual)))?;
+    d.set_item("tail", f(&|x| Some(x.sol.tail_ratio())))?;
+    d.set_item("pivot_ratio", f(&|x| Some(x.sol.pivot_ratio)))?;
     d.set_item(
-        "pb_exists",
-        rows.iter().map(|r| r.pb_exists).collect::<Vec<_>>(),
+        "iterations",
+        sols.iter()
+            .map(|s| s.as_ref().map(|x| x.sol.iterations))
+            .collect::<Vec<_>>(),
     )?;
     d.set_item(
-        "pb_stable",
-        rows.iter().map(|r| r.pb_stable).collect::<Vec<_>>(),
+        "floquet_steps",
+        sols.iter()
+            .map(|s| s.as_ref().and_then(|x| x.floquet.as_ref()).map(|fl| fl.steps))
+            .collect::<Vec<_>>(),
     )?;
-    d.set_item("N", n_harm)?;
-    d.set_item("rows", n)?;
+    d.set_item(
+        "floquet_error",
+        sols.iter()
+            .map(|s| s.as_ref().and_then(|x| x.floquet_error.clone()))
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item("N", vec![n_harm; rows.len()])?;
+    d.set_item("attempts", rows.iter().map(|r| r.attempts).collect::<Vec<_>>())?;
+    d.set_item("seconds", rows.iter().map(|r| r.seconds).collect::<Vec<_>>())?;
+    d.set_item("origin", rows.iter().map(|r| r.origin).collect::<Vec<_>>())?;
+    d.set_item("pb_exists", rows.iter().map(|r| r.pb_exists).collect::<Vec<_>>())?;
+    d.set_item("pb_stable", rows.iter().map(|r| r.pb_stable).collect::<Vec<_>>())?;
     Ok(d)
+}
+
+/// Default chunk length (values of the last parameter per chunk) for grid lengths `lens`.
+#[pyfunction]
+fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
+    if lens.is_empty() || lens.contains(&0) {
+        return Err(PyValueError::new_err("grid: every parameter needs values"));
+    }
+    Ok(ballbal_core::scan::default_chunk(&lens))
 }
 
 #[pymodule]
@@ -464,6 +564,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbit_closure, m)?)?;
     m.add_function(wrap_pyfunction!(scan, m)?)?;
+    m.add_function(wrap_pyfunction!(default_chunk, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

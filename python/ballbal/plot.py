@@ -1,0 +1,69 @@
+"""Plots of scan tables (matplotlib, installed with the ``plot`` extra)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+_MARK = {"stable": ("o", "tab:blue"), "unstable": ("x", "tab:red"),
+         "undetermined": ("^", "tab:gray")}
+
+
+def _pyplot() -> Any:
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as e:  # pragma: no cover - depends on the install
+        raise ImportError("plotting needs matplotlib: pip install 'ballbal[plot]'") from e
+    return plt
+
+
+def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = "R-R",
+             ax: Any = None, title: str | None = None) -> Any:
+    """The thesis' map (figures 3-6 to 3-16): solutions of ``type`` over the (x, y) plane,
+    stable and unstable markers, and the perfect balance's stable region shaded."""
+    plt = _pyplot()
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6, 4.5))
+    for col in (x, y):
+        if col not in df.columns:
+            raise ValueError(f"{col}: not a column of this scan (columns: {df.columns})")
+    pts = df.unique(subset=[x, y], keep="first").sort([y, x])
+    xs, ys = np.unique(pts[x].to_numpy()), np.unique(pts[y].to_numpy())
+    stable = np.full((ys.size, xs.size), np.nan)
+    for row in pts.select(x, y, "pb_stable").iter_rows():
+        stable[np.searchsorted(ys, row[1]), np.searchsorted(xs, row[0])] = float(row[2])
+    if xs.size > 1 and ys.size > 1:
+        ax.contourf(xs, ys, stable, levels=[0.5, 1.5], colors=["#cfe8cf"])
+    ax.plot([], [], "s", color="#cfe8cf", label="perfect balance stable")
+    sols = df.filter((pl.col("type") == type) & (pl.col("status") == "converged"))
+    for verdict, (m, c) in _MARK.items():
+        s = sols.filter(pl.col("stability") == verdict)
+        if s.height:
+            ax.scatter(s[x], s[y], marker=m, color=c, s=28, label=f"{type} {verdict}",
+                       facecolors="none" if m == "o" and verdict != "stable" else None)
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    ax.set_title(title or f"{type} solutions")
+    ax.legend(loc="best", fontsize=8)
+    return ax
+
+
+def omega_curves(df: pl.DataFrame, *, x: str = "eta", by: str = "Omega",
+                 type: str = "R-R", stable_only: bool = True, ax: Any = None) -> Any:
+    """omega against ``x`` for each value of ``by`` (the thesis' figure 3-7)."""
+    plt = _pyplot()
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6, 4.5))
+    s = df.filter((pl.col("type") == type) & (pl.col("status") == "converged"))
+    if stable_only:
+        s = s.filter(pl.col("stability") == "stable")
+    for v in sorted(s[by].unique().to_list()):
+        part = s.filter(pl.col(by) == v).sort(x)
+        ax.plot(part[x], part["omega"], "o-", ms=3, label=f"{by} = {v:g}")
+    ax.set_xlabel(x)
+    ax.set_ylabel("omega")
+    ax.set_title(f"{type}: frequency of the ball motion")
+    ax.legend(fontsize=7, ncol=2)
+    return ax
