@@ -1,6 +1,7 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
 from ._native import __version__
+from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
     Equilibrium,
     PeriodicSolution,
@@ -18,10 +19,12 @@ __all__ = [
     "ScanInterrupted",
     "PeriodicSolution",
     "__version__",
+    "accuracy_cost",
     "equilibria",
     "from_seed003",
     "load_scene",
     "periodic",
+    "plot_accuracy_cost",
     "read_scan",
     "scan",
     "scan_meta",

@@ -121,6 +121,11 @@ class PeriodicSolution:
     trivial_error: float | None
     floquet_steps: int | None
     condition: float
+    tail: float = float("nan")
+    target_met: bool | None = None
+    hill_multipliers: np.ndarray | None = None
+    hill_stability: Stability | None = None
+    verdicts_disagree: bool | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -177,11 +182,25 @@ class PeriodicSolution:
         )
 
 
+def harmonics(N: int | str, target: float) -> tuple[int, float | None]:
+    """``(starting N, target or None)`` from ``N`` = an integer or ``"auto"``."""
+    if isinstance(N, str):
+        if N != "auto":
+            raise ValueError(f"N: must be an integer in [1, 256] or 'auto', got {N!r}")
+        return 3, float(target)
+    if isinstance(N, bool) or not isinstance(N, (int, np.integer)):
+        raise ValueError(f"N: must be an integer in [1, 256] or 'auto', got {N!r}")
+    return int(N), None
+
+
 def periodic(
     balancer: Balancer,
     pattern: str = "R-R",
     *,
-    N: int = 3,
+    N: int | str = 3,
+    target: float = 1e-6,
+    N_max: int = 32,
+    hill: bool = True,
     samples: int | None = None,
     tol: float = 1e-10,
     step_tol: float = 1e-8,
@@ -206,6 +225,13 @@ def periodic(
     needs the largest non-trivial modulus further than ``max(margin, trivial_error)``
     from 1.
 
+    ``N="auto"`` starts at 3 and raises the harmonics (solving from the last) until the
+    highest harmonic relative to the motion (``tail``) and the trivial multiplier's
+    distance from 1 are below ``target`` (or ``N_max`` is reached: ``target_met`` says
+    which). ``hill`` adds a second stability estimate by Hill's method (eigenvalues of
+    the Hill matrix, no time integration): ``hill_multipliers``, ``hill_stability``, and
+    ``verdicts_disagree`` when one says stable and the other unstable.
+
     A solve that fails is returned with its ``status`` (``diverged``, ``singular``,
     ``max_iterations``, ``no_guess``) and ``omega = None``; it never raises for that.
     """
@@ -219,13 +245,17 @@ def periodic(
         else:
             go, gc = float(guess[0]), np.asarray(guess[1], dtype=float)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
+    n0, auto = harmonics(N, target)
     d = _native.periodic(
-        *balancer.native_args(), pattern, int(N), samples, float(tol), float(step_tol),
+        *balancer.native_args(), pattern, n0, samples, float(tol), float(step_tol),
         int(max_iter), go, gc, bool(floquet), float(rtol), float(atol), float(margin),
-        int(max_steps), float(settle), float(window), 1e-9,
+        int(max_steps), float(settle), float(window), 1e-9, auto, int(N_max), bool(hill),
     )
     mult = d["mult_re"] + 1j * d["mult_im"] if "mult_re" in d else None
+    hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None
     return PeriodicSolution(
+        tail=d["tail"], target_met=d["target_met"], hill_multipliers=hill_m,
+        hill_stability=d.get("hill_stability"), verdicts_disagree=d["verdicts_disagree"],
         balancer=balancer, status=d["status"], type=d["type"], omega=d["omega"],
         coeffs=d["coeffs"], winding=d["winding"], N=d["N"], samples=d["samples"],
         residual=d["residual"], iterations=d["iterations"], multipliers=mult,

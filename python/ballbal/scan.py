@@ -22,6 +22,7 @@ import numpy as np
 import polars as pl
 
 from . import _native
+from .analysis import harmonics
 from .model import Balancer
 
 SCANNABLE = ("mu", "zeta", "zeta_b", "delta", "Omega", "eta")
@@ -37,6 +38,7 @@ _SCHEMA: dict[str, Any] = {
     "pivot_ratio": pl.Float64, "iterations": pl.Int64, "floquet_steps": pl.Int64,
     "floquet_error": pl.Utf8, "N": pl.Int64, "attempts": pl.Int64, "seconds": pl.Float64,
     "origin": pl.Utf8, "pb_exists": pl.Boolean, "pb_stable": pl.Boolean,
+    "target_met": pl.Boolean, "hill_stability": pl.Utf8, "verdicts_disagree": pl.Boolean,
 }
 
 
@@ -101,7 +103,8 @@ class _Job:
             *self.balancer.native_args(), list(self.names), [list(v) for v in self.values],
             list(self.patterns), o["N"], o["samples"], o["tol"], o["step_tol"],
             o["max_iter"], o["floquet"], o["rtol"], o["atol"], o["margin"], o["max_steps"],
-            o["settle"], o["window"], o["guess_rtol"], o["seeds"], o["starts"], self.chunk,
+            o["settle"], o["window"], o["guess_rtol"], o["auto"], o["N_max"], o["hill"],
+            o["seeds"], o["starts"], self.chunk,
             o["max_tail"], threads, chunks, on_chunk,
         )
 
@@ -219,7 +222,10 @@ def scan(
     balancer: Balancer,
     *,
     patterns: Sequence[str] = ("R-R",),
-    N: int = 3,
+    N: int | str = 3,
+    target: float = 1e-4,
+    N_max: int = 32,
+    hill: bool = False,
     samples: int | None = None,
     tol: float = 1e-10,
     step_tol: float = 1e-8,
@@ -258,6 +264,12 @@ def scan(
     with none gets one row with ``status="not_found"`` and nulls. ``max_tail`` refuses
     series whose last harmonic is that large relative to the motion (``N`` too small).
 
+    ``N="auto"``: continuation runs at N = 3 and each solution found is refined until
+    its highest harmonic and trivial multiplier error are below ``target`` (at most
+    ``N_max``): easy points stay cheap; ``N`` and ``target_met`` say what each row got.
+    ``hill=True`` adds Hill's-method verdicts (``hill_stability``) and flags rows where
+    they contradict the monodromy's (``verdicts_disagree``).
+
     ``out``: a directory; each finished chunk is written there as Parquet at once, and a
     later call with the same arguments and ``out`` skips the chunks on disk (resume).
     ``executor``: a ``concurrent.futures`` executor or Dask ``Client``; the chunks run
@@ -286,8 +298,9 @@ def scan(
     local_threads = (os.cpu_count() or 1) if threads is None else int(threads)
     if local_threads < 1:
         raise ValueError(f"threads: must be >= 1, got {threads}")
+    n0, auto = harmonics(N, target)
     options = (
-        ("N", int(N)), ("samples", None if samples is None else int(samples)),
+        ("N", n0), ("auto", auto), ("N_max", int(N_max)), ("hill", bool(hill)), ("samples", None if samples is None else int(samples)),
         ("tol", float(tol)), ("step_tol", float(step_tol)), ("max_iter", int(max_iter)),
         ("floquet", bool(floquet)), ("rtol", float(rtol)), ("atol", float(atol)),
         ("margin", float(margin)), ("max_steps", int(max_steps)), ("settle", float(settle)),

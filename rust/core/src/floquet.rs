@@ -69,6 +69,47 @@ pub struct Floquet {
     pub rhs_evals: usize,
 }
 
+/// The verdict on a set of multipliers (largest modulus first).
+#[derive(Debug, Clone, Copy)]
+pub struct Judgement {
+    pub trivial: usize,
+    pub trivial_error: f64,
+    pub max_modulus: f64,
+    pub stability: Stability,
+}
+
+/// Finds the trivial multiplier (closest to 1) and judges the others: stable if all lie
+/// inside the unit circle by more than `max(margin, trivial error)`, unstable if one lies
+/// outside by more than that, undetermined otherwise.
+pub fn judge(ev: &[(f64, f64)], margin: f64) -> Judgement {
+    let (trivial, trivial_error) = ev
+        .iter()
+        .enumerate()
+        .map(|(i, z)| (i, (z.0 - 1.0).hypot(z.1)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((0, f64::INFINITY));
+    let max_modulus = ev
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != trivial)
+        .map(|(_, z)| z.0.hypot(z.1))
+        .fold(0.0, f64::max);
+    let margin = margin.max(trivial_error);
+    let stability = if max_modulus < 1.0 - margin {
+        Stability::Stable
+    } else if max_modulus > 1.0 + margin {
+        Stability::Unstable
+    } else {
+        Stability::Undetermined
+    };
+    Judgement {
+        trivial,
+        trivial_error,
+        max_modulus,
+        stability,
+    }
+}
+
 /// Monodromy matrix (row-major `2d x 2d`) of the linearisation about `sol`.
 pub fn monodromy<D: Dynamics + ?Sized>(
     model: &D,
@@ -137,26 +178,9 @@ pub fn floquet<D: Dynamics + ?Sized>(
         crate::Error::Integration("eigenvalues of the monodromy matrix did not converge".into())
     })?;
     ev.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
-    let (trivial, trivial_error) = ev
-        .iter()
-        .enumerate()
-        .map(|(i, z)| (i, (z.0 - 1.0).hypot(z.1)))
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-        .unwrap();
-    let max_modulus = ev
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| *i != trivial)
-        .map(|(_, z)| z.0.hypot(z.1))
-        .fold(0.0, f64::max);
-    let margin = opts.margin.max(trivial_error);
-    let stability = if max_modulus < 1.0 - margin {
-        Stability::Stable
-    } else if max_modulus > 1.0 + margin {
-        Stability::Unstable
-    } else {
-        Stability::Undetermined
-    };
+    let v = judge(&ev, opts.margin);
+    let (trivial, trivial_error, max_modulus, stability) =
+        (v.trivial, v.trivial_error, v.max_modulus, v.stability);
     Ok(Floquet {
         multipliers: ev,
         trivial,
@@ -166,4 +190,167 @@ pub fn floquet<D: Dynamics + ?Sized>(
         steps,
         rhs_evals: evals,
     })
+}
+
+/// Floquet multipliers by Hill's method: an estimate independent of the RK45 monodromy.
+///
+/// With `xi = e^{s t} sum_k p_k e^{i k omega t}` the linearisation `xi' = A(t) xi`
+/// becomes the eigenproblem `sum_l A_{k-l} p_l - i k omega p_k = s p_k` (`A_k` the
+/// Fourier coefficients of `A(t)`, sampled from the series and transformed). Each true
+/// exponent appears once per harmonic shift; the copy whose eigenvector is centred on
+/// the zeroth harmonic is the best resolved, so the `2d` eigenvalues whose eigenvectors
+/// have the smallest harmonic centroid are taken and mapped to multipliers `e^{s T}`.
+/// Returns them largest modulus first.
+pub fn hill_multipliers<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    n_hill: usize,
+) -> Result<Vec<(f64, f64)>> {
+    use faer::c64;
+    let d = model.ndof();
+    let n2 = 2 * d;
+    let h = n_hill as i64;
+    // Enough samples to resolve A's harmonics up to 2H without aliasing.
+    let s = (8 * n_hill + 8).max(64);
+    let om = sol.omega;
+    let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
+    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    let mut cols = vec![0.0; 2 * d * d];
+    let mut amat = vec![0.0; n2 * n2];
+    let nk = (4 * h + 1) as usize;
+    // coef[(kk + 2H) * n2^2 + ..]: complex Fourier coefficients of A for kk in -2H..2H.
+    let mut coef = vec![c64::new(0.0, 0.0); nk * n2 * n2];
+    for j in 0..s {
+        let tau = 2.0 * std::f64::consts::PI * j as f64 / s as f64;
+        sol.eval(tau, &mut q, &mut qt, &mut qtt);
+        for i in 0..d {
+            v[i] = om * qt[i];
+            a[i] = om * om * qtt[i];
+        }
+        let t = tau / om;
+        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        crate::linalg::state_matrix(model, t, &q, &k, &c, &mut cols, &mut amat);
+        for (ki, kk) in (-2 * h..=2 * h).enumerate() {
+            let (sn, cs) = (-(kk as f64) * tau).sin_cos();
+            let e = c64::new(cs / s as f64, sn / s as f64);
+            let block = &mut coef[ki * n2 * n2..(ki + 1) * n2 * n2];
+            for (b, &x) in block.iter_mut().zip(&amat) {
+                *b += e * x;
+            }
+        }
+    }
+    let size = n2 * (2 * n_hill + 1);
+    let hm = faer::Mat::<c64>::from_fn(size, size, |r, col| {
+        let (kr, i) = ((r / n2) as i64 - h, r % n2);
+        let (kc, j) = ((col / n2) as i64 - h, col % n2);
+        let ki = (kr - kc + 2 * h) as usize;
+        let mut z = coef[ki * n2 * n2 + i * n2 + j];
+        if r == col {
+            z -= c64::new(0.0, kr as f64 * om);
+        }
+        z
+    });
+    let eig = hm.eigen().map_err(|_| {
+        crate::Error::Integration("eigen-decomposition of the Hill matrix failed".into())
+    })?;
+    let (sv, u) = (eig.S(), eig.U());
+    let blocks = 2 * n_hill + 1;
+    // Each eigenvalue with the centroid of its eigenvector over the harmonic index: the
+    // copy of an exponent whose eigenvector sits on the central harmonics is the
+    // accurate one (copies near the truncation edge are not).
+    let mut ev: Vec<(c64, f64)> = (0..size)
+        .map(|col| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for b in 0..blocks {
+                let w: f64 = (0..n2).map(|i| u[(b * n2 + i, col)].norm_sqr()).sum();
+                num += w * (b as f64 - n_hill as f64);
+                den += w;
+            }
+            (
+                sv[col],
+                if den > 0.0 {
+                    (num / den).abs()
+                } else {
+                    f64::INFINITY
+                },
+            )
+        })
+        .collect();
+    if ev
+        .iter()
+        .any(|(z, _)| !z.re.is_finite() || !z.im.is_finite())
+    {
+        return Err(crate::Error::Integration(
+            "the Hill matrix has non-finite eigenvalues".into(),
+        ));
+    }
+    ev.sort_by(|a, b| a.1.total_cmp(&b.1));
+    // An exponent on the strip's edge (a negative real multiplier) has two copies equally
+    // centred, s and s - i omega: keep one, so that the next exponent is not pushed out.
+    let mut chosen: Vec<c64> = Vec::with_capacity(n2);
+    for (z, _) in ev {
+        let copy = chosen.iter().any(|c| {
+            let k = (z.im - c.im) / om;
+            (z.re - c.re).abs() <= 1e-6 * (1.0 + c.re.abs())
+                && k.round() != 0.0
+                && (k - k.round()).abs() < 1e-4
+        });
+        if !copy {
+            chosen.push(z);
+        }
+        if chosen.len() == n2 {
+            break;
+        }
+    }
+    let ev = chosen;
+    let period = sol.period();
+    let mut mults: Vec<(f64, f64)> = ev
+        .iter()
+        .map(|z| {
+            let r = (z.re * period).exp();
+            let (sn, cs) = (z.im * period).sin_cos();
+            (r * cs, r * sn)
+        })
+        .collect();
+    mults.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
+    Ok(mults)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::hb::{solve, HbOptions};
+    use crate::periodic::{periodic, PeriodicOptions};
+    use crate::Planar;
+
+    #[test]
+    fn hill_agrees_with_monodromy_on_the_standard_case() {
+        hill_agrees(8);
+        // N = 3: two negative real multipliers, whose exponents sit on the strip's edge.
+        hill_agrees(3);
+    }
+
+    fn hill_agrees(n_harm: usize) {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let opts = PeriodicOptions {
+            hb: HbOptions {
+                n_harm,
+                ..Default::default()
+            },
+            floquet: Some(FloquetOptions::default()),
+            ..Default::default()
+        };
+        let r = periodic(&p, &[true, true], None, &opts);
+        let f = r.floquet.unwrap();
+        let sol = solve(&p, &r.sol, &opts.hb);
+        let hill = hill_multipliers(&p, &sol, 12).unwrap();
+        let mods = |v: &[(f64, f64)]| -> Vec<f64> { v.iter().map(|z| z.0.hypot(z.1)).collect() };
+        let (a, b) = (mods(&f.multipliers), mods(&hill));
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x - y).abs() < 1e-4, "monodromy {a:?}\nhill {b:?}");
+        }
+        // The spec's shooting value of the leading non-trivial modulus.
+        assert!((b[1] - 0.8637).abs() < 2e-4, "{b:?}");
+    }
 }

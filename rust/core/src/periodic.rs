@@ -4,7 +4,7 @@
 //! simulation: settle, detect which balls rotate, measure the period, fit the series.
 
 use crate::equilibria::wrap;
-use crate::floquet::{floquet, Floquet, FloquetOptions};
+use crate::floquet::{floquet, hill_multipliers, judge, Floquet, FloquetOptions, Stability};
 use crate::hb::{fit_coefficients, solve, HbOptions, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics, Planar};
 use crate::ode::{solve_at, Dopri5, Options};
@@ -278,12 +278,26 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     ))
 }
 
+/// Choose the number of harmonics per solution instead of fixing it.
+#[derive(Debug, Clone)]
+pub struct AutoHarmonics {
+    /// Accuracy asked for: the highest harmonic relative to the motion
+    /// ([`HbSolution::tail_ratio`]) and the trivial multiplier's distance from 1 must both
+    /// fall below it (the latter not below what the RK45 tolerance allows).
+    pub target: f64,
+    pub n_max: usize,
+}
+
 #[derive(Debug, Clone, Default)]
 pub struct PeriodicOptions {
     pub hb: HbOptions,
     /// `None` skips the Floquet analysis.
     pub floquet: Option<FloquetOptions>,
     pub guess: GuessOptions,
+    /// `Some`: raise N from `hb.n_harm` until the target is met.
+    pub auto: Option<AutoHarmonics>,
+    /// Also estimate the multipliers by Hill's method and compare the verdicts.
+    pub hill: bool,
 }
 
 #[derive(Debug, Clone)]
@@ -292,6 +306,23 @@ pub struct Periodic {
     pub floquet: Option<Floquet>,
     /// Why the Floquet analysis failed, if it did.
     pub floquet_error: Option<String>,
+    /// With `auto`: whether the accuracy target was met within `n_max` harmonics.
+    pub target_met: Option<bool>,
+    /// Hill's-method multipliers and verdict, when asked for and computable.
+    pub hill: Option<(Vec<(f64, f64)>, Stability)>,
+}
+
+impl Periodic {
+    /// Whether the two stability estimates contradict each other (one says stable, the
+    /// other unstable); an undetermined verdict contradicts neither.
+    pub fn verdicts_disagree(&self) -> Option<bool> {
+        let f = self.floquet.as_ref()?.stability;
+        let (_, h) = self.hill.as_ref()?;
+        Some(matches!(
+            (f, *h),
+            (Stability::Stable, Stability::Unstable) | (Stability::Unstable, Stability::Stable)
+        ))
+    }
 }
 
 /// Solves from `guess`, or from a simulated guess of the requested pattern, and runs
@@ -327,18 +358,96 @@ pub fn periodic(
 }
 
 pub fn finish(p: &Planar, sol: HbSolution, opts: &PeriodicOptions) -> Periodic {
-    let (floquet, floquet_error) = match (&opts.floquet, sol.status) {
-        (Some(fo), Status::Converged) => match floquet(p, &sol, fo) {
+    let converged = sol.status == Status::Converged;
+    let mut sol = sol;
+    let mut target_met = None;
+    let run_floquet = |sol: &HbSolution| match (&opts.floquet, converged) {
+        (Some(fo), true) => match floquet(p, sol, fo) {
             Ok(f) => (Some(f), None),
             Err(e) => (None, Some(e.to_string())),
         },
         _ => (None, None),
     };
+    let (mut fl, mut fl_err);
+    match (&opts.auto, converged) {
+        (Some(a), true) => {
+            // The floor below which RK45's own error hides the trivial multiplier's.
+            let floor = opts.floquet.as_ref().map_or(0.0, |f| 100.0 * f.rtol);
+            loop {
+                sol = refine(p, sol, &opts.hb, a);
+                (fl, fl_err) = run_floquet(&sol);
+                let tail_ok = sol.tail_ratio() <= a.target;
+                let triv_ok = fl
+                    .as_ref()
+                    .is_none_or(|f| f.trivial_error <= a.target.max(floor));
+                if (tail_ok && triv_ok) || sol.n_harm >= a.n_max {
+                    target_met = Some(tail_ok && triv_ok);
+                    break;
+                }
+                let next = next_n(sol.n_harm, a.n_max);
+                let s = solve(
+                    p,
+                    &sol,
+                    &HbOptions {
+                        n_harm: next,
+                        ..opts.hb.clone()
+                    },
+                );
+                if s.status != Status::Converged {
+                    target_met = Some(false);
+                    break;
+                }
+                sol = s;
+            }
+        }
+        _ => (fl, fl_err) = run_floquet(&sol),
+    }
+    let hill = if opts.hill && sol.status == Status::Converged {
+        let margin = opts.floquet.as_ref().map_or(1e-6, |f| f.margin);
+        hill_multipliers(p, &sol, (2 * sol.n_harm).max(8))
+            .ok()
+            .map(|m| {
+                let v = judge(&m, margin);
+                (m, v.stability)
+            })
+    } else {
+        None
+    };
     Periodic {
         sol,
-        floquet,
-        floquet_error,
+        floquet: fl,
+        floquet_error: fl_err,
+        target_met,
+        hill,
     }
+}
+
+fn next_n(n: usize, n_max: usize) -> usize {
+    (n + n.div_ceil(2)).clamp(n + 1, n_max.max(n + 1))
+}
+
+/// Raises the harmonics of a converged solution until its highest one is below the
+/// target relative to the motion (or `n_max` is reached, or a larger N fails to
+/// converge), each solve started from the last.
+pub fn refine(p: &Planar, sol: HbSolution, hb: &HbOptions, a: &AutoHarmonics) -> HbSolution {
+    let mut sol = sol;
+    while sol.status == Status::Converged && sol.tail_ratio() > a.target && sol.n_harm < a.n_max {
+        let next = next_n(sol.n_harm, a.n_max);
+        let s = solve(
+            p,
+            &sol,
+            &HbOptions {
+                n_harm: next,
+                ..hb.clone()
+            },
+        );
+        if s.status != Status::Converged {
+            // Keep the last converged solution; the caller sees the target unmet.
+            return sol;
+        }
+        sol = s;
+    }
+    sol
 }
 
 /// Placeholder result for "no starting guess": no coefficients worth reading.

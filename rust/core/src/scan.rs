@@ -636,6 +636,7 @@ mod tests {
                     atol: 1e-8,
                     ..Default::default()
                 },
+                ..Default::default()
             },
             seeds: 2,
             starts: 2,

@@ -141,8 +141,24 @@ fn solution_dict<'py>(
     py: Python<'py>,
     r: ballbal_core::periodic::Periodic,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let disagree = r.verdicts_disagree();
+    let top = PyDict::new(py);
+    top.set_item("target_met", r.target_met)?;
+    top.set_item("verdicts_disagree", disagree)?;
+    if let Some((m, st)) = &r.hill {
+        top.set_item(
+            "hill_re",
+            PyArray1::from_vec(py, m.iter().map(|z| z.0).collect()),
+        )?;
+        top.set_item(
+            "hill_im",
+            PyArray1::from_vec(py, m.iter().map(|z| z.1).collect()),
+        )?;
+        top.set_item("hill_stability", st.as_str())?;
+    }
     let s = r.sol;
-    let d = PyDict::new(py);
+    let d = top;
+    d.set_item("tail", s.tail_ratio())?;
     let ok = s.status == Status::Converged;
     d.set_item("status", s.status.as_str())?;
     d.set_item("type", pattern_string(&s.winding))?;
@@ -197,6 +213,9 @@ fn periodic_options(
     settle: f64,
     window: f64,
     guess_rtol: f64,
+    auto: Option<f64>,
+    n_max: usize,
+    hill: bool,
 ) -> PyResult<PeriodicOptions> {
     let hb = HbOptions {
         n_harm,
@@ -212,13 +231,35 @@ fn periodic_options(
     }
     Options::new(guess_rtol, guess_rtol * 1e-2)
         .validate(1)
-        .map_err(|_| PyValueError::new_err(format!("guess_rtol: must be a finite number > 0, got {guess_rtol}")))?;
+        .map_err(|_| {
+            PyValueError::new_err(format!(
+                "guess_rtol: must be a finite number > 0, got {guess_rtol}"
+            ))
+        })?;
     if !(settle > 0.0 && window > 0.0 && settle.is_finite() && window.is_finite()) {
         return Err(PyValueError::new_err(
             "settle, window: must be finite and > 0",
         ));
     }
+    let auto = match auto {
+        None => None,
+        Some(t) if t > 0.0 && t < 1.0 => {
+            if n_max < n_harm || n_max > 256 {
+                return Err(PyValueError::new_err(format!(
+                    "N_max: must be in [N, 256] = [{n_harm}, 256], got {n_max}"
+                )));
+            }
+            Some(ballbal_core::periodic::AutoHarmonics { target: t, n_max })
+        }
+        Some(t) => {
+            return Err(PyValueError::new_err(format!(
+                "target: must be a number in (0, 1), got {t}"
+            )))
+        }
+    };
     Ok(PeriodicOptions {
+        auto,
+        hill,
         hb,
         floquet: floquet.then_some(FloquetOptions {
             rtol: f_rtol,
@@ -239,7 +280,7 @@ fn periodic_options(
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, pattern, n_harm, samples, tol, step_tol, max_iter,
                     guess_omega, guess_coeffs, floquet, f_rtol, f_atol, margin, max_steps, settle,
-                    window, guess_rtol))]
+                    window, guess_rtol, auto, n_max, hill))]
 #[allow(clippy::too_many_arguments)]
 fn periodic<'py>(
     py: Python<'py>,
@@ -265,12 +306,15 @@ fn periodic<'py>(
     settle: f64,
     window: f64,
     guess_rtol: f64,
+    auto: Option<f64>,
+    n_max: usize,
+    hill: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let rotating = parse_pattern(pattern, p.n_balls()).map_err(to_py)?;
     let opts = periodic_options(
         n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, max_steps,
-        settle, window, guess_rtol,
+        settle, window, guess_rtol, auto, n_max, hill,
     )?;
     let d = p.ndof();
     let guess = match (guess_omega, guess_coeffs) {
@@ -345,8 +389,8 @@ fn orbit_closure(
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, names, values, patterns,
                     n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin,
-                    max_steps, settle, window, guess_rtol, seeds, starts, chunk, max_tail,
-                    threads, chunks, on_chunk))]
+                    max_steps, settle, window, guess_rtol, auto, n_max, hill, seeds, starts,
+                    chunk, max_tail, threads, chunks, on_chunk))]
 #[allow(clippy::too_many_arguments)]
 fn scan(
     py: Python<'_>,
@@ -372,6 +416,9 @@ fn scan(
     settle: f64,
     window: f64,
     guess_rtol: f64,
+    auto: Option<f64>,
+    n_max: usize,
+    hill: bool,
     seeds: usize,
     starts: usize,
     chunk: usize,
@@ -391,7 +438,7 @@ fn scan(
         .map_err(to_py)?;
     let mut opts = periodic_options(
         n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, max_steps,
-        settle, window, guess_rtol,
+        settle, window, guess_rtol, auto, n_max, hill,
     )?;
     opts.guess.atol = guess_rtol * 1e-3;
     let spec = ScanSpec {
@@ -476,7 +523,9 @@ fn scan_columns<'py>(
     for (k, name) in names.iter().enumerate() {
         d.set_item(
             name,
-            rows.iter().map(|r| values[k][r.index[k]]).collect::<Vec<_>>(),
+            rows.iter()
+                .map(|r| values[k][r.index[k]])
+                .collect::<Vec<_>>(),
         )?;
     }
     let conv = |r: &ballbal_core::scan::ScanRow| -> Option<Periodic> { r.result.clone() };
@@ -484,12 +533,26 @@ fn scan_columns<'py>(
     let f = |g: &dyn Fn(&Periodic) -> Option<f64>| -> Vec<Option<f64>> {
         sols.iter().map(|s| s.as_ref().and_then(g)).collect()
     };
-    d.set_item("type", rows.iter().map(|r| patterns[r.pattern].clone()).collect::<Vec<_>>())?;
-    d.set_item("solution", rows.iter().map(|r| r.solution).collect::<Vec<_>>())?;
+    d.set_item(
+        "type",
+        rows.iter()
+            .map(|r| patterns[r.pattern].clone())
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "solution",
+        rows.iter().map(|r| r.solution).collect::<Vec<_>>(),
+    )?;
     d.set_item(
         "status",
         sols.iter()
-            .map(|s| if s.is_some() { "converged" } else { "not_found" })
+            .map(|s| {
+                if s.is_some() {
+                    "converged"
+                } else {
+                    "not_found"
+                }
+            })
             .collect::<Vec<_>>(),
     )?;
     d.set_item("omega", f(&|x| Some(x.sol.omega)))?;
@@ -505,8 +568,14 @@ fn scan_columns<'py>(
             })
             .collect::<Vec<_>>(),
     )?;
-    d.set_item("max_modulus", f(&|x| x.floquet.as_ref().map(|fl| fl.max_modulus)))?;
-    d.set_item("trivial_error", f(&|x| x.floquet.as_ref().map(|fl| fl.trivial_error)))?;
+    d.set_item(
+        "max_modulus",
+        f(&|x| x.floquet.as_ref().map(|fl| fl.max_modulus)),
+    )?;
+    d.set_item(
+        "trivial_error",
+        f(&|x| x.floquet.as_ref().map(|fl| fl.trivial_error)),
+    )?;
     let mults = |part: fn(&(f64, f64)) -> f64| -> Vec<Option<Vec<f64>>> {
         sols.iter()
             .map(|s| {
@@ -530,7 +599,11 @@ fn scan_columns<'py>(
     d.set_item(
         "floquet_steps",
         sols.iter()
-            .map(|s| s.as_ref().and_then(|x| x.floquet.as_ref()).map(|fl| fl.steps))
+            .map(|s| {
+                s.as_ref()
+                    .and_then(|x| x.floquet.as_ref())
+                    .map(|fl| fl.steps)
+            })
             .collect::<Vec<_>>(),
     )?;
     d.set_item(
@@ -539,12 +612,51 @@ fn scan_columns<'py>(
             .map(|s| s.as_ref().and_then(|x| x.floquet_error.clone()))
             .collect::<Vec<_>>(),
     )?;
-    d.set_item("N", vec![n_harm; rows.len()])?;
-    d.set_item("attempts", rows.iter().map(|r| r.attempts).collect::<Vec<_>>())?;
-    d.set_item("seconds", rows.iter().map(|r| r.seconds).collect::<Vec<_>>())?;
+    d.set_item(
+        "N",
+        sols.iter()
+            .map(|s| s.as_ref().map_or(n_harm, |x| x.sol.n_harm))
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "target_met",
+        sols.iter()
+            .map(|s| s.as_ref().and_then(|x| x.target_met))
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "hill_stability",
+        sols.iter()
+            .map(|s| {
+                s.as_ref()
+                    .and_then(|x| x.hill.as_ref())
+                    .map(|h| h.1.as_str())
+            })
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "verdicts_disagree",
+        sols.iter()
+            .map(|s| s.as_ref().and_then(|x| x.verdicts_disagree()))
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "attempts",
+        rows.iter().map(|r| r.attempts).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "seconds",
+        rows.iter().map(|r| r.seconds).collect::<Vec<_>>(),
+    )?;
     d.set_item("origin", rows.iter().map(|r| r.origin).collect::<Vec<_>>())?;
-    d.set_item("pb_exists", rows.iter().map(|r| r.pb_exists).collect::<Vec<_>>())?;
-    d.set_item("pb_stable", rows.iter().map(|r| r.pb_stable).collect::<Vec<_>>())?;
+    d.set_item(
+        "pb_exists",
+        rows.iter().map(|r| r.pb_exists).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "pb_stable",
+        rows.iter().map(|r| r.pb_stable).collect::<Vec<_>>(),
+    )?;
     Ok(d)
 }
 

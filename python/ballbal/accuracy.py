@@ -1,0 +1,145 @@
+"""What accuracy costs in time: harmonics, samples and tolerances against error and
+seconds at one parameter point."""
+
+from __future__ import annotations
+
+import statistics
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+from .analysis import PeriodicSolution, periodic
+from .model import Balancer
+
+
+def _match_error(a: np.ndarray, ref: np.ndarray) -> float:
+    """Largest distance between multipliers after pairing each reference multiplier with
+    the nearest unused one (pairing by sorted modulus mixes up near-equal moduli)."""
+    left = list(a)
+    worst = 0.0
+    for r in sorted(ref, key=lambda z: -abs(z)):
+        k = int(np.argmin([abs(z - r) for z in left]))
+        worst = max(worst, abs(left.pop(k) - r))
+    return worst
+
+
+def _coeff_error(c: np.ndarray, ref: np.ndarray) -> float:
+    n = max(c.shape[1], ref.shape[1])
+    pad = np.zeros((c.shape[0], n))
+    padr = np.zeros((ref.shape[0], n))
+    pad[:, : c.shape[1]] = c
+    padr[:, : ref.shape[1]] = ref
+    return float(np.max(np.abs(pad - padr)) / max(1.0, float(np.max(np.abs(ref)))))
+
+
+def accuracy_cost(
+    balancer: Balancer,
+    pattern: str = "R-R",
+    *,
+    N: Sequence[int] = (1, 2, 3, 4, 5, 6, 8, 10, 12, 16),
+    samples: Sequence[int] = (4, 6, 8, 16, 32),
+    tol: Sequence[float] = (1e-3, 1e-5, 1e-7, 1e-9, 1e-11),
+    rtol: Sequence[float] = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+    base_N: int = 12,
+    reference_N: int = 32,
+    neighbour: float = 0.01,
+    repeats: int = 5,
+    guess: PeriodicSolution | None = None,
+) -> pl.DataFrame:
+    """Error against time for each accuracy knob at one point, as a polars table.
+
+    Knobs, each varied with the others at a high-accuracy baseline (``base_N``
+    harmonics, default samples, Newton tol 1e-10, RK45 rtol 1e-9): ``N``; ``samples``
+    per period as a multiple of N (at ``base_N``); the Newton ``tol``; the RK45 ``rtol``
+    of the monodromy (atol = rtol / 100). Every setting is solved from the same warm
+    start, the solution at ``Omega - neighbour`` (what a scan does), ``repeats`` times;
+    ``seconds`` is the median wall time of harmonic balance plus Floquet.
+
+    Errors are against a reference with ``reference_N`` harmonics and tight tolerances
+    (rtol 1e-11), whose own orbit closure after one period of time simulation is in the
+    column ``reference_closure``: ``omega_error`` (relative), ``coeff_error`` (largest
+    coefficient difference relative to the largest coefficient), ``multiplier_error``
+    (largest distance between paired multipliers), ``trivial_error`` (the computed
+    trivial multiplier's distance from 1) and whether the verdict matches the
+    reference's.
+    """
+    if repeats < 1:
+        raise ValueError(f"repeats: must be >= 1, got {repeats}")
+    tight: dict[str, Any] = dict(tol=1e-12, step_tol=1e-10, rtol=1e-11, atol=1e-13, hill=False)
+    if guess is None:
+        start = periodic(balancer, pattern, N=8, hill=False)
+        if not start.converged:
+            raise ValueError(f"pattern: no {pattern} solution found at this point by "
+                             f"simulation (status {start.status}); pass guess=")
+        guess = start
+    ref = periodic(balancer, pattern, N=reference_N, guess=guess, **tight)
+    if not ref.converged or ref.multipliers is None:
+        raise ValueError(f"reference: the N = {reference_N} solve did not converge "
+                         f"(status {ref.status})")
+    closure = ref.verify(rtol=1e-11, atol=1e-13)
+    near_b = balancer.replace(Omega=balancer.Omega - neighbour)
+    near = periodic(near_b, pattern, N=reference_N, guess=ref, hill=False)
+    warm = near if near.converged else ref
+
+    settings: list[tuple[str, float, dict[str, Any]]] = []
+    base: dict[str, Any] = dict(N=base_N, samples=None, tol=1e-10, rtol=1e-9, atol=1e-11)
+    for n in N:
+        settings.append(("N", n, {**base, "N": int(n)}))
+    for m in samples:
+        s = max(int(m * base_N), 2 * base_N + 2)
+        settings.append(("samples", s, {**base, "samples": s}))
+    for t in tol:
+        settings.append(("tol", t, {**base, "tol": t, "step_tol": max(t * 100, 1e-8)}))
+    for r in rtol:
+        settings.append(("rtol", r, {**base, "rtol": r, "atol": r / 100}))
+
+    rows = []
+    for knob, value, kw in settings:
+        times = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            s = periodic(balancer, pattern, guess=warm, hill=False, **kw)
+            times.append(time.perf_counter() - t0)
+        ok = s.converged and s.multipliers is not None
+        rows.append({
+            "knob": knob, "value": float(value), "N": int(kw["N"]),
+            "samples": s.samples, "tol": float(kw["tol"]), "rtol": float(kw["rtol"]),
+            "status": s.status, "iterations": s.iterations,
+            "floquet_steps": s.floquet_steps, "seconds": statistics.median(times),
+            "omega_error": abs(s.omega - ref.omega) / ref.omega if ok else None,
+            "coeff_error": _coeff_error(s.coeffs, ref.coeffs) if ok else None,
+            "multiplier_error": _match_error(s.multipliers, ref.multipliers) if ok else None,
+            "trivial_error": s.trivial_error, "tail": s.tail if ok else None,
+            "verdict_ok": (s.stability == ref.stability) if ok else None,
+            "reference_closure": closure,
+        })
+    return pl.DataFrame(rows)
+
+
+def plot_accuracy_cost(df: pl.DataFrame, *, error: str = "multiplier_error", ax: Any = None,
+                       title: str | None = None) -> Any:
+    """Error against time, one curve per knob, with the Pareto front of all settings."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(6.5, 4.5))
+    ok = df.filter(pl.col(error).is_not_null() & (pl.col(error) > 0))
+    for knob, mark in (("N", "o-"), ("samples", "s-"), ("tol", "^-"), ("rtol", "v-")):
+        part = ok.filter(pl.col("knob") == knob).sort("value")
+        if part.height:
+            ax.loglog(part["seconds"] * 1e3, part[error], mark, ms=4, label=knob)
+            if knob == "N":
+                for n, sx, e in part.select("N", "seconds", error).iter_rows():
+                    ax.annotate(f"N={n}", (sx * 1e3, e), fontsize=6, xytext=(3, 3),
+                                textcoords="offset points")
+    front = ok.sort("seconds").with_columns(pl.col(error).cum_min().alias("_front"))
+    front = front.filter(pl.col(error) == pl.col("_front"))
+    ax.loglog(front["seconds"] * 1e3, front[error], "k:", lw=1, label="Pareto front")
+    ax.set_xlabel("time per point (ms): harmonic balance + Floquet")
+    ax.set_ylabel(error.replace("_", " "))
+    ax.set_title(title or "accuracy against cost")
+    ax.legend(fontsize=7)
+    return ax
