@@ -39,12 +39,14 @@ def main() -> None:
           f"{'steps':>6} {'HB+Floquet [us]':>16} {'Floquet error':>14} {'|omega-0.251413|':>17}")
     for N in (3, 6, 12):
         t_hb, sol = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed,
-                                                         floquet=False))
-        tight = ballbal.periodic(b, "R-R", N=N, guess=seed, rtol=1e-11, atol=1e-14)
+                                                         floquet=False, hill=False))
+        tight = ballbal.periodic(b, "R-R", N=N, guess=seed, rtol=1e-11, atol=1e-14,
+                                 hill=False)
         ref = np.sort(np.abs(tight.multipliers))
         for rtol in (1e-5, 1e-6):
             t_all, full = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed,
-                                                               rtol=rtol, atol=rtol * 1e-3))
+                                                               rtol=rtol, atol=rtol * 1e-3,
+                                                               hill=False))
             err = np.max(np.abs(np.sort(np.abs(full.multipliers)) - ref))
             print(f"{N:3d} {t_hb * 1e6:14.0f} {sol.iterations:6d} {rtol:6.0e} "
                   f"{(t_all - t_hb) * 1e6:13.0f} {full.floquet_steps:6d} {t_all * 1e6:16.0f} "
@@ -59,7 +61,15 @@ def main() -> None:
     mult = scipy_point()
     t_sp = time.perf_counter() - t0
     t6, _ = median_time(lambda: ballbal.periodic(b, "R-R", N=6, guess=seed, rtol=1e-6,
-                                                 atol=1e-9), 30)
+                                                 atol=1e-9, hill=False), 30)
+    for N in (3, 6, 12):
+        t_h, h = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed, rtol=1e-6,
+                                                      atol=1e-9), 10)
+        t_n, _ = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed, rtol=1e-6,
+                                                      atol=1e-9, hill=False), 10)
+        d = np.max(np.abs(np.sort(np.abs(h.multipliers)) - np.sort(np.abs(h.hill_multipliers))))
+        print(f"N = {N:2d}: Hill's-method check adds {(t_h - t_n) * 1e3:.1f} ms "
+              f"(HB + Floquet {t_n * 1e3:.2f} ms); moduli agree to {d:.1e}")
     print(f"scipy shooting + finite-difference monodromy: {t_sp * 1e3:.0f} ms "
           f"(max modulus {np.sort(np.abs(mult))[-2]:.4f}); ballbal N = 6: {t6 * 1e6:.0f} us; "
           f"ratio {t_sp / t6:.0f}")

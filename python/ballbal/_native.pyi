@@ -31,7 +31,8 @@ def scan(
     names: list[str], values: list[list[float]], patterns: list[str], n_harm: int,
     samples: int | None, tol: float, step_tol: float, max_iter: int, floquet: bool,
     f_rtol: float, f_atol: float, margin: float, max_steps: int, settle: float, window: float,
-    guess_rtol: float, auto: float | None, n_max: int, hill: bool, seeds: int, starts: int, chunk: int, max_tail: float, threads: int,
+    guess_rtol: float, auto: float | None, n_max: int, hill: bool, seeds: int, starts: int,
+    chunk: int, max_tail: float, threads: int,
     chunks: list[int], on_chunk: Callable[[int, dict[str, Any]], None],
 ) -> None: ...
 def default_chunk(lens: list[int]) -> int: ...

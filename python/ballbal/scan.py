@@ -300,7 +300,8 @@ def scan(
         raise ValueError(f"threads: must be >= 1, got {threads}")
     n0, auto = harmonics(N, target)
     options = (
-        ("N", n0), ("auto", auto), ("N_max", int(N_max)), ("hill", bool(hill)), ("samples", None if samples is None else int(samples)),
+        ("N", n0), ("auto", auto), ("N_max", int(N_max)), ("hill", bool(hill)),
+        ("samples", None if samples is None else int(samples)),
         ("tol", float(tol)), ("step_tol", float(step_tol)), ("max_iter", int(max_iter)),
         ("floquet", bool(floquet)), ("rtol", float(rtol)), ("atol", float(atol)),
         ("margin", float(margin)), ("max_steps", int(max_steps)), ("settle", float(settle)),
