@@ -8,23 +8,24 @@ cd "$root"
 py=${PYTHON:-python3}
 export CARGO_TERM_COLOR=never
 
-echo "== cargo test (core, no Python)"
+stamp() { echo "== [$(( SECONDS / 60 ))m$(( SECONDS % 60 ))s] $*"; }
+stamp "cargo test (core, no Python)"
 cargo test --release -p ballbal-core
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-echo "== build wheel"
+stamp "build wheel"
 "$py" -m venv "$work/build-env"
 "$work/build-env/bin/pip" install -q --upgrade pip "maturin>=1.5,<2"
 "$work/build-env/bin/maturin" build --release --out "$work/dist" -q
 wheel=$(ls "$work"/dist/ballbal-*.whl)
 
-echo "== install $(basename "$wheel") into a clean venv"
+stamp "install $(basename "$wheel") into a clean venv"
 "$py" -m venv "$work/venv"
 "$work/venv/bin/pip" install -q --upgrade pip
 "$work/venv/bin/pip" install -q "$wheel[test,plot]"
 
-echo "== pytest against the installed package"
+stamp "pytest against the installed package"
 cp -r tests "$work/tests"
 cd "$work"
 "$work/venv/bin/python" -m pytest -q -p no:cacheprovider tests "$@"
