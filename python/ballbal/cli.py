@@ -53,7 +53,30 @@ def _print_periodic(b: Balancer, pattern: str, N: int) -> None:
     mods = " ".join(f"{m:.4f}" for m in np.sort(np.abs(s.multipliers))[::-1])
     print(f"  {s.type} N={N}: omega={s.omega:.6f} (period {s.period:.3f}), {s.stability}; "
           f"|multipliers| {mods}; trivial error {s.trivial_error:.1e}; residual "
-          f"{s.residual:.1e}; orbit closure by simulation {s.verify():.1e}; {dt * 1e3:.1f} ms")
+          f"{s.residual:.1e}; orbit closure by simulation {s.verify():.1e}; Hill's method: "
+          f"{s.hill_stability}; {dt * 1e3:.1f} ms")
+
+
+def _print_map(b: Balancer) -> None:
+    t = time.perf_counter()
+    df = scan(b, Omega=(1.0, 2.0, 0.1), eta=(0.4, 1.5, 0.1), patterns=["R-R", "O-O", "R-O"])
+    dt = time.perf_counter() - t
+    print(f"Scan of the thesis grid (zeta {b.zeta}, zeta_b {b.zeta_b}; R-R, O-O, R-O; "
+          f"{dt:.2f} s): S stable R-R, u unstable R-R, o other stable type, "
+          "+ perfect balance stable, . nothing")
+    oms = sorted(set(df["Omega"].to_list()))
+    print("  eta  " + "".join(f"{om:>4.1f}" for om in oms))
+    for eta in sorted(set(df["eta"].to_list()), reverse=True):
+        line = []
+        for om in oms:
+            here = df.filter((df["Omega"] == om) & (df["eta"] == eta))
+            ok = here.filter(here["status"] == "converged")
+            rr = ok.filter(ok["type"] == "R-R")["stability"].to_list()
+            other = ok.filter((ok["type"] != "R-R") & (ok["stability"] == "stable")).height
+            c = ("S" if "stable" in rr else "u" if rr else "o" if other else
+                 "+" if here["pb_stable"][0] else ".")
+            line.append(f"{c:>4}")
+        print(f"  {eta:3.1f}  " + "".join(line))
 
 
 def _scan(a: argparse.Namespace) -> int:
@@ -132,6 +155,7 @@ def main(argv: list[str] | None = None) -> int:
             print("Periodic solutions (balls merged, rotating):")
             for N in (3, 8):
                 _print_periodic(b, "R-R", N)
+            _print_map(b.replace(zeta_b=0.1))
         elif a.cmd == "scan":
             return _scan(a)
         elif a.cmd == "plot":
