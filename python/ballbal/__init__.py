@@ -11,13 +11,16 @@ from .analysis import (
 )
 from .model import Balancer, from_seed003, zeta_from_log_decrement
 from .scan import ScanInterrupted, read_scan, scan, scan_meta
-from .scene import load_scene
+from .scene import Impulse, Ramp, Scene, load_scene
 
 __all__ = [
     "Balancer",
     "Equilibrium",
+    "Impulse",
     "ScanInterrupted",
     "PeriodicSolution",
+    "Ramp",
+    "Scene",
     "__version__",
     "accuracy_cost",
     "equilibria",

@@ -4,27 +4,34 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+Effects = (
+    tuple[float, tuple[float, float, float] | None, float,
+          tuple[float, float, float, float] | None]
+    | None
+)
+
 __version__: str
 
 def simulate(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     y0: npt.NDArray[np.float64], t0: float, t_eval: npt.NDArray[np.float64], rtol: float,
-    atol: list[float],
+    atol: list[float], effects: Effects = None,
 ) -> tuple[npt.NDArray[np.float64], int, int, int]: ...
 def equilibria(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
+    effects: Effects = None,
 ) -> list[dict[str, Any]]: ...
 def periodic(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     pattern: str, n_harm: int, samples: int | None, tol: float, step_tol: float, max_iter: int,
     guess_omega: float | None, guess_coeffs: npt.NDArray[np.float64] | None, floquet: bool,
     f_rtol: float, f_atol: float, margin: float, max_steps: int, settle: float, window: float,
-    guess_rtol: float, auto: float | None, n_max: int, hill: bool,
+    guess_rtol: float, auto: float | None, n_max: int, hill: bool, effects: Effects = None,
 ) -> dict[str, Any]: ...
 def orbit_closure(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     sol_omega: float, coeffs: npt.NDArray[np.float64], winding: list[float], rtol: float,
-    atol: float,
+    atol: float, effects: Effects = None,
 ) -> float: ...
 def scan(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],

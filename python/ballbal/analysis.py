@@ -11,6 +11,7 @@ import polars as pl
 
 from . import _native
 from .model import Balancer
+from .scene import Scene
 
 Stability = Literal["stable", "unstable", "undetermined"]
 
@@ -25,7 +26,7 @@ def _state_names(n: int) -> list[str]:
 
 
 def simulate(
-    balancer: Balancer,
+    balancer: Balancer | Scene,
     y0: Sequence[float] | np.ndarray | None = None,
     t_eval: Sequence[float] | np.ndarray | None = None,
     *,
@@ -57,11 +58,12 @@ def simulate(
         raise ValueError("t_eval: must hold at least one time")
     if t0 is None:
         t0 = float(t_span[0]) if t_span is not None else 0.0
-    y, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol), _atol(atol))
+    y, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol), _atol(atol),
+                             balancer.native_effects())
     cols: dict[str, Any] = {"t": t}
     for name, col in zip(_state_names(n), np.asarray(y).T, strict=True):
         cols[name] = col
-    ph = balancer.Omega * t
+    ph = balancer.theta(t)
     cols["X"] = cols["x"] * np.cos(ph) - cols["y"] * np.sin(ph)
     cols["Y"] = cols["x"] * np.sin(ph) + cols["y"] * np.cos(ph)
     return pl.DataFrame(cols)
@@ -82,11 +84,11 @@ class Equilibrium:
     char_poly: np.ndarray
 
 
-def equilibria(balancer: Balancer) -> list[Equilibrium]:
+def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
     """All equilibria (perfect balance first), with eigenvalues, the relative-stability
     index (largest real part) and, where defined, the Routh–Hurwitz verdict."""
     out = []
-    for d in _native.equilibria(*balancer.native_args()):
+    for d in _native.equilibria(*balancer.native_args(), balancer.native_effects()):
         out.append(Equilibrium(
             kind=d["kind"], q=d["q"], residual=d["residual"],
             eigenvalues=d["eig_re"] + 1j * d["eig_im"], stability_index=d["index"],
@@ -105,7 +107,7 @@ class PeriodicSolution:
     ``tau = omega t``, with ``winding[j] = -1`` for a rotating ball.
     """
 
-    balancer: Balancer
+    balancer: Balancer | Scene
     status: str
     type: str
     omega: float | None
@@ -179,6 +181,7 @@ class PeriodicSolution:
         return _native.orbit_closure(
             *self.balancer.native_args(), self.omega, np.ascontiguousarray(self.coeffs.ravel()),
             [float(w) for w in self.winding], float(rtol), float(atol),
+            self.balancer.native_effects(),
         )
 
 
@@ -194,7 +197,7 @@ def harmonics(N: int | str, target: float) -> tuple[int, float | None]:
 
 
 def periodic(
-    balancer: Balancer,
+    balancer: Balancer | Scene,
     pattern: str = "R-R",
     *,
     N: int | str = 3,
@@ -250,6 +253,7 @@ def periodic(
         *balancer.native_args(), pattern, n0, samples, float(tol), float(step_tol),
         int(max_iter), go, gc, bool(floquet), float(rtol), float(atol), float(margin),
         int(max_steps), float(settle), float(window), 1e-9, auto, int(N_max), bool(hill),
+        balancer.native_effects(),
     )
     mult = d["mult_re"] + 1j * d["mult_im"] if "mult_re" in d else None
     hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None

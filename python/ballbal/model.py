@@ -9,12 +9,18 @@ from typing import Any
 
 
 def _tuple(name: str, v: float | Sequence[float]) -> tuple[float, ...]:
-    if isinstance(v, (int, float)):
+    bad = ValueError(f"{name}: must be a number or a sequence of numbers, got {v!r}")
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
         return (float(v),)
+    if isinstance(v, (str, bytes)):
+        raise bad
     try:
-        return tuple(float(x) for x in v)
+        items = list(v)
     except TypeError as e:
-        raise ValueError(f"{name}: must be a number or a sequence of numbers, got {v!r}") from e
+        raise bad from e
+    if any(isinstance(x, (bool, str, bytes)) or not isinstance(x, (int, float)) for x in items):
+        raise bad
+    return tuple(float(x) for x in items)
 
 
 @dataclass(frozen=True)
@@ -34,6 +40,11 @@ class Balancer:
     eta: tuple[float, ...] = field(default=(1.0, 1.0))
 
     def __post_init__(self) -> None:
+        for name in ("mu", "zeta", "delta", "Omega"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise ValueError(f"{name}: must be a number, got {v!r}")
+            object.__setattr__(self, name, float(v))
         object.__setattr__(self, "eta", _tuple("eta", self.eta))
         zb = _tuple("zeta_b", self.zeta_b)
         object.__setattr__(self, "zeta_b", zb[0] if len(zb) == 1 else zb)
@@ -46,6 +57,16 @@ class Balancer:
         zb = [self.zeta_b] if isinstance(self.zeta_b, float) else list(self.zeta_b)
         return (float(self.mu), float(self.zeta), zb, float(self.delta), float(self.Omega),
                 list(self.eta))
+
+    def native_effects(self) -> None:
+        """A plain balancer has no effects (see :class:`ballbal.scene.Scene`)."""
+        return None
+
+    def theta(self, t: Any) -> Any:
+        """The disk's angle at time(s) t."""
+        import numpy as np
+
+        return self.Omega * np.asarray(t, dtype=float)
 
     def replace(self, **changes: Any) -> Balancer:
         return replace(self, **changes)

@@ -24,6 +24,7 @@ import polars as pl
 from . import _native
 from .analysis import harmonics
 from .model import Balancer
+from .scene import Scene
 
 SCANNABLE = ("mu", "zeta", "zeta_b", "delta", "Omega", "eta")
 _INDEXED = ("eta[", "zeta_b[")
@@ -219,7 +220,7 @@ def _as_completed(futures: list[Any]) -> Iterable[Any]:
 
 
 def scan(
-    balancer: Balancer,
+    balancer: Balancer | Scene,
     *,
     patterns: Sequence[str] = ("R-R",),
     N: int | str = 3,
@@ -278,6 +279,13 @@ def scan(
     ``f(done_points, total_points)``. Ctrl-C stops the scan and returns the finished
     chunks with a :class:`ScanInterrupted` warning.
     """
+    if isinstance(balancer, Scene):
+        if balancer.native_effects() is not None:
+            raise ValueError(
+                "scene: scans of scenes with effects (springs, ramp, gravity, impulse) are "
+                "not available yet; scan the plain balancer, or simulate the scene"
+            )
+        balancer = balancer.balancer
     axes_all: dict[str, GridSpec] = dict(grid or {})
     for k, v in axes.items():
         if k in axes_all:

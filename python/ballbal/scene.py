@@ -1,15 +1,33 @@
-"""Scene files (TOML) for the planar balancer: its parameters, nothing else yet.
+"""Scenes: the planar balancer plus the physical effects a user switches on.
 
-A file holds the keys of :class:`~ballbal.Balancer` (``mu, zeta, zeta_b, delta, Omega,
-eta``) and optionally ``balls`` (equal balls when ``eta`` is one number). Unknown keys
-are errors, so a misspelt parameter never silently falls back to a default.
+A scene is a :class:`Balancer` with optional effects (``model.md`` units: lengths over
+the eccentricity ``e``, time over ``1/w_n``, forces over ``M e w_n^2``):
+
+* ``springs``: circumferential springs between neighbouring balls (a ring), stiffness
+  ``k_d / k``, rest spacing ``2 pi / n`` (seed 004's ball-spring balancer);
+* ``ramp``: the spin changes linearly from ``Omega`` to ``ramp.to`` over
+  ``ramp.duration`` from ``ramp.start`` (a run-up, or seed 001's speed disturbance);
+* ``gravity``: ``g / (e w_n^2)`` for a horizontal spin axis (gravity along -Y of the
+  ground frame; the disk's x axis is along +X at t = 0);
+* ``impulse``: seed 002's load on the rotor ``amplitude exp(-sharpness (t - t0)^2)``
+  along the ground direction ``angle``.
+
+Every analysis accepts a scene. Time simulation works with any; periodic solutions and
+Floquet need an autonomous scene (no ramp, gravity or impulse: asking is an error that
+names the effect). Equilibria and scans of scenes with springs come in a later version.
+
+Files (TOML): the balancer's keys at the top level or in ``[balancer]`` (``balls`` for
+equal balls), and optional tables ``[springs] stiffness``, ``[ramp] to, start,
+duration``, ``[gravity] g``, ``[impulse] amplitude, t0, sharpness, angle``. Unknown keys
+and tables are errors.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import sys
-from dataclasses import fields
+from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
 from .model import Balancer
@@ -18,6 +36,151 @@ if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
+
+
+def _num(where: str, v: Any) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise ValueError(f"{where}: must be a finite number, got {v!r}")
+    return float(v)
+
+
+@dataclass(frozen=True)
+class Ramp:
+    to: float
+    start: float = 0.0
+    duration: float = 1.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            object.__setattr__(self, f.name, _num(f"ramp.{f.name}", getattr(self, f.name)))
+        if self.to <= 0:
+            raise ValueError(f"ramp.to: must be > 0, got {self.to}")
+        if self.duration <= 0:
+            raise ValueError(f"ramp.duration: must be > 0, got {self.duration}")
+
+
+@dataclass(frozen=True)
+class Impulse:
+    amplitude: float
+    t0: float
+    sharpness: float
+    angle: float = -math.pi / 2
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            object.__setattr__(self, f.name, _num(f"impulse.{f.name}", getattr(self, f.name)))
+        if self.sharpness <= 0:
+            raise ValueError(f"impulse.sharpness: must be > 0, got {self.sharpness}")
+
+
+@dataclass(frozen=True)
+class Scene:
+    balancer: Balancer = field(default_factory=Balancer)
+    springs: float = 0.0
+    ramp: Ramp | None = None
+    gravity: float = 0.0
+    impulse: Impulse | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.balancer, Balancer):
+            raise ValueError(f"balancer: must be a Balancer, got {type(self.balancer).__name__}")
+        object.__setattr__(self, "springs", _num("springs", self.springs))
+        object.__setattr__(self, "gravity", _num("gravity", self.gravity))
+        if self.springs < 0:
+            raise ValueError(f"springs: must be >= 0 (k_d / k), got {self.springs}")
+        if self.springs > 0 and self.balancer.n_balls < 2:
+            raise ValueError("springs: ball springs need at least 2 balls")
+        if self.gravity < 0:
+            raise ValueError(f"gravity: must be >= 0, got {self.gravity}")
+        for name, kind in (("ramp", Ramp), ("impulse", Impulse)):
+            v = getattr(self, name)
+            if v is not None and not isinstance(v, kind):
+                raise ValueError(f"{name}: must be a {kind.__name__} or None")
+
+    # the interface the analyses use, shared with Balancer
+    @property
+    def n_balls(self) -> int:
+        return self.balancer.n_balls
+
+    @property
+    def Omega(self) -> float:  # noqa: N802 - the thesis' symbol
+        return self.balancer.Omega
+
+    def native_args(self) -> tuple[float, float, list[float], float, float, list[float]]:
+        return self.balancer.native_args()
+
+    def native_effects(self) -> tuple[Any, ...] | None:
+        if self.springs == 0 and self.ramp is None and self.gravity == 0 and self.impulse is None:
+            return None
+        ramp = None if self.ramp is None else (self.ramp.to, self.ramp.start, self.ramp.duration)
+        imp = None if self.impulse is None else (
+            self.impulse.amplitude, self.impulse.t0, self.impulse.sharpness, self.impulse.angle)
+        return (self.springs, ramp, self.gravity, imp)
+
+    @property
+    def time_dependence(self) -> str | None:
+        """The effect that makes the scene time dependent, or None if it is autonomous."""
+        if self.ramp is not None:
+            return "ramp"
+        if self.gravity != 0:
+            return "gravity"
+        if self.impulse is not None:
+            return "impulse"
+        return None
+
+    def theta(self, t: Any) -> Any:
+        """The disk's angle at time(s) t (0 at t = 0)."""
+        import numpy as np
+
+        t = np.asarray(t, dtype=float)
+        w0 = self.Omega
+        if self.ramp is None:
+            return w0 * t
+        r = self.ramp
+        rate = (r.to - w0) / r.duration
+        end = r.start + r.duration
+        u = np.clip(t - r.start, 0.0, r.duration)
+        after = np.maximum(t - end, 0.0)
+        return w0 * (t - after) + 0.5 * rate * u * u + r.to * after
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"balancer": asdict(self.balancer)}
+        b = d["balancer"]
+        b["eta"] = list(b["eta"])
+        if isinstance(b["zeta_b"], tuple):
+            b["zeta_b"] = list(b["zeta_b"])
+        if self.springs:
+            d["springs"] = {"stiffness": self.springs}
+        if self.ramp is not None:
+            d["ramp"] = asdict(self.ramp)
+        if self.gravity:
+            d["gravity"] = {"g": self.gravity}
+        if self.impulse is not None:
+            d["impulse"] = asdict(self.impulse)
+        return d
+
+    def to_toml(self) -> str:
+        lines: list[str] = []
+        for table, values in self.to_dict().items():
+            lines.append(f"[{table}]")
+            for k, v in values.items():
+                lines.append(f"{k} = {_toml_value(v)}")
+            lines.append("")
+        return "\n".join(lines)
+
+    def save(self, path: str | os.PathLike[str]) -> None:
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(self.to_toml())
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return repr(float(v))
+
+
+_TABLES = {"springs": {"stiffness"}, "ramp": {"to", "start", "duration"}, "gravity": {"g"},
+           "impulse": {"amplitude", "t0", "sharpness", "angle"}}
 
 
 def balancer_from_dict(d: dict[str, Any], where: str = "scene") -> Balancer:
@@ -29,21 +192,60 @@ def balancer_from_dict(d: dict[str, Any], where: str = "scene") -> Balancer:
     d = dict(d)
     balls = d.pop("balls", None)
     if balls is not None:
-        if not isinstance(balls, int) or balls < 1:
+        if isinstance(balls, bool) or not isinstance(balls, int) or balls < 1:
             raise ValueError(f"balls: must be an integer >= 1, got {balls!r}")
         eta = d.get("eta", 1.0)
         if isinstance(eta, (int, float)):
             d["eta"] = (float(eta),) * balls
-        elif len(eta) != balls:
-            raise ValueError(f"eta: has {len(eta)} values but balls = {balls}")
-    b = Balancer(**d)
-    return b.validate()
+        elif not isinstance(eta, list) or len(eta) != balls:
+            raise ValueError(f"eta: must be one number or {balls} numbers (balls = {balls})")
+    for k, v in d.items():
+        vals = list(v) if isinstance(v, (list, tuple)) else [v]
+        if not vals:
+            raise ValueError(f"{k}: must not be empty")
+        for x in vals:
+            _num(k, x)
+    return Balancer(**d).validate()
 
 
-def load_scene(path: str | os.PathLike[str]) -> Balancer:
+def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
+    if not isinstance(d, dict):
+        raise ValueError(f"{where}: a scene is a table of keys, got {type(d).__name__}")
+    tables = {k for k, v in d.items() if isinstance(v, dict)}
+    unknown = sorted(tables - set(_TABLES) - {"balancer"})
+    if unknown:
+        raise ValueError(f"{where}: unknown table(s) {', '.join(unknown)} "
+                         f"(allowed: balancer, {', '.join(_TABLES)})")
+    if "balancer" in tables:
+        flat = sorted(set(d) - tables)
+        if flat:
+            raise ValueError(f"{where}: key(s) {', '.join(flat)} outside a table; put the "
+                             "balancer's keys in [balancer]")
+        b = balancer_from_dict(d["balancer"], where)
+    else:
+        b = balancer_from_dict({k: v for k, v in d.items() if k not in tables}, where)
+    for t in tables & set(_TABLES):
+        extra = sorted(set(d[t]) - _TABLES[t])
+        if extra:
+            raise ValueError(f"{t}: unknown key(s) {', '.join(extra)} "
+                             f"(allowed: {', '.join(sorted(_TABLES[t]))})")
+    try:
+        return Scene(
+            balancer=b,
+            springs=d["springs"]["stiffness"] if "springs" in d else 0.0,
+            ramp=Ramp(**d["ramp"]) if "ramp" in d else None,
+            gravity=d["gravity"]["g"] if "gravity" in d else 0.0,
+            impulse=Impulse(**d["impulse"]) if "impulse" in d else None,
+        )
+    except (KeyError, TypeError) as e:
+        raise ValueError(f"{where}: incomplete effect table ({e})") from e
+
+
+def load_scene(path: str | os.PathLike[str]) -> Scene:
+    """A scene from a TOML file (see the module's description of the format)."""
     try:
         with open(path, "rb") as f:
             d = tomllib.load(f)
     except tomllib.TOMLDecodeError as e:
         raise ValueError(f"scene: {path} is not valid TOML: {e}") from e
-    return balancer_from_dict(d, where=str(path))
+    return scene_from_dict(d, where=str(path))

@@ -17,7 +17,9 @@ pub mod model;
 pub mod ode;
 pub mod periodic;
 pub mod scan;
+pub mod scene;
 pub mod simulate;
 
 pub use error::{Error, Result};
 pub use model::{Dynamics, Planar};
+pub use scene::Scene;

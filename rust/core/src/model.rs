@@ -46,6 +46,11 @@ pub trait Dynamics: Send + Sync {
     fn time_dependence(&self) -> Option<String> {
         None
     }
+    /// The disk's spin `Omega` at rest of any spin profile: simulated starts begin at
+    /// rest in the ground frame, i.e. with ball rates `-Omega`.
+    fn base_spin(&self) -> f64 {
+        0.0
+    }
 }
 
 /// Planar n-ball automatic balancer on an isotropic spring–damper support.
@@ -137,8 +142,15 @@ impl Planar {
     }
 
     /// `g(q, v) = F(q, v, 0)`: everything but the inertia terms.
+    #[inline]
     pub fn forces(&self, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let (om, z, dl) = (self.omega_s, self.zeta, self.delta);
+        self.forces_at(self.omega_s, q, v, out);
+    }
+
+    /// [`Self::forces`] at spin `om` (a scene's spin may vary in time).
+    #[inline]
+    pub fn forces_at(&self, om: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let (z, dl) = (self.zeta, self.delta);
         let (x, y, vx, vy) = (q[0], q[1], v[0], v[1]);
         let k = 1.0 - om * om;
         let mut fx = 2.0 * z * vx - 2.0 * om * vy + k * x - 2.0 * z * om * y - self.mu * om * om;
@@ -191,23 +203,10 @@ impl Planar {
         }
         Planar::new(p.mu, p.zeta, &p.zeta_b, p.delta, p.omega_s, &p.eta)
     }
-}
 
-fn indexed(name: &str, base: &str) -> Option<usize> {
-    let rest = name
-        .strip_prefix(base)?
-        .strip_prefix('[')?
-        .strip_suffix(']')?;
-    rest.parse().ok()
-}
-
-impl Dynamics for Planar {
-    fn ndof(&self) -> usize {
-        self.eta.len() + 2
-    }
-
-    fn residual(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
-        self.forces(q, v, out);
+    /// Adds the inertia terms `M(q) a` to `out`.
+    #[inline]
+    pub fn add_inertia(&self, q: &[f64], a: &[f64], out: &mut [f64]) {
         let (ax, ay) = (a[0], a[1]);
         for i in 0..self.n_balls() {
             let (s, c) = q[2 + i].sin_cos();
@@ -221,9 +220,12 @@ impl Dynamics for Planar {
         out[1] += ay;
     }
 
-    fn jacobians(
+    /// [`Dynamics::jacobians`] at spin `om`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn jacobians_at(
         &self,
-        _t: f64,
+        om: f64,
         q: &[f64],
         v: &[f64],
         a: &[f64],
@@ -235,7 +237,7 @@ impl Dynamics for Planar {
         k.fill(0.0);
         c.fill(0.0);
         m.fill(0.0);
-        let (om, z, dl) = (self.omega_s, self.zeta, self.delta);
+        let (z, dl) = (self.zeta, self.delta);
         let stiff = 1.0 - om * om;
         k[0] = stiff;
         k[1] = -2.0 * z * om;
@@ -275,6 +277,42 @@ impl Dynamics for Planar {
                 + 2.0 * om * (-s * v[0] + cs * v[1])
                 + om * om * (q[0] * cs + q[1] * s);
         }
+    }
+}
+
+fn indexed(name: &str, base: &str) -> Option<usize> {
+    let rest = name
+        .strip_prefix(base)?
+        .strip_prefix('[')?
+        .strip_suffix(']')?;
+    rest.parse().ok()
+}
+
+impl Dynamics for Planar {
+    fn ndof(&self) -> usize {
+        self.eta.len() + 2
+    }
+
+    fn residual(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+        self.forces(q, v, out);
+        self.add_inertia(q, a, out);
+    }
+
+    fn jacobians(
+        &self,
+        _t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        self.jacobians_at(self.omega_s, q, v, a, k, c, m);
+    }
+
+    fn base_spin(&self) -> f64 {
+        self.omega_s
     }
 
     fn solve_mass(&self, _t: f64, q: &[f64], rhs: &mut [f64]) {

@@ -6,7 +6,7 @@
 use crate::equilibria::wrap;
 use crate::floquet::{floquet, hill_multipliers, judge, Floquet, FloquetOptions, Stability};
 use crate::hb::{fit_coefficients, solve, HbOptions, HbSolution, Status};
-use crate::model::{first_order_rhs, Dynamics, Planar};
+use crate::model::{first_order_rhs, Dynamics};
 use crate::ode::{solve_at, Dopri5, Options};
 use std::f64::consts::PI;
 
@@ -57,8 +57,8 @@ impl Default for GuessOptions {
 
 /// Deterministic initial states: at rest in the ground frame (`b_i' = -Omega`, the
 /// thesis' basin set-up) from merged, opposed and spread ball positions.
-pub fn initial_states(p: &Planar) -> Vec<Vec<f64>> {
-    let n = p.n_balls();
+pub fn initial_states<D: Dynamics + ?Sized>(p: &D) -> Vec<Vec<f64>> {
+    let n = p.ndof() - 2;
     let d = n + 2;
     let mut configs: Vec<Vec<f64>> = vec![
         vec![0.0; n],
@@ -80,7 +80,7 @@ pub fn initial_states(p: &Planar) -> Vec<Vec<f64>> {
     ];
     configs.dedup();
     let mut out = vec![];
-    for rate in [-p.omega_s, 0.0] {
+    for rate in [-p.base_spin(), 0.0] {
         for b in &configs {
             let mut y = vec![0.0; 2 * d];
             for i in 0..n {
@@ -325,10 +325,19 @@ impl Periodic {
     }
 }
 
+/// `Ok` for an autonomous model; otherwise the error naming the effect that makes it
+/// time dependent (harmonic balance, Floquet theory and equilibria need autonomy).
+pub fn require_autonomous<D: Dynamics + ?Sized>(model: &D) -> crate::Result<()> {
+    match model.time_dependence() {
+        None => Ok(()),
+        Some(effect) => Err(crate::Error::NotAutonomous { effect }),
+    }
+}
+
 /// Solves from `guess`, or from a simulated guess of the requested pattern, and runs
 /// the Floquet analysis on a converged solution.
-pub fn periodic(
-    p: &Planar,
+pub fn periodic<D: Dynamics + ?Sized>(
+    p: &D,
     rotating: &[bool],
     guess: Option<&HbSolution>,
     opts: &PeriodicOptions,
@@ -357,7 +366,7 @@ pub fn periodic(
     finish(p, sol, opts)
 }
 
-pub fn finish(p: &Planar, sol: HbSolution, opts: &PeriodicOptions) -> Periodic {
+pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptions) -> Periodic {
     let converged = sol.status == Status::Converged;
     let mut sol = sol;
     let mut target_met = None;
@@ -431,7 +440,12 @@ fn next_n(n: usize, n_max: usize) -> usize {
 /// Raises the harmonics of a converged solution until its highest one is below the
 /// target relative to the motion (or `n_max` is reached, or a larger N fails to
 /// converge), each solve started from the last.
-pub fn refine(p: &Planar, sol: HbSolution, hb: &HbOptions, a: &AutoHarmonics) -> HbSolution {
+pub fn refine<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: HbSolution,
+    hb: &HbOptions,
+    a: &AutoHarmonics,
+) -> HbSolution {
     let mut sol = sol;
     while sol.status == Status::Converged && sol.tail_ratio() > a.target && sol.n_harm < a.n_max {
         let next = next_n(sol.n_harm, a.n_max);
@@ -453,7 +467,7 @@ pub fn refine(p: &Planar, sol: HbSolution, hb: &HbOptions, a: &AutoHarmonics) ->
 }
 
 /// Placeholder result for "no starting guess": no coefficients worth reading.
-pub fn no_guess(p: &Planar, rotating: &[bool], n_harm: usize) -> HbSolution {
+pub fn no_guess<D: Dynamics + ?Sized>(p: &D, rotating: &[bool], n_harm: usize) -> HbSolution {
     let d = p.ndof();
     let mut winding = vec![0.0; d];
     for (i, &r) in rotating.iter().enumerate() {
@@ -502,6 +516,7 @@ pub fn closure_error<D: Dynamics + ?Sized>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Planar;
 
     fn thesis(om: f64, eta: f64) -> Planar {
         Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap()

@@ -7,10 +7,11 @@ use ballbal_core::floquet::FloquetOptions;
 use ballbal_core::hb::{HbOptions, HbSolution, Status};
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{
-    closure_error, parse_pattern, pattern_string, periodic as core_periodic, PeriodicOptions,
+    closure_error, parse_pattern, pattern_string, periodic as core_periodic, require_autonomous,
+    PeriodicOptions,
 };
 use ballbal_core::simulate::simulate as core_simulate;
-use ballbal_core::{Dynamics, Error, Planar};
+use ballbal_core::{Dynamics, Error, Planar, Scene};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -56,6 +57,49 @@ fn planar(
     Planar::new(mu, zeta, &zeta_b, delta, omega, &eta).map_err(to_py)
 }
 
+/// Effects of a scene: `(springs, ramp (to, start, duration), gravity, impulse
+/// (amplitude, t0, sharpness, angle))`; `None` for the plain planar balancer.
+type Effects = Option<(
+    f64,
+    Option<(f64, f64, f64)>,
+    f64,
+    Option<(f64, f64, f64, f64)>,
+)>;
+
+fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
+    use ballbal_core::scene::{Impulse, Ramp};
+    let Some((springs, ramp, gravity, impulse)) = effects else {
+        return Ok(None);
+    };
+    Scene::new(
+        p.clone(),
+        springs,
+        ramp.map(|(to, start, duration)| Ramp {
+            to,
+            start,
+            duration,
+        }),
+        gravity,
+        impulse.map(|(amplitude, t0, sharpness, angle)| Impulse {
+            amplitude,
+            t0,
+            sharpness,
+            angle,
+        }),
+    )
+    .map(Some)
+    .map_err(to_py)
+}
+
+/// Analyses other than simulation need an autonomous scene.
+fn autonomous_scene(p: &Planar, effects: Effects, what: &str) -> PyResult<Option<Scene>> {
+    let s = scene(p, effects)?;
+    if let Some(sc) = &s {
+        require_autonomous(sc).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+    }
+    Ok(s)
+}
+
 fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]> {
     a.as_slice()
         .map_err(|_| PyValueError::new_err(format!("{name}: must be a contiguous float64 array")))
@@ -64,7 +108,7 @@ fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]
 /// Integrates from `y0` and returns `(y, accepted_steps, rejected_steps, rhs_evals)`,
 /// `y` of shape `(len(t_eval), 2 (n + 2))`.
 #[pyfunction]
-#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, y0, t0, t_eval, rtol, atol))]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, y0, t0, t_eval, rtol, atol, effects=None))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -79,8 +123,10 @@ fn simulate<'py>(
     t_eval: PyReadonlyArray1<'py, f64>,
     rtol: f64,
     atol: Vec<f64>,
+    effects: Effects,
 ) -> PyResult<(Bound<'py, PyAny>, usize, usize, usize)> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let sc = scene(&p, effects)?;
     let y0 = slice(&y0, "y0")?.to_vec();
     let te = slice(&t_eval, "t_eval")?.to_vec();
     let opts = Options {
@@ -88,7 +134,10 @@ fn simulate<'py>(
         atol,
         ..Default::default()
     };
-    let traj = guarded(py, || core_simulate(&p, &y0, t0, &te, &opts))?;
+    let traj = guarded(py, || match &sc {
+        None => core_simulate(&p, &y0, t0, &te, &opts),
+        Some(sc) => core_simulate(sc, &y0, t0, &te, &opts),
+    })?;
     let cols = y0.len();
     let flat: Vec<f64> = traj.y.into_iter().flatten().collect();
     let arr = PyArray1::from_vec(py, flat).reshape([te.len(), cols])?;
@@ -102,6 +151,8 @@ fn simulate<'py>(
 
 /// All equilibria with their stability, as a list of dicts.
 #[pyfunction]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, effects=None))]
+#[allow(clippy::too_many_arguments)]
 fn equilibria<'py>(
     py: Python<'py>,
     mu: f64,
@@ -110,8 +161,15 @@ fn equilibria<'py>(
     delta: f64,
     omega: f64,
     eta: Vec<f64>,
+    effects: Effects,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    if autonomous_scene(&p, effects, "equilibria")?.is_some() {
+        return Err(PyValueError::new_err(
+            "springs: equilibria of scenes with ball springs are not available yet \
+             (time simulation and periodic solutions are)",
+        ));
+    }
     let eqs = guarded(py, || Ok(core_equilibria(&p)))?;
     let mut out = vec![];
     for e in eqs {
@@ -280,7 +338,7 @@ fn periodic_options(
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, pattern, n_harm, samples, tol, step_tol, max_iter,
                     guess_omega, guess_coeffs, floquet, f_rtol, f_atol, margin, max_steps, settle,
-                    window, guess_rtol, auto, n_max, hill))]
+                    window, guess_rtol, auto, n_max, hill, effects=None))]
 #[allow(clippy::too_many_arguments)]
 fn periodic<'py>(
     py: Python<'py>,
@@ -309,8 +367,10 @@ fn periodic<'py>(
     auto: Option<f64>,
     n_max: usize,
     hill: bool,
+    effects: Effects,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let sc = autonomous_scene(&p, effects, "periodic")?;
     let rotating = parse_pattern(pattern, p.n_balls()).map_err(to_py)?;
     let opts = periodic_options(
         n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, max_steps,
@@ -346,14 +406,18 @@ fn periodic<'py>(
         }
     };
     let r = guarded(py, || {
-        Ok(core_periodic(&p, &rotating, guess.as_ref(), &opts))
+        Ok(match &sc {
+            None => core_periodic(&p, &rotating, guess.as_ref(), &opts),
+            Some(sc) => core_periodic(sc, &rotating, guess.as_ref(), &opts),
+        })
     })?;
     solution_dict(py, r)
 }
 
 /// The "NI" check: max distance after one simulated period from the orbit's own state.
 #[pyfunction]
-#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, sol_omega, coeffs, winding, rtol, atol))]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, sol_omega, coeffs, winding, rtol, atol,
+                    effects=None))]
 #[allow(clippy::too_many_arguments)]
 fn orbit_closure(
     py: Python<'_>,
@@ -368,8 +432,10 @@ fn orbit_closure(
     winding: Vec<f64>,
     rtol: f64,
     atol: f64,
+    effects: Effects,
 ) -> PyResult<f64> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let sc = scene(&p, effects)?;
     let c = slice(&coeffs, "coeffs")?.to_vec();
     let d = winding.len();
     if d == 0 || c.len() % d != 0 || (c.len() / d) % 2 != 1 {
@@ -379,7 +445,10 @@ fn orbit_closure(
     }
     let n_harm = (c.len() / d - 1) / 2;
     let sol = HbSolution::start(sol_omega, c, winding, n_harm, Status::Converged);
-    guarded(py, || closure_error(&p, &sol, rtol, atol))
+    guarded(py, || match &sc {
+        None => closure_error(&p, &sol, rtol, atol),
+        Some(sc) => closure_error(sc, &sol, rtol, atol),
+    })
 }
 
 /// Parallel scan of a parameter grid, chunk by chunk. `on_chunk(index, columns)` is

@@ -1,0 +1,243 @@
+"""Scenes: each effect checked against a formulation written here independently (the
+Lagrangian in ground-fixed coordinates), against limits, and for clear errors."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.integrate import solve_ivp
+
+import ballbal
+from ballbal.scene import scene_from_dict
+
+from reference import jacobi_integral
+
+
+def ground_rhs(scene, t, s):
+    """Equations of motion in the ground frame: rotor centre (X, Y), absolute ball angles
+    phi_i, disk angle theta(t) prescribed. From T = sum of m |v|^2 / 2 over rotor, the
+    eccentric disk and the balls; V = support spring + gravity + ball springs; track
+    damping on phi_i' - theta', support damping on (X', Y')."""
+    b = scene.balancer
+    n = b.n_balls
+    eta = np.asarray(b.eta)
+    zb = np.broadcast_to(np.asarray(b.zeta_b, dtype=float), (n,))
+    mu, dl, z, g = b.mu, b.delta, b.zeta, scene.gravity
+    fb = mu * eta / dl
+    X, Y, phi = s[0], s[1], s[2 : 2 + n]
+    dX, dY, dphi = s[n + 2], s[n + 3], s[n + 4 :]
+    # spin profile, written out again here
+    w0, dw, th = b.Omega, 0.0, b.Omega * t
+    if scene.ramp is not None:
+        r = scene.ramp
+        rate = (r.to - w0) / r.duration
+        if r.start <= t < r.start + r.duration:
+            u = t - r.start
+            w0, dw, th = w0 + rate * u, rate, b.Omega * t + 0.5 * rate * u * u
+        elif t >= r.start + r.duration:
+            end = r.start + r.duration
+            th = b.Omega * end + 0.5 * rate * r.duration**2 + r.to * (t - end)
+            w0 = r.to
+    fx = fy = 0.0
+    if scene.impulse is not None:
+        f = scene.impulse
+        amp = f.amplitude * math.exp(-f.sharpness * (t - f.t0) ** 2)
+        fx, fy = amp * math.cos(f.angle), amp * math.sin(f.angle)
+    S, C = np.sin(phi), np.cos(phi)
+    M = np.eye(n + 2)
+    M[0, 2:] = M[2:, 0] = -fb * dl * S
+    M[1, 2:] = M[2:, 1] = fb * dl * C
+    M[2:, 2:] = np.diag(fb * dl**2)
+    rhs = np.empty(n + 2)
+    rhs[0] = (fx - 2 * z * dX - X + mu * (math.sin(th) * dw + math.cos(th) * w0**2)
+              + np.sum(fb * dl * C * dphi**2))
+    rhs[1] = (fy - 2 * z * dY - Y - g - mu * (math.cos(th) * dw - math.sin(th) * w0**2)
+              + np.sum(fb * dl * S * dphi**2))
+    # ball springs: V = k dl^2 / 2 sum (phi_{j+1} - phi_j - 2 pi / n)^2, ring closed
+    dv = np.zeros(n)
+    if scene.springs:
+        kd = scene.springs * dl**2
+        for j in range(n):
+            nxt = (j + 1) % n
+            sj = phi[nxt] - phi[j] - 2 * math.pi / n + (2 * math.pi if nxt == 0 else 0.0)
+            dv[j] -= kd * sj
+            dv[nxt] += kd * sj
+    rhs[2:] = -2 * zb * mu * eta * dl * (dphi - w0) - g * fb * dl * C - dv
+    return np.concatenate([s[n + 2 :], np.linalg.solve(M, rhs)])
+
+
+def to_ground(scene, t, df):
+    n = scene.n_balls
+    th = scene.theta(t)
+    x, y = df["x"].to_numpy(), df["y"].to_numpy()
+    X = np.cos(th) * x - np.sin(th) * y
+    Y = np.sin(th) * x + np.cos(th) * y
+    phi = np.stack([th + df[f"b{i + 1}"].to_numpy() for i in range(n)])
+    return X, Y, phi
+
+
+FULL = ballbal.Scene(
+    balancer=ballbal.Balancer(mu=0.25, zeta=0.03, zeta_b=(0.04, 0.05, 0.03), delta=20.0,
+                              Omega=1.2, eta=(0.9, 1.1, 0.7)),
+    springs=2e-3, ramp=ballbal.Ramp(to=1.8, start=5.0, duration=20.0), gravity=0.05,
+    impulse=ballbal.Impulse(amplitude=0.5, t0=12.0, sharpness=2.0, angle=0.7),
+)
+
+
+def test_every_effect_against_the_ground_frame_lagrangian():
+    sc = FULL
+    n = sc.n_balls
+    y0 = np.array([0.2, -0.1, 0.3, 2.0, 4.5, 0.05, 0.1, -0.2, 0.1, 0.3])
+    t = np.linspace(0.0, 40.0, 81)
+    df = ballbal.simulate(sc, y0, t, rtol=1e-11, atol=1e-13)
+    X, Y, phi = to_ground(sc, t, df)
+    # the same initial state in ground coordinates (Omega(0) = 1.2, theta(0) = 0)
+    w = sc.Omega
+    g0 = np.concatenate([[y0[0], y0[1]], y0[2 : 2 + n],
+                         [y0[n + 2] - w * y0[1], y0[n + 3] + w * y0[0]], w + y0[n + 4 :]])
+    ref = solve_ivp(lambda tt, s: ground_rhs(sc, tt, s), (0, 40), g0, t_eval=t,
+                    rtol=1e-11, atol=1e-13, method="DOP853", max_step=0.05)
+    assert ref.success
+    assert np.max(np.abs(X - ref.y[0])) < 1e-7
+    assert np.max(np.abs(Y - ref.y[1])) < 1e-7
+    assert np.max(np.abs(phi - ref.y[2 : 2 + n])) < 1e-7
+    # and the effects do something: without them the motion differs
+    plain = ballbal.simulate(sc.balancer, y0, t, rtol=1e-11, atol=1e-13)
+    assert np.max(np.abs(plain["x"].to_numpy() - df["x"].to_numpy())) > 1e-2
+
+
+@pytest.mark.parametrize("effect", ["springs", "ramp", "gravity", "impulse"])
+def test_each_effect_alone_against_the_ground_frame(effect):
+    kw = {"springs": 0.0, "ramp": None, "gravity": 0.0, "impulse": None}
+    kw[effect] = getattr(FULL, effect)
+    sc = ballbal.Scene(balancer=FULL.balancer, **kw)
+    n = sc.n_balls
+    y0 = np.array([0.1, 0.1, 0.0, 2.1, 4.2, 0.0, 0.0, -1.2, -1.2, -1.2])
+    t = np.linspace(0.0, 30.0, 31)
+    df = ballbal.simulate(sc, y0, t, rtol=1e-11, atol=1e-13)
+    X, Y, phi = to_ground(sc, t, df)
+    w = sc.Omega
+    g0 = np.concatenate([[y0[0], y0[1]], y0[2 : 2 + n],
+                         [y0[n + 2] - w * y0[1], y0[n + 3] + w * y0[0]], w + y0[n + 4 :]])
+    ref = solve_ivp(lambda tt, s: ground_rhs(sc, tt, s), (0, 30), g0, t_eval=t,
+                    rtol=1e-11, atol=1e-13, method="DOP853", max_step=0.05)
+    assert max(np.max(np.abs(X - ref.y[0])), np.max(np.abs(Y - ref.y[1])),
+               np.max(np.abs(phi - ref.y[2 : 2 + n]))) < 1e-7
+
+
+def test_effects_at_zero_equal_the_planar_model():
+    b = FULL.balancer
+    off = ballbal.Scene(balancer=b, ramp=ballbal.Ramp(to=b.Omega, start=0.0, duration=3.0),
+                        impulse=ballbal.Impulse(amplitude=0.0, t0=1.0, sharpness=1.0))
+    assert off.native_effects() is not None  # the scene path really runs
+    t = np.linspace(0, 50, 101)
+    a = ballbal.simulate(b, t_span=(0, 50))
+    c = ballbal.simulate(off, t_span=(0, 50))
+    assert np.max(np.abs(a.drop("t").to_numpy() - c.drop("t").to_numpy())) < 1e-12
+    assert t.size == 101
+
+
+def test_spring_potential_joins_the_jacobi_integral():
+    """Undamped, constant spin: T2 - T0 + V_support + V_springs is conserved; without the
+    spring term it is not (so the spring force is the gradient of that potential)."""
+    b = ballbal.Balancer(mu=0.3, zeta=0.0, zeta_b=0.0, delta=20, Omega=1.4, eta=(0.8, 1.2, 0.5))
+    k = 3e-3
+    sc = ballbal.Scene(balancer=b, springs=k)
+    y0 = np.array([0.2, -0.1, 0.0, 2.0, 4.0, 0.05, 0.1, -0.3, 0.2, 0.1])
+    t = np.linspace(0, 200, 401)
+    s = ballbal.simulate(sc, y0, t, rtol=1e-10, atol=1e-12).drop(["t", "X", "Y"]).to_numpy()
+    beta = s[:, 2:5]
+    sp = np.stack([beta[:, 1] - beta[:, 0], beta[:, 2] - beta[:, 1],
+                   beta[:, 0] + 2 * np.pi - beta[:, 2]], axis=1) - 2 * np.pi / 3
+    v_springs = 0.5 * k * b.delta**2 * np.sum(sp**2, axis=1)
+    h = jacobi_integral(b, s) + v_springs
+    assert np.max(np.abs(h - h[0])) < 1e-7
+    h_wrong = jacobi_integral(b, s)
+    assert np.max(np.abs(h_wrong - h_wrong[0])) > 1e-3
+
+
+def test_periodic_solution_with_springs_is_a_real_orbit():
+    base = ballbal.periodic(ballbal.Balancer(), "R-R", N=8)
+    s = ballbal.periodic(ballbal.Scene(springs=1e-5), "R-R", N=12, guess=base)
+    assert s.converged and abs(s.omega - base.omega) > 1e-3  # the springs matter
+    assert s.verify() < 1e-6  # time simulation of the same scene closes the orbit
+    assert not s.verdicts_disagree and s.stability == s.hill_stability
+
+
+@pytest.mark.parametrize(("kw", "effect"), [
+    ({"ramp": ballbal.Ramp(to=2.0)}, "ramp"), ({"gravity": 0.1}, "gravity"),
+    ({"impulse": ballbal.Impulse(amplitude=1.0, t0=1.0, sharpness=1.0)}, "impulse"),
+])
+def test_time_dependent_scenes_refuse_harmonic_balance(kw, effect):
+    sc = ballbal.Scene(**kw)
+    assert sc.time_dependence == effect
+    with pytest.raises(ValueError, match=f"^periodic: .*'{effect}'"):
+        ballbal.periodic(sc, "R-R")
+    with pytest.raises(ValueError, match=f"^equilibria: .*'{effect}'"):
+        ballbal.equilibria(sc)
+    with pytest.raises(ValueError, match="^scene: scans of scenes with effects"):
+        ballbal.scan(sc, Omega=[1.2], eta=[1.0])
+    ballbal.simulate(sc, t_span=(0, 5))  # simulation always works
+
+
+def test_scene_without_effects_is_the_balancer():
+    sc = ballbal.Scene(balancer=ballbal.Balancer(Omega=1.3))
+    a = ballbal.scan(sc, Omega=[1.2], eta=[1.0])
+    b = ballbal.scan(sc.balancer, Omega=[1.2], eta=[1.0])
+    assert a.drop("seconds").equals(b.drop("seconds"))
+    with pytest.raises(ValueError, match="^springs: equilibria"):
+        ballbal.equilibria(ballbal.Scene(springs=1e-3))
+
+
+def test_scene_files_round_trip(tmp_path):
+    p = tmp_path / "full.toml"
+    FULL.save(p)
+    assert ballbal.load_scene(p) == FULL
+    flat = tmp_path / "flat.toml"
+    flat.write_text("mu = 0.2\nOmega = 1.3\neta = 0.9\nballs = 3\n")
+    sc = ballbal.load_scene(flat)
+    assert sc.balancer.eta == (0.9, 0.9, 0.9) and sc.native_effects() is None
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("mu = 0.2\nzetta = 0.1\n", "unknown key"),
+    ("[balancer]\nmu = 0.2\n[spring]\nstiffness = 1.0\n", "unknown table"),
+    ("[balancer]\nmu = 0.2\n[springs]\nk = 1.0\n", "springs: unknown key"),
+    ("[balancer]\nmu = 0.2\n[ramp]\nstart = 1.0\n", "incomplete"),
+    ("[balancer]\nmu = 0.2\n[ramp]\nto = 2.0\nduration = 0.0\n", "ramp.duration"),
+    ("[balancer]\nmu = 2.0\n", "mu"),
+    ("mu = 'x'\n", "mu"),
+    ("[balancer]\nmu = 0.2\n[gravity]\ng = -1.0\n", "gravity"),
+    ("[balancer]\neta = [1.0]\n[springs]\nstiffness = 0.1\n", "springs"),
+    ("mu = 0.2\n[balancer]\nzeta = 0.1\n", "outside a table"),
+    ("mu = = 1\n", "not valid TOML"),
+])
+def test_malformed_scene_files_say_what_is_wrong(tmp_path, text, message):
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        ballbal.load_scene(p)
+
+
+values = st.one_of(st.floats(allow_nan=True), st.integers(-3, 3), st.text(max_size=3),
+                   st.booleans(), st.lists(st.floats(0.1, 2.0), max_size=3))
+keys = st.sampled_from(["mu", "zeta", "zeta_b", "delta", "Omega", "eta", "balls", "k", "x"])
+tables = st.sampled_from(["springs", "ramp", "gravity", "impulse", "balancer", "bearing"])
+inner = st.dictionaries(st.sampled_from(["stiffness", "to", "start", "duration", "g",
+                                         "amplitude", "t0", "sharpness", "angle", "mu", "q"]),
+                        values, max_size=4)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.dictionaries(keys, values, max_size=6), st.dictionaries(tables, inner, max_size=3))
+def test_random_scene_dictionaries_give_a_scene_or_a_clear_error(flat, tabs):
+    d = {**flat, **tabs}
+    try:
+        sc = scene_from_dict(d)
+    except ValueError as e:
+        assert str(e) and ":" in str(e)
+        return
+    assert isinstance(sc, ballbal.Scene)
+    assert scene_from_dict(sc.to_dict()) == sc
