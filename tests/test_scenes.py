@@ -4,6 +4,7 @@ Lagrangian in ground-fixed coordinates), against limits, and for clear errors.""
 import math
 
 import numpy as np
+import polars as pl
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -241,3 +242,33 @@ def test_random_scene_dictionaries_give_a_scene_or_a_clear_error(flat, tabs):
         return
     assert isinstance(sc, ballbal.Scene)
     assert scene_from_dict(sc.to_dict()) == sc
+
+
+def test_speed_disturbance_ends_in_the_closed_form_perfect_balance():
+    b = ballbal.Balancer(Omega=2.0, zeta=0.05, zeta_b=0.1, eta=(0.8, 0.8))
+    res = ballbal.disturbance_response(b, to=2.5, t_end=1500)
+    assert res.final_r < 1e-6 and res.settle_time is not None
+    end = res.trajectory.row(-1, named=True)
+    angle = math.acos(-1 / (2 * 0.8))  # perfect balance, closed form
+    got = sorted(abs(math.remainder(end[k], 2 * math.pi)) for k in ("b1", "b2"))
+    assert np.allclose(got, angle, atol=1e-6)
+    assert res.peak > 10 * 0.01  # the disturbance really throws the rotor out
+
+
+def test_track_damping_trade_off_of_seed_001():
+    """More track damping: a smaller peak; past a point, a longer settling; the combined
+    index has an interior optimum."""
+    b = ballbal.Balancer(Omega=2.0, zeta=0.05, eta=(1.0, 1.0))
+    zb = [0.01, 0.05, 0.1, 0.2, 0.4, 0.8]
+    df = ballbal.track_damping_study(b, zb, to=2.5, t_end=2000)
+    peak = df["peak"].to_list()
+    settle = df["settle_time"].to_list()
+    assert all(p1 > p2 for p1, p2 in zip(peak, peak[1:], strict=False)), peak
+    assert settle[5] > settle[4] > settle[2] and settle[0] > settle[2], settle
+    best = df.filter(pl.col("optimal"))["zeta_b"][0]
+    assert zb[0] < best < zb[-1], df
+
+
+def test_disturbance_needs_a_stable_perfect_balance():
+    with pytest.raises(ValueError, match="^balancer: the perfect balance"):
+        ballbal.disturbance_response(ballbal.Balancer(Omega=1.2), to=1.5)

@@ -12,9 +12,11 @@ from .analysis import (
 from .model import Balancer, from_seed003, zeta_from_log_decrement
 from .scan import ScanInterrupted, read_scan, scan, scan_meta
 from .scene import Impulse, Ramp, Scene, load_scene
+from .transient import DisturbanceResponse, disturbance_response, track_damping_study
 
 __all__ = [
     "Balancer",
+    "DisturbanceResponse",
     "Equilibrium",
     "Impulse",
     "ScanInterrupted",
@@ -23,6 +25,7 @@ __all__ = [
     "Scene",
     "__version__",
     "accuracy_cost",
+    "disturbance_response",
     "equilibria",
     "from_seed003",
     "load_scene",
@@ -32,5 +35,6 @@ __all__ = [
     "scan",
     "scan_meta",
     "simulate",
+    "track_damping_study",
     "zeta_from_log_decrement",
 ]
