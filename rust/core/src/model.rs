@@ -136,19 +136,19 @@ impl Planar {
     }
 
     /// Ball mass parameter `m_i = mu eta_i`.
-    #[inline]
+    #[inline(always)]
     pub fn m(&self, i: usize) -> f64 {
         self.mu * self.eta[i]
     }
 
     /// `g(q, v) = F(q, v, 0)`: everything but the inertia terms.
-    #[inline]
+    #[inline(always)]
     pub fn forces(&self, q: &[f64], v: &[f64], out: &mut [f64]) {
         self.forces_at(self.omega_s, q, v, out);
     }
 
     /// [`Self::forces`] at spin `om` (a scene's spin may vary in time).
-    #[inline]
+    #[inline(always)]
     pub fn forces_at(&self, om: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
         let (z, dl) = (self.zeta, self.delta);
         let (x, y, vx, vy) = (q[0], q[1], v[0], v[1]);
@@ -205,7 +205,7 @@ impl Planar {
     }
 
     /// Adds the inertia terms `M(q) a` to `out`.
-    #[inline]
+    #[inline(always)]
     pub fn add_inertia(&self, q: &[f64], a: &[f64], out: &mut [f64]) {
         let (ax, ay) = (a[0], a[1]);
         for i in 0..self.n_balls() {
@@ -222,7 +222,7 @@ impl Planar {
 
     /// [`Dynamics::jacobians`] at spin `om`.
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     pub fn jacobians_at(
         &self,
         om: f64,
