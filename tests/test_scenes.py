@@ -272,3 +272,4 @@ def test_track_damping_trade_off_of_seed_001():
 def test_disturbance_needs_a_stable_perfect_balance():
     with pytest.raises(ValueError, match="^balancer: the perfect balance"):
         ballbal.disturbance_response(ballbal.Balancer(Omega=1.2), to=1.5)
+

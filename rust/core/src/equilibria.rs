@@ -64,13 +64,24 @@ pub fn wrap(a: f64) -> f64 {
     r
 }
 
-fn static_residual(p: &Planar, q: &[f64], out: &mut [f64]) {
+fn static_residual<D: Dynamics + ?Sized>(p: &D, q: &[f64], out: &mut [f64]) {
     let z = vec![0.0; q.len()];
     p.residual(0.0, q, &z, &z, out);
 }
 
-/// Analyse a point known (or claimed) to be an equilibrium.
+/// Analyse a point known (or claimed) to be an equilibrium of the planar balancer.
 pub fn analyse(p: &Planar, q: &[f64], kind: &str) -> Equilibrium {
+    analyse_model(p, q, kind, true)
+}
+
+/// [`analyse`] for any model; `family` says whether a perfect balance of three or more
+/// balls is a family of equilibria (true for free balls, not when springs tie them).
+pub fn analyse_model<D: Dynamics + ?Sized>(
+    p: &D,
+    q: &[f64],
+    kind: &str,
+    family: bool,
+) -> Equilibrium {
     let d = p.ndof();
     let z = vec![0.0; d];
     let mut r = vec![0.0; d];
@@ -84,8 +95,9 @@ pub fn analyse(p: &Planar, q: &[f64], kind: &str) -> Equilibrium {
     let ev = eigenvalues(&a, 2 * d).unwrap_or_default();
     // A perfect balance with n >= 3 balls is an (n-2)-parameter family: those
     // directions have zero eigenvalues and say nothing about attraction.
-    let neutral = if kind == "perfect_balance" && p.n_balls() >= 3 {
-        p.n_balls() - 2
+    let n_balls = d - 2;
+    let neutral = if family && kind == "perfect_balance" && n_balls >= 3 {
+        n_balls - 2
     } else {
         0
     };
@@ -128,11 +140,12 @@ fn equal_balls(p: &Planar) -> bool {
     p.eta.windows(2).all(|w| w[0] == w[1])
 }
 
-fn classify(p: &Planar, q: &[f64]) -> &'static str {
-    if q[0].hypot(q[1]) < 1e-9 {
+fn classify(q: &[f64]) -> &'static str {
+    // Newton's points (as opposed to closed forms) carry its tolerance.
+    if q[0].hypot(q[1]) < 1e-6 {
         return "perfect_balance";
     }
-    if p.n_balls() == 2 {
+    if q.len() == 4 {
         let diff = wrap(q[2] - q[3]);
         if diff.abs() < 1e-7 {
             return "together";
@@ -191,7 +204,7 @@ fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, &'static str)> {
 }
 
 /// Newton (least squares, so that families of equilibria do not stall it) on `F(q,0,0) = 0`.
-fn newton_static(p: &Planar, q0: &[f64]) -> Option<Vec<f64>> {
+fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>> {
     let d = p.ndof();
     let z = vec![0.0; d];
     let mut q = q0.to_vec();
@@ -221,22 +234,24 @@ fn newton_static(p: &Planar, q0: &[f64]) -> Option<Vec<f64>> {
     (rn < 1e-10).then_some(q)
 }
 
-fn same_equilibrium(p: &Planar, a: &[f64], b: &[f64]) -> bool {
-    if (a[0] - b[0]).abs() > 1e-7 || (a[1] - b[1]).abs() > 1e-7 {
+fn same_equilibrium(equal: bool, a: &[f64], b: &[f64]) -> bool {
+    // Newton's points near a nearly degenerate equilibrium (weak springs) scatter by more
+    // than its residual suggests: compare at that accuracy.
+    if (a[0] - b[0]).abs() > 1e-5 || (a[1] - b[1]).abs() > 1e-5 {
         return false;
     }
-    let n = p.n_balls();
-    let direct = (0..n).all(|i| wrap(a[2 + i] - b[2 + i]).abs() < 1e-6);
+    let n = a.len() - 2;
+    let direct = (0..n).all(|i| wrap(a[2 + i] - b[2 + i]).abs() < 1e-4);
     if direct {
         return true;
     }
-    if equal_balls(p) {
+    if equal {
         // Identical balls: the same physical state up to relabelling.
         let mut sa: Vec<f64> = a[2..].iter().map(|&v| wrap(v)).collect();
         let mut sb: Vec<f64> = b[2..].iter().map(|&v| wrap(v)).collect();
         sa.sort_by(f64::total_cmp);
         sb.sort_by(f64::total_cmp);
-        return sa.iter().zip(&sb).all(|(u, v)| wrap(u - v).abs() < 1e-6);
+        return sa.iter().zip(&sb).all(|(u, v)| wrap(u - v).abs() < 1e-4);
     }
     false
 }
@@ -245,21 +260,37 @@ fn same_equilibrium(p: &Planar, a: &[f64], b: &[f64]) -> bool {
 /// balls; otherwise Newton from a deterministic set of starts.
 pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
     let n = p.n_balls();
-    let mut found: Vec<(Vec<f64>, String)> = vec![];
     if n == 2 && equal_balls(p) && p.zeta > 0.0 {
-        for (q, kind) in closed_form_two_equal(p) {
-            found.push((q, kind.to_string()));
-        }
-    } else {
-        for q0 in starts(p) {
-            if let Some(q) = newton_static(p, &q0) {
-                if !found.iter().any(|(f, _)| same_equilibrium(p, f, &q)) {
-                    let kind = classify(p, &q).to_string();
-                    found.push((q, kind));
-                }
+        let found = closed_form_two_equal(p)
+            .into_iter()
+            .map(|(q, kind)| (q, kind.to_string()))
+            .collect();
+        return sorted_analysed(p, found, true);
+    }
+    equilibria_of(p, equal_balls(p), true)
+}
+
+/// All equilibria of any autonomous model, by Newton from a deterministic set of starts.
+/// `equal`: the balls are identical (states that differ by relabelling are one);
+/// `family`: see [`analyse_model`].
+pub fn equilibria_of<D: Dynamics + ?Sized>(p: &D, equal: bool, family: bool) -> Vec<Equilibrium> {
+    let mut found: Vec<(Vec<f64>, String)> = vec![];
+    for q0 in starts(p.ndof() - 2) {
+        if let Some(q) = newton_static(p, &q0) {
+            if !found.iter().any(|(f, _)| same_equilibrium(equal, f, &q)) {
+                let kind = classify(&q).to_string();
+                found.push((q, kind));
             }
         }
     }
+    sorted_analysed(p, found, family)
+}
+
+fn sorted_analysed<D: Dynamics + ?Sized>(
+    p: &D,
+    mut found: Vec<(Vec<f64>, String)>,
+    family: bool,
+) -> Vec<Equilibrium> {
     let order = |k: &str| match k {
         "perfect_balance" => 0,
         "together" => 1,
@@ -271,11 +302,13 @@ pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
             .cmp(&order(&b.1))
             .then(a.0[0].total_cmp(&b.0[0]))
     });
-    found.iter().map(|(q, k)| analyse(p, q, k)).collect()
+    found
+        .iter()
+        .map(|(q, k)| analyse_model(p, q, k, family))
+        .collect()
 }
 
-fn starts(p: &Planar) -> Vec<Vec<f64>> {
-    let n = p.n_balls();
+fn starts(n: usize) -> Vec<Vec<f64>> {
     let per = match n {
         1 => 24,
         2 => 12,

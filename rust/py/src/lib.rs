@@ -165,6 +165,9 @@ fn equilibria<'py>(
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     if autonomous_scene(&p, effects, "equilibria")?.is_some() {
+        // Newton finds them (equilibria_of), but with springs angles that differ by whole
+        // turns are different spring windings, many of them balls passing each other:
+        // that needs ordered starts and a winding-aware identity first.
         return Err(PyValueError::new_err(
             "springs: equilibria of scenes with ball springs are not available yet \
              (time simulation and periodic solutions are)",
