@@ -87,34 +87,17 @@ impl Scene {
         }
         check_range("gravity", gravity, 0.0, false, f64::INFINITY, true)?;
         if let Some(f) = &impulse {
-            check_range(
-                "impulse.amplitude",
-                f.amplitude,
-                f64::NEG_INFINITY,
-                true,
-                f64::INFINITY,
-                true,
-            )?;
-            check_range(
-                "impulse.t0",
-                f.t0,
-                f64::NEG_INFINITY,
-                true,
-                f64::INFINITY,
-                true,
-            )?;
+            for (name, v) in [
+                ("impulse.amplitude", f.amplitude),
+                ("impulse.t0", f.t0),
+                ("impulse.angle", f.angle),
+            ] {
+                check_range(name, v, f64::NEG_INFINITY, true, f64::INFINITY, true)?;
+            }
             check_range(
                 "impulse.sharpness",
                 f.sharpness,
                 0.0,
-                true,
-                f64::INFINITY,
-                true,
-            )?;
-            check_range(
-                "impulse.angle",
-                f.angle,
-                f64::NEG_INFINITY,
                 true,
                 f64::INFINITY,
                 true,
