@@ -179,14 +179,12 @@ pub fn floquet<D: Dynamics + ?Sized>(
     })?;
     ev.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
     let v = judge(&ev, opts.margin);
-    let (trivial, trivial_error, max_modulus, stability) =
-        (v.trivial, v.trivial_error, v.max_modulus, v.stability);
     Ok(Floquet {
         multipliers: ev,
-        trivial,
-        trivial_error,
-        max_modulus,
-        stability,
+        trivial: v.trivial,
+        trivial_error: v.trivial_error,
+        max_modulus: v.max_modulus,
+        stability: v.stability,
         steps,
         rhs_evals: evals,
     })

@@ -357,6 +357,11 @@ pub struct Dense<'a> {
 }
 
 impl Dense<'_> {
+    /// The state at the end of the step (no interpolation needed).
+    pub fn end(&self) -> &[f64] {
+        self.y_new
+    }
+
     pub fn eval(&self, t: f64, out: &mut [f64]) {
         let th = (t - self.t0) / self.h;
         let th1 = 1.0 - th;

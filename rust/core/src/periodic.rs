@@ -114,11 +114,9 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     // periodic motion cannot appear from rest in an autonomous system): stop there
     // rather than settle for the whole time.
     let mut at_rest = false;
-    let mut probe = vec![0.0; 2 * d];
     let (_, ys, _) = solver
         .integrate(rhs, 0.0, y0, g.settle, &opts, |_, tb, dense| {
-            dense.eval(tb, &mut probe);
-            at_rest = tb > 50.0 && probe[d..].iter().all(|v| v.abs() < 1e-7);
+            at_rest = tb > 50.0 && dense.end()[d..].iter().all(|v| v.abs() < 1e-7);
             !at_rest
         })
         .ok()?;
@@ -393,20 +391,13 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
                     target_met = Some(tail_ok && triv_ok);
                     break;
                 }
-                let next = next_n(sol.n_harm, a.n_max);
-                let s = solve(
-                    p,
-                    &sol,
-                    &HbOptions {
-                        n_harm: next,
-                        ..opts.hb.clone()
-                    },
-                );
-                if s.status != Status::Converged {
-                    target_met = Some(false);
-                    break;
+                match more_harmonics(p, &sol, &opts.hb, a) {
+                    Some(s) => sol = s,
+                    None => {
+                        target_met = Some(false);
+                        break;
+                    }
                 }
-                sol = s;
             }
         }
         _ => (fl, fl_err) = run_floquet(&sol),
@@ -433,8 +424,25 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
     }
 }
 
-fn next_n(n: usize, n_max: usize) -> usize {
-    (n + n.div_ceil(2)).clamp(n + 1, n_max.max(n + 1))
+/// The solution re-solved with half as many harmonics again (at most `n_max`), started
+/// from itself; `None` if that solve does not converge.
+fn more_harmonics<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: &HbSolution,
+    hb: &HbOptions,
+    a: &AutoHarmonics,
+) -> Option<HbSolution> {
+    let n = sol.n_harm;
+    let next = (n + n.div_ceil(2)).clamp(n + 1, a.n_max.max(n + 1));
+    let s = solve(
+        p,
+        sol,
+        &HbOptions {
+            n_harm: next,
+            ..hb.clone()
+        },
+    );
+    (s.status == Status::Converged).then_some(s)
 }
 
 /// Raises the harmonics of a converged solution until its highest one is below the
@@ -448,20 +456,11 @@ pub fn refine<D: Dynamics + ?Sized>(
 ) -> HbSolution {
     let mut sol = sol;
     while sol.status == Status::Converged && sol.tail_ratio() > a.target && sol.n_harm < a.n_max {
-        let next = next_n(sol.n_harm, a.n_max);
-        let s = solve(
-            p,
-            &sol,
-            &HbOptions {
-                n_harm: next,
-                ..hb.clone()
-            },
-        );
-        if s.status != Status::Converged {
+        match more_harmonics(p, &sol, hb, a) {
+            Some(s) => sol = s,
             // Keep the last converged solution; the caller sees the target unmet.
-            return sol;
+            None => return sol,
         }
-        sol = s;
     }
     sol
 }

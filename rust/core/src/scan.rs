@@ -22,7 +22,6 @@ use crate::equilibria::{equilibria, Verdict};
 use crate::error::{Error, Result};
 use crate::floquet::FloquetOptions;
 use crate::hb::{solve, HbSolution, Status};
-use crate::model::Dynamics;
 use crate::periodic::{finish, guess_from_state, initial_states, Periodic, PeriodicOptions};
 use crate::Planar;
 use rayon::prelude::*;
@@ -126,14 +125,11 @@ impl ScanSpec<'_> {
                 format!("must be a number > 0, got {}", self.max_tail),
             ));
         }
-        if self.starts > initial_states(self.base).len() {
+        let available = initial_states(self.base).len();
+        if self.starts > available {
             return Err(Error::param(
                 "starts",
-                format!(
-                    "must be in [1, {}], got {}",
-                    initial_states(self.base).len(),
-                    self.starts
-                ),
+                format!("must be in [1, {available}], got {}", self.starts),
             ));
         }
         Ok(())
@@ -367,7 +363,7 @@ fn scan_chunk(
     let mut attempts = vec![vec![0usize; np]; npts];
     let mut fail_secs = vec![vec![0.0f64; np]; npts];
     let n_harm = spec.opts.hb.n_harm;
-    let starts: Vec<Vec<f64>> = spread(initial_states(spec.base), spec.starts);
+    let starts = spread(initial_states(spec.base).len(), spec.starts);
     let half = starts.len().div_ceil(2);
     let mut tasks: Vec<(usize, usize)> = seeds
         .iter()
@@ -387,16 +383,9 @@ fn scan_chunk(
             }
             let t = Instant::now();
             let model = &params[p];
-            // The initial states are at rest in the ground frame for the base spin;
-            // keep them at rest for this point's spin.
-            let mut y0 = starts[s].clone();
-            let d = model.ndof();
-            for v in &mut y0[d + 2..] {
-                if *v != 0.0 {
-                    *v = -model.omega_s;
-                }
-            }
-            let g = guess_from_state(model, &y0, None, n_harm, &spec.opts.guess)?;
+            // This point's own states: "at rest in the ground frame" depends on its spin.
+            let y0 = &initial_states(model)[starts[s]];
+            let g = guess_from_state(model, y0, None, n_harm, &spec.opts.guess)?;
             let rot: Vec<bool> = g.winding[2..].iter().map(|w| *w != 0.0).collect();
             let k = spec.patterns.iter().position(|r| *r == rot)?;
             let sol = solve(model, &g, &spec.opts.hb);
@@ -421,7 +410,7 @@ fn scan_chunk(
     check()?;
     let mut frontier: Vec<(usize, usize)> = vec![];
     for (p, f) in seeded.into_iter().flatten() {
-        if admit(&sols[p], &f) {
+        if admit(&sols[p], f.pattern, &f.key) {
             sols[p].push(f);
             frontier.push((p, sols[p].len() - 1));
         }
@@ -481,23 +470,20 @@ fn scan_chunk(
                             continue;
                         };
                         let key = orbit_key(&sol);
-                        let dup = |f: &Found| f.pattern == k && same_orbit(&f.key, &key);
-                        if sols[q].iter().any(dup) || new.iter().any(dup) {
+                        // Before the Floquet analysis, which a known orbit does not need.
+                        if !admit(&sols[q], k, &key) || !admit(&new, k, &key) {
                             secs[k] += t.elapsed().as_secs_f64();
                             continue;
                         }
                         let res = finish(&params[q], sol, &spec.opts);
-                        let f = Found {
+                        new.push(Found {
                             pattern: k,
                             res,
                             origin: "continuation",
                             parent: Some((p, s)),
                             key,
                             seconds: t.elapsed().as_secs_f64(),
-                        };
-                        if admit(&sols[q], &f) && admit(&new, &f) {
-                            new.push(f);
-                        }
+                        });
                     }
                 }
                 (new, tries, secs)
@@ -511,7 +497,7 @@ fn scan_chunk(
                 fail_secs[q][k] += secs[k];
             }
             for f in new {
-                if admit(&sols[q], &f) {
+                if admit(&sols[q], f.pattern, &f.key) {
                     sols[q].push(f);
                     frontier.push((q, sols[q].len() - 1));
                 }
@@ -519,6 +505,10 @@ fn scan_chunk(
         }
     }
 
+    let mut seed_runs = vec![0usize; npts];
+    for &(p, _) in &tasks {
+        seed_runs[p] += 1;
+    }
     let mut rows = vec![];
     for p in 0..npts {
         let index = geo.index(p);
@@ -531,7 +521,7 @@ fn scan_chunk(
                 solution: None,
                 result: None,
                 origin: "none",
-                attempts: attempts[p][k] + tasks.iter().filter(|t| t.0 == p).count(),
+                attempts: attempts[p][k] + seed_runs[p],
                 seconds: fail_secs[p][k],
                 pb_exists: pb[p].0,
                 pb_stable: pb[p].1,
@@ -558,12 +548,12 @@ fn accept(s: &HbSolution, guess: &HbSolution, max_tail: f64) -> bool {
     s.status == Status::Converged && s.winding == guess.winding && s.tail_ratio() <= max_tail
 }
 
-/// Whether `f` is new among `have` and its type still has room.
-fn admit(have: &[Found], f: &Found) -> bool {
-    let same_type = have.iter().filter(|h| h.pattern == f.pattern);
+/// Whether an orbit of type `pattern` with `key` is new among `have`, and its type
+/// still has room there.
+fn admit(have: &[Found], pattern: usize, key: &[f64]) -> bool {
     let mut n = 0;
-    for h in same_type {
-        if same_orbit(&h.key, &f.key) {
+    for h in have.iter().filter(|h| h.pattern == pattern) {
+        if same_orbit(&h.key, key) {
             return false;
         }
         n += 1;
@@ -584,26 +574,11 @@ fn extrapolate(a: &HbSolution, b: &HbSolution) -> HbSolution {
     g
 }
 
-/// `k` of the initial states, spread over the list (which alternates configurations
-/// and starts at rest in the ground frame, then relative to the disk).
-fn spread(all: Vec<Vec<f64>>, k: usize) -> Vec<Vec<f64>> {
-    let n = all.len();
+/// Indices of `k` of the `n` initial states, spread over the list (which alternates
+/// configurations and starts at rest in the ground frame, then relative to the disk).
+fn spread(n: usize, k: usize) -> Vec<usize> {
     let k = k.min(n);
-    (0..k)
-        .map(|i| all[(i * n / k + i / 2) % n].clone())
-        .collect()
-}
-
-/// Simulation settings for seeds: a guess only has to land Newton in its basin, and the
-/// scan benchmark finds the same solutions on the thesis grid as with the single-point
-/// defaults (rtol 1e-9, settle 1500, window 2500) at a third of the cost.
-pub fn scan_guess_default() -> crate::periodic::GuessOptions {
-    crate::periodic::GuessOptions {
-        settle: 1000.0,
-        window: 2000.0,
-        rtol: 1e-5,
-        atol: 1e-8,
-    }
+    (0..k).map(|i| (i * n / k + i / 2) % n).collect()
 }
 
 /// Floquet tolerances suited to many points (see the periodic benchmark).

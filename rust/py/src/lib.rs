@@ -202,23 +202,21 @@ fn solution_dict<'py>(
     py: Python<'py>,
     r: ballbal_core::periodic::Periodic,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let disagree = r.verdicts_disagree();
-    let top = PyDict::new(py);
-    top.set_item("target_met", r.target_met)?;
-    top.set_item("verdicts_disagree", disagree)?;
+    let d = PyDict::new(py);
+    d.set_item("target_met", r.target_met)?;
+    d.set_item("verdicts_disagree", r.verdicts_disagree())?;
     if let Some((m, st)) = &r.hill {
-        top.set_item(
+        d.set_item(
             "hill_re",
             PyArray1::from_vec(py, m.iter().map(|z| z.0).collect()),
         )?;
-        top.set_item(
+        d.set_item(
             "hill_im",
             PyArray1::from_vec(py, m.iter().map(|z| z.1).collect()),
         )?;
-        top.set_item("hill_stability", st.as_str())?;
+        d.set_item("hill_stability", st.as_str())?;
     }
     let s = r.sol;
-    let d = top;
     d.set_item("tail", s.tail_ratio())?;
     let ok = s.status == Status::Converged;
     d.set_item("status", s.status.as_str())?;
@@ -274,6 +272,7 @@ fn periodic_options(
     settle: f64,
     window: f64,
     guess_rtol: f64,
+    guess_atol: f64,
     auto: Option<f64>,
     n_max: usize,
     hill: bool,
@@ -290,7 +289,7 @@ fn periodic_options(
     if max_steps == 0 {
         return Err(PyValueError::new_err("max_steps: must be >= 1"));
     }
-    Options::new(guess_rtol, guess_rtol * 1e-2)
+    Options::new(guess_rtol, guess_atol)
         .validate(1)
         .map_err(|_| {
             PyValueError::new_err(format!(
@@ -332,7 +331,7 @@ fn periodic_options(
             settle,
             window,
             rtol: guess_rtol,
-            atol: guess_rtol * 1e-2,
+            atol: guess_atol,
         },
     })
 }
@@ -376,8 +375,23 @@ fn periodic<'py>(
     let sc = autonomous_scene(&p, effects, "periodic")?;
     let rotating = parse_pattern(pattern, p.n_balls()).map_err(to_py)?;
     let opts = periodic_options(
-        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, max_steps,
-        settle, window, guess_rtol, auto, n_max, hill,
+        n_harm,
+        samples,
+        tol,
+        step_tol,
+        max_iter,
+        floquet,
+        f_rtol,
+        f_atol,
+        margin,
+        max_steps,
+        settle,
+        window,
+        guess_rtol,
+        guess_rtol * 1e-2,
+        auto,
+        n_max,
+        hill,
     )?;
     let d = p.ndof();
     let guess = match (guess_omega, guess_coeffs) {
@@ -508,11 +522,26 @@ fn scan(
         .map(|s| parse_pattern(s, p.n_balls()))
         .collect::<Result<Vec<_>, _>>()
         .map_err(to_py)?;
-    let mut opts = periodic_options(
-        n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin, max_steps,
-        settle, window, guess_rtol, auto, n_max, hill,
+    // Seeds only need a guess in Newton's basin: a looser simulation than periodic()'s.
+    let opts = periodic_options(
+        n_harm,
+        samples,
+        tol,
+        step_tol,
+        max_iter,
+        floquet,
+        f_rtol,
+        f_atol,
+        margin,
+        max_steps,
+        settle,
+        window,
+        guess_rtol,
+        guess_rtol * 1e-3,
+        auto,
+        n_max,
+        hill,
     )?;
-    opts.guess.atol = guess_rtol * 1e-3;
     let spec = ScanSpec {
         base: &p,
         names: names.clone(),
@@ -525,7 +554,6 @@ fn scan(
         threads,
         max_tail,
     };
-    spec.validate().map_err(to_py)?;
     let cancel = AtomicBool::new(false);
     let (tx, rx) = mpsc::channel::<(usize, Vec<ScanRow>)>();
     // `detach` needs a `Sync` capture; the receiver is only used from this thread.
@@ -600,11 +628,14 @@ fn scan_columns<'py>(
                 .collect::<Vec<_>>(),
         )?;
     }
-    let conv = |r: &ballbal_core::scan::ScanRow| -> Option<Periodic> { r.result.clone() };
-    let sols: Vec<Option<Periodic>> = rows.iter().map(conv).collect();
-    let f = |g: &dyn Fn(&Periodic) -> Option<f64>| -> Vec<Option<f64>> {
-        sols.iter().map(|s| s.as_ref().and_then(g)).collect()
-    };
+    let sols: Vec<Option<&Periodic>> = rows.iter().map(|r| r.result.as_ref()).collect();
+    // A column over the rows with a solution, None elsewhere.
+    fn col<'a, T>(
+        sols: &[Option<&'a Periodic>],
+        g: impl Fn(&'a Periodic) -> Option<T>,
+    ) -> Vec<Option<T>> {
+        sols.iter().map(|s| s.and_then(&g)).collect()
+    }
     d.set_item(
         "type",
         rows.iter()
@@ -627,91 +658,55 @@ fn scan_columns<'py>(
             })
             .collect::<Vec<_>>(),
     )?;
-    d.set_item("omega", f(&|x| Some(x.sol.omega)))?;
+    d.set_item("omega", col(&sols, |x| Some(x.sol.omega)))?;
     d.set_item(
         "stability",
-        sols.iter()
-            .map(|s| {
-                s.as_ref().map(|x| {
-                    x.floquet
-                        .as_ref()
-                        .map_or("undetermined", |fl| fl.stability.as_str())
-                })
-            })
-            .collect::<Vec<_>>(),
+        col(&sols, |x| {
+            Some(
+                x.floquet
+                    .as_ref()
+                    .map_or("undetermined", |fl| fl.stability.as_str()),
+            )
+        }),
     )?;
     d.set_item(
         "max_modulus",
-        f(&|x| x.floquet.as_ref().map(|fl| fl.max_modulus)),
+        col(&sols, |x| x.floquet.as_ref().map(|fl| fl.max_modulus)),
     )?;
     d.set_item(
         "trivial_error",
-        f(&|x| x.floquet.as_ref().map(|fl| fl.trivial_error)),
+        col(&sols, |x| x.floquet.as_ref().map(|fl| fl.trivial_error)),
     )?;
-    let mults = |part: fn(&(f64, f64)) -> f64| -> Vec<Option<Vec<f64>>> {
-        sols.iter()
-            .map(|s| {
-                s.as_ref()
-                    .and_then(|x| x.floquet.as_ref())
-                    .map(|fl| fl.multipliers.iter().map(part).collect())
-            })
-            .collect()
+    let part = |k: fn(&(f64, f64)) -> f64| {
+        col(&sols, |x| {
+            x.floquet
+                .as_ref()
+                .map(|fl| fl.multipliers.iter().map(k).collect::<Vec<f64>>())
+        })
     };
-    d.set_item("mult_re", mults(|z| z.0))?;
-    d.set_item("mult_im", mults(|z| z.1))?;
-    d.set_item("residual", f(&|x| Some(x.sol.residual)))?;
-    d.set_item("tail", f(&|x| Some(x.sol.tail_ratio())))?;
-    d.set_item("pivot_ratio", f(&|x| Some(x.sol.pivot_ratio)))?;
-    d.set_item(
-        "iterations",
-        sols.iter()
-            .map(|s| s.as_ref().map(|x| x.sol.iterations))
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("mult_re", part(|z| z.0))?;
+    d.set_item("mult_im", part(|z| z.1))?;
+    d.set_item("residual", col(&sols, |x| Some(x.sol.residual)))?;
+    d.set_item("tail", col(&sols, |x| Some(x.sol.tail_ratio())))?;
+    d.set_item("pivot_ratio", col(&sols, |x| Some(x.sol.pivot_ratio)))?;
+    d.set_item("iterations", col(&sols, |x| Some(x.sol.iterations)))?;
     d.set_item(
         "floquet_steps",
-        sols.iter()
-            .map(|s| {
-                s.as_ref()
-                    .and_then(|x| x.floquet.as_ref())
-                    .map(|fl| fl.steps)
-            })
-            .collect::<Vec<_>>(),
+        col(&sols, |x| x.floquet.as_ref().map(|fl| fl.steps)),
     )?;
-    d.set_item(
-        "floquet_error",
-        sols.iter()
-            .map(|s| s.as_ref().and_then(|x| x.floquet_error.clone()))
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("floquet_error", col(&sols, |x| x.floquet_error.clone()))?;
     d.set_item(
         "N",
         sols.iter()
-            .map(|s| s.as_ref().map_or(n_harm, |x| x.sol.n_harm))
+            .map(|s| s.map_or(n_harm, |x| x.sol.n_harm))
             .collect::<Vec<_>>(),
     )?;
-    d.set_item(
-        "target_met",
-        sols.iter()
-            .map(|s| s.as_ref().and_then(|x| x.target_met))
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("target_met", col(&sols, |x| x.target_met))?;
     d.set_item(
         "hill_stability",
-        sols.iter()
-            .map(|s| {
-                s.as_ref()
-                    .and_then(|x| x.hill.as_ref())
-                    .map(|h| h.1.as_str())
-            })
-            .collect::<Vec<_>>(),
+        col(&sols, |x| x.hill.as_ref().map(|h| h.1.as_str())),
     )?;
-    d.set_item(
-        "verdicts_disagree",
-        sols.iter()
-            .map(|s| s.as_ref().and_then(|x| x.verdicts_disagree()))
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("verdicts_disagree", col(&sols, |x| x.verdicts_disagree()))?;
     d.set_item(
         "attempts",
         rows.iter().map(|r| r.attempts).collect::<Vec<_>>(),
