@@ -3,14 +3,20 @@
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 
+def _is_number(v: Any) -> bool:
+    # numbers.Real takes numpy scalars too; a bool is not a parameter value.
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
 def _tuple(name: str, v: float | Sequence[float]) -> tuple[float, ...]:
     bad = ValueError(f"{name}: must be a number or a sequence of numbers, got {v!r}")
-    if isinstance(v, (int, float)) and not isinstance(v, bool):
+    if _is_number(v):
         return (float(v),)
     if isinstance(v, (str, bytes)):
         raise bad
@@ -18,7 +24,7 @@ def _tuple(name: str, v: float | Sequence[float]) -> tuple[float, ...]:
         items = list(v)
     except TypeError as e:
         raise bad from e
-    if any(isinstance(x, (bool, str, bytes)) or not isinstance(x, (int, float)) for x in items):
+    if not all(_is_number(x) for x in items):
         raise bad
     return tuple(float(x) for x in items)
 
@@ -42,7 +48,7 @@ class Balancer:
     def __post_init__(self) -> None:
         for name in ("mu", "zeta", "delta", "Omega"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)):
+            if not _is_number(v):
                 raise ValueError(f"{name}: must be a number, got {v!r}")
             object.__setattr__(self, name, float(v))
         object.__setattr__(self, "eta", _tuple("eta", self.eta))

@@ -153,12 +153,13 @@ class _Store:
 
     def __init__(self, path: str | os.PathLike[str], job: _Job) -> None:
         self.dir = Path(path)
-        meta = job.meta()
+        # As it reads back from JSON (tuples become lists), to compare with the file.
+        meta = json.loads(json.dumps(job.meta()))
         mfile = self.dir / "meta.json"
         if mfile.exists():
             old = json.loads(mfile.read_text())
-            if old != json.loads(json.dumps(meta)):
-                diff = sorted(k for k in meta if old.get(k) != json.loads(json.dumps(meta[k])))
+            if old != meta:
+                diff = sorted(k for k in meta if old.get(k) != meta[k])
                 raise ValueError(
                     f"out: {self.dir} holds a different scan (it differs in "
                     f"{', '.join(diff)}); choose another directory or delete it"

@@ -30,7 +30,7 @@ import sys
 from dataclasses import asdict, dataclass, field, fields
 from typing import Any
 
-from .model import Balancer
+from .model import Balancer, _is_number
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -39,7 +39,7 @@ else:  # pragma: no cover
 
 
 def _num(where: str, v: Any) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+    if not _is_number(v) or not math.isfinite(v):
         raise ValueError(f"{where}: must be a finite number, got {v!r}")
     return float(v)
 
@@ -195,16 +195,10 @@ def balancer_from_dict(d: dict[str, Any], where: str = "scene") -> Balancer:
         if isinstance(balls, bool) or not isinstance(balls, int) or balls < 1:
             raise ValueError(f"balls: must be an integer >= 1, got {balls!r}")
         eta = d.get("eta", 1.0)
-        if isinstance(eta, (int, float)):
+        if _is_number(eta):
             d["eta"] = (float(eta),) * balls
         elif not isinstance(eta, list) or len(eta) != balls:
             raise ValueError(f"eta: must be one number or {balls} numbers (balls = {balls})")
-    for k, v in d.items():
-        vals = list(v) if isinstance(v, (list, tuple)) else [v]
-        if not vals:
-            raise ValueError(f"{k}: must not be empty")
-        for x in vals:
-            _num(k, x)
     return Balancer(**d).validate()
 
 
