@@ -9,9 +9,10 @@ from .analysis import (
     periodic,
     simulate,
 )
+from .balance import balance_map, balanced_state, plot_balance_map
 from .model import Balancer, from_seed003, zeta_from_log_decrement
 from .scan import ScanInterrupted, read_scan, scan, scan_meta
-from .scene import Impulse, Ramp, Scene, load_scene
+from .scene import Impulse, Ramp, Scene, Tilt, load_scene
 from .transient import DisturbanceResponse, disturbance_response, track_damping_study
 
 __all__ = [
@@ -23,14 +24,18 @@ __all__ = [
     "PeriodicSolution",
     "Ramp",
     "Scene",
+    "Tilt",
     "__version__",
     "accuracy_cost",
+    "balance_map",
+    "balanced_state",
     "disturbance_response",
     "equilibria",
     "from_seed003",
     "load_scene",
     "periodic",
     "plot_accuracy_cost",
+    "plot_balance_map",
     "read_scan",
     "scan",
     "scan_meta",

@@ -6,9 +6,11 @@ import numpy.typing as npt
 
 Effects = (
     tuple[float, tuple[float, float, float] | None, float,
-          tuple[float, float, float, float] | None]
+          tuple[float, float, float, float] | None,
+          tuple[float, float, float, float, float] | None]
     | None
 )
+PlanarArgs = tuple[float, float, list[float], float, float, list[float]]
 
 __version__: str
 
@@ -21,6 +23,9 @@ def equilibria(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     effects: Effects = None,
 ) -> list[dict[str, Any]]: ...
+def balanced_states(
+    points: list[tuple[PlanarArgs, Effects]],
+) -> list[dict[str, Any] | None]: ...
 def periodic(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     pattern: str, n_harm: int, samples: int | None, tol: float, step_tol: float, max_iter: int,

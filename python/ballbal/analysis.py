@@ -20,8 +20,8 @@ def _atol(atol: float | Sequence[float]) -> list[float]:
     return [float(atol)] if np.isscalar(atol) else [float(a) for a in atol]  # type: ignore[arg-type]
 
 
-def _state_names(n: int) -> list[str]:
-    q = ["x", "y"] + [f"b{i + 1}" for i in range(n)]
+def _state_names(model: Balancer | Scene) -> list[str]:
+    q = model.coordinates
     return q + [f"d{c}" for c in q]
 
 
@@ -37,18 +37,23 @@ def simulate(
 ) -> pl.DataFrame:
     """Integrate the equations of motion with the core's Dormand–Prince 5(4).
 
-    ``y0 = (x, y, b_1..b_n, x', y', b_1'..b_n')`` in the rotating frame (default: the
-    thesis' start: at rest in the ground frame, balls spread over half the track). The
+    ``y0 = (q, q')`` in the rotating frame, ``q = (x, y, b_1..b_n)`` (with a tilting disk
+    ``(x, y, A, B, b_1..b_n)``: ``balancer.coordinates``); default: the thesis' start, at
+    rest in the ground frame, balls spread over half the track. The
     state is given at ``t0`` (default ``t_span[0]``, else 0). Give output times ``t_eval``
     (strictly monotone, not before ``t0``) or ``t_span`` for 1001 evenly spaced outputs.
     Returns columns ``t``, the state, and ``X, Y``: the disk centre in the fixed frame.
     """
     n = balancer.n_balls
+    d = len(balancer.coordinates)
     if y0 is None:
-        y0 = np.zeros(2 * (n + 2))
-        y0[2 : 2 + n] = np.linspace(0.0, np.pi, n, endpoint=False) + 0.3
-        y0[n + 4 :] = -balancer.Omega
+        y0 = np.zeros(2 * d)
+        y0[d - n : d] = np.linspace(0.0, np.pi, n, endpoint=False) + 0.3
+        y0[2 * d - n :] = -balancer.Omega
     y0 = np.ascontiguousarray(y0, dtype=np.float64).ravel()
+    if y0.size != 2 * d:
+        raise ValueError(f"y0: needs 2 x {d} values ({', '.join(balancer.coordinates)} and "
+                         f"their rates), got {y0.size}")
     if t_eval is None:
         if t_span is None:
             raise ValueError("t_eval: give output times, or t_span=(t0, t1)")
@@ -61,7 +66,7 @@ def simulate(
     y, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol), _atol(atol),
                              balancer.native_effects())
     cols: dict[str, Any] = {"t": t}
-    for name, col in zip(_state_names(n), np.asarray(y).T, strict=True):
+    for name, col in zip(_state_names(balancer), np.asarray(y).T, strict=True):
         cols[name] = col
     ph = balancer.theta(t)
     cols["X"] = cols["x"] * np.cos(ph) - cols["y"] * np.sin(ph)
@@ -87,15 +92,17 @@ class Equilibrium:
 def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
     """All equilibria (perfect balance first), with eigenvalues, the relative-stability
     index (largest real part) and, where defined, the Routh–Hurwitz verdict."""
-    out = []
-    for d in _native.equilibria(*balancer.native_args(), balancer.native_effects()):
-        out.append(Equilibrium(
-            kind=d["kind"], q=d["q"], residual=d["residual"],
-            eigenvalues=d["eig_re"] + 1j * d["eig_im"], stability_index=d["index"],
-            stability=d["stability"], neutral=d["neutral"], routh_hurwitz=d["routh_hurwitz"],
-            char_poly=d["char_poly"],
-        ))
-    return out
+    return [_equilibrium(d)
+            for d in _native.equilibria(*balancer.native_args(), balancer.native_effects())]
+
+
+def _equilibrium(d: dict[str, Any]) -> Equilibrium:
+    return Equilibrium(
+        kind=d["kind"], q=d["q"], residual=d["residual"],
+        eigenvalues=d["eig_re"] + 1j * d["eig_im"], stability_index=d["index"],
+        stability=d["stability"], neutral=d["neutral"], routh_hurwitz=d["routh_hurwitz"],
+        char_poly=d["char_poly"],
+    )
 
 
 @dataclass(frozen=True)
@@ -157,7 +164,7 @@ class PeriodicSolution:
         m = np.arange(1, self.N + 1)
         cos, sin = np.cos(np.outer(tau, m)), np.sin(np.outer(tau, m))
         cols: dict[str, Any] = {"t": tt}
-        names = _state_names(self.balancer.n_balls)
+        names = _state_names(self.balancer)
         d = len(self.winding)
         a, b = self.coeffs[:, 1::2], self.coeffs[:, 2::2]
         q = self.coeffs[:, 0] + cos @ a.T + sin @ b.T + np.outer(tau, self.winding)

@@ -64,6 +64,11 @@ class Balancer:
         return (float(self.mu), float(self.zeta), zb, float(self.delta), float(self.Omega),
                 list(self.eta))
 
+    @property
+    def coordinates(self) -> list[str]:
+        """Names of the generalised coordinates, in the state's order."""
+        return ["x", "y"] + [f"b{i + 1}" for i in range(self.n_balls)]
+
     def native_effects(self) -> None:
         """A plain balancer has no effects (see :class:`ballbal.scene.Scene`)."""
         return None

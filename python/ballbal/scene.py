@@ -10,16 +10,25 @@ the eccentricity ``e``, time over ``1/w_n``, forces over ``M e w_n^2``):
 * ``gravity``: ``g / (e w_n^2)`` for a horizontal spin axis (gravity along -Y of the
   ground frame; the disk's x axis is along +X at t = 0);
 * ``impulse``: seed 002's load on the rotor ``amplitude exp(-sharpness (t - t0)^2)``
-  along the ground direction ``angle``.
+  along the ground direction ``angle``;
+* ``tilt``: the disk tilts on a flexible, simply supported shaft, with gyroscopic
+  coupling (seed 004; :class:`Tilt`). The state gains two coordinates after ``x, y``:
+  ``A, B``, the Euler tilts ``alpha, beta`` scaled by ``delta`` (the track rim's axial
+  displacement over ``e``; radians are ``A / delta``).
 
-Every analysis accepts a scene. Time simulation works with any; periodic solutions and
-Floquet need an autonomous scene (no ramp, gravity or impulse: asking is an error that
-names the effect). Equilibria and scans of scenes with springs come in a later version.
+The support is the isotropic spring–damper of ``model.md`` (a fluid-film bearing is a
+later issue: it will be one more support kind here).
+
+Every analysis accepts a scene. Time simulation works with any; periodic solutions,
+Floquet and equilibria need an autonomous scene (no ramp, gravity or impulse: asking
+is an error that names the effect). With springs, :func:`ballbal.balanced_state` gives
+the balanced equilibrium (the full set is not available yet); scans of periodic
+solutions take the planar balancer only.
 
 Files (TOML): the balancer's keys at the top level or in ``[balancer]`` (``balls`` for
 equal balls), and optional tables ``[springs] stiffness``, ``[ramp] to, start,
-duration``, ``[gravity] g``, ``[impulse] amplitude, t0, sharpness, angle``. Unknown keys
-and tables are errors.
+duration``, ``[gravity] g``, ``[impulse] amplitude, t0, sharpness, angle``, ``[tilt] a,
+b, j_t, j_z, zeta_r``. Unknown keys and tables are errors.
 """
 
 from __future__ import annotations
@@ -27,7 +36,7 @@ from __future__ import annotations
 import math
 import os
 import sys
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
 from .model import Balancer, _is_number
@@ -74,12 +83,58 @@ class Impulse:
 
 
 @dataclass(frozen=True)
+class Tilt:
+    """A disk that tilts on a massless, simply supported shaft (seed 004).
+
+    ``a, b``: the disk's distances from the two bearings, over the track radius ``r_t``;
+    ``j_t, j_z``: the disk's transverse and polar moments of inertia about its mass
+    centre, over ``M r_t^2``; ``zeta_r``: tilt damping ratio ``c_r / (2 sqrt(J_t
+    k_phiphi))``, on the disk normal's rate in the ground frame. The shaft's stiffness at
+    the disk is the ``k`` of ``w_n``; beam theory then fixes the coupling and tilt
+    stiffnesses :attr:`kappa_c` and :attr:`kappa_t`. ``a == b`` (disk at mid-span)
+    decouples translation and tilt.
+    """
+
+    a: float
+    b: float
+    j_t: float
+    j_z: float
+    zeta_r: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            object.__setattr__(self, f.name, _num(f"tilt.{f.name}", getattr(self, f.name)))
+        for name in ("a", "b", "j_t"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"tilt.{name}: must be > 0, got {getattr(self, name)}")
+        if not 0 <= self.j_z <= 2 * self.j_t:
+            raise ValueError(f"tilt.j_z: must be in [0, 2 j_t] = [0, {2 * self.j_t}] (a rigid "
+                             f"body's polar moment is at most the sum of the other two), "
+                             f"got {self.j_z}")
+        if self.zeta_r < 0:
+            raise ValueError(f"tilt.zeta_r: must be >= 0, got {self.zeta_r}")
+
+    @property
+    def kappa_c(self) -> float:
+        """Translation–tilt coupling stiffness, over ``k r_t``."""
+        a, b = self.a, self.b
+        return a * b * (a - b) / (a * a - a * b + b * b)
+
+    @property
+    def kappa_t(self) -> float:
+        """Tilt stiffness, over ``k r_t^2``."""
+        a, b = self.a, self.b
+        return a * a * b * b / (a * a - a * b + b * b)
+
+
+@dataclass(frozen=True)
 class Scene:
     balancer: Balancer = field(default_factory=Balancer)
     springs: float = 0.0
     ramp: Ramp | None = None
     gravity: float = 0.0
     impulse: Impulse | None = None
+    tilt: Tilt | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.balancer, Balancer):
@@ -92,7 +147,7 @@ class Scene:
             raise ValueError("springs: ball springs need at least 2 balls")
         if self.gravity < 0:
             raise ValueError(f"gravity: must be >= 0, got {self.gravity}")
-        for name, kind in (("ramp", Ramp), ("impulse", Impulse)):
+        for name, kind in (("ramp", Ramp), ("impulse", Impulse), ("tilt", Tilt)):
             v = getattr(self, name)
             if v is not None and not isinstance(v, kind):
                 raise ValueError(f"{name}: must be a {kind.__name__} or None")
@@ -109,13 +164,35 @@ class Scene:
     def native_args(self) -> tuple[float, float, list[float], float, float, list[float]]:
         return self.balancer.native_args()
 
+    @property
+    def coordinates(self) -> list[str]:
+        """Names of the generalised coordinates, in the state's order."""
+        rotor = ["x", "y"] + (["A", "B"] if self.tilt is not None else [])
+        return rotor + [f"b{i + 1}" for i in range(self.n_balls)]
+
+    def replace(self, **changes: Any) -> Scene:
+        """A copy with fields changed; balancer fields (``Omega``, ``eta``, ...) and tilt
+        fields (``j_t``, ``a``, ...) may be given directly."""
+        bal = {k: changes.pop(k) for k in list(changes) if k in _BALANCER_FIELDS}
+        tl = {k: changes.pop(k) for k in list(changes) if k in _TILT_FIELDS}
+        if bal:
+            changes["balancer"] = self.balancer.replace(**bal).validate()
+        if tl:
+            if self.tilt is None:
+                raise ValueError(f"{', '.join(tl)}: the scene has no tilt to change")
+            changes["tilt"] = replace(self.tilt, **tl)
+        return replace(self, **changes)
+
     def native_effects(self) -> tuple[Any, ...] | None:
-        if self.springs == 0 and self.ramp is None and self.gravity == 0 and self.impulse is None:
+        if (self.springs == 0 and self.ramp is None and self.gravity == 0
+                and self.impulse is None and self.tilt is None):
             return None
         ramp = None if self.ramp is None else (self.ramp.to, self.ramp.start, self.ramp.duration)
         imp = None if self.impulse is None else (
             self.impulse.amplitude, self.impulse.t0, self.impulse.sharpness, self.impulse.angle)
-        return (self.springs, ramp, self.gravity, imp)
+        tl = None if self.tilt is None else (
+            self.tilt.a, self.tilt.b, self.tilt.j_t, self.tilt.j_z, self.tilt.zeta_r)
+        return (self.springs, ramp, self.gravity, imp, tl)
 
     @property
     def time_dependence(self) -> str | None:
@@ -157,6 +234,8 @@ class Scene:
             d["gravity"] = {"g": self.gravity}
         if self.impulse is not None:
             d["impulse"] = asdict(self.impulse)
+        if self.tilt is not None:
+            d["tilt"] = asdict(self.tilt)
         return d
 
     def to_toml(self) -> str:
@@ -180,7 +259,10 @@ def _toml_value(v: Any) -> str:
 
 
 _TABLES = {"springs": {"stiffness"}, "ramp": {"to", "start", "duration"}, "gravity": {"g"},
-           "impulse": {"amplitude", "t0", "sharpness", "angle"}}
+           "impulse": {"amplitude", "t0", "sharpness", "angle"},
+           "tilt": {"a", "b", "j_t", "j_z", "zeta_r"}}
+_BALANCER_FIELDS = {f.name for f in fields(Balancer)}
+_TILT_FIELDS = {f.name for f in fields(Tilt)}
 
 
 def balancer_from_dict(d: dict[str, Any], where: str = "scene") -> Balancer:
@@ -230,6 +312,7 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
             ramp=Ramp(**d["ramp"]) if "ramp" in d else None,
             gravity=d["gravity"]["g"] if "gravity" in d else 0.0,
             impulse=Impulse(**d["impulse"]) if "impulse" in d else None,
+            tilt=Tilt(**d["tilt"]) if "tilt" in d else None,
         )
     except (KeyError, TypeError) as e:
         raise ValueError(f"{where}: incomplete effect table ({e})") from e

@@ -95,7 +95,8 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
     let ev = eigenvalues(&a, 2 * d).unwrap_or_default();
     // A perfect balance with n >= 3 balls is an (n-2)-parameter family: those
     // directions have zero eigenvalues and say nothing about attraction.
-    let n_balls = d - 2;
+    let o = p.first_ball();
+    let n_balls = d - o;
     let neutral = if family && kind == "perfect_balance" && n_balls >= 3 {
         n_balls - 2
     } else {
@@ -124,7 +125,7 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
         kind: kind.to_string(),
         q: q.iter()
             .enumerate()
-            .map(|(i, &v)| if i >= 2 { wrap(v) } else { v })
+            .map(|(i, &v)| if i >= o { wrap(v) } else { v })
             .collect(),
         residual,
         eigenvalues: ev,
@@ -140,13 +141,13 @@ fn equal_balls(p: &Planar) -> bool {
     p.eta.windows(2).all(|w| w[0] == w[1])
 }
 
-fn classify(q: &[f64]) -> &'static str {
+fn classify(q: &[f64], o: usize) -> &'static str {
     // Newton's points (as opposed to closed forms) carry its tolerance.
-    if q[0].hypot(q[1]) < 1e-6 {
+    if q[..o].iter().all(|v| v.abs() < 1e-6) {
         return "perfect_balance";
     }
-    if q.len() == 4 {
-        let diff = wrap(q[2] - q[3]);
+    if q.len() == o + 2 {
+        let diff = wrap(q[o] - q[o + 1]);
         if diff.abs() < 1e-7 {
             return "together";
         }
@@ -204,7 +205,7 @@ fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, &'static str)> {
 }
 
 /// Newton (least squares, so that families of equilibria do not stall it) on `F(q,0,0) = 0`.
-fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>> {
+pub fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>> {
     let d = p.ndof();
     let z = vec![0.0; d];
     let mut q = q0.to_vec();
@@ -234,21 +235,21 @@ fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>> {
     (rn < 1e-10).then_some(q)
 }
 
-fn same_equilibrium(equal: bool, a: &[f64], b: &[f64]) -> bool {
+fn same_equilibrium(equal: bool, o: usize, a: &[f64], b: &[f64]) -> bool {
     // Newton's points near a nearly degenerate equilibrium (weak springs) scatter by more
     // than its residual suggests: compare at that accuracy.
-    if (a[0] - b[0]).abs() > 1e-5 || (a[1] - b[1]).abs() > 1e-5 {
+    if (0..o).any(|i| (a[i] - b[i]).abs() > 1e-5) {
         return false;
     }
-    let n = a.len() - 2;
-    let direct = (0..n).all(|i| wrap(a[2 + i] - b[2 + i]).abs() < 1e-4);
+    let n = a.len() - o;
+    let direct = (0..n).all(|i| wrap(a[o + i] - b[o + i]).abs() < 1e-4);
     if direct {
         return true;
     }
     if equal {
         // Identical balls: the same physical state up to relabelling.
-        let mut sa: Vec<f64> = a[2..].iter().map(|&v| wrap(v)).collect();
-        let mut sb: Vec<f64> = b[2..].iter().map(|&v| wrap(v)).collect();
+        let mut sa: Vec<f64> = a[o..].iter().map(|&v| wrap(v)).collect();
+        let mut sb: Vec<f64> = b[o..].iter().map(|&v| wrap(v)).collect();
         sa.sort_by(f64::total_cmp);
         sb.sort_by(f64::total_cmp);
         return sa.iter().zip(&sb).all(|(u, v)| wrap(u - v).abs() < 1e-4);
@@ -275,10 +276,11 @@ pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
 /// `family`: see [`analyse_model`].
 pub fn equilibria_of<D: Dynamics + ?Sized>(p: &D, equal: bool, family: bool) -> Vec<Equilibrium> {
     let mut found: Vec<(Vec<f64>, String)> = vec![];
-    for q0 in starts(p.ndof() - 2) {
+    let o = p.first_ball();
+    for q0 in starts(p.ndof() - o, o) {
         if let Some(q) = newton_static(p, &q0) {
-            if !found.iter().any(|(f, _)| same_equilibrium(equal, f, &q)) {
-                let kind = classify(&q).to_string();
+            if !found.iter().any(|(f, _)| same_equilibrium(equal, o, f, &q)) {
+                let kind = classify(&q, o).to_string();
                 found.push((q, kind));
             }
         }
@@ -308,7 +310,7 @@ fn sorted_analysed<D: Dynamics + ?Sized>(
         .collect()
 }
 
-fn starts(n: usize) -> Vec<Vec<f64>> {
+fn starts(n: usize, o: usize) -> Vec<Vec<f64>> {
     let per = match n {
         1 => 24,
         2 => 12,
@@ -318,11 +320,11 @@ fn starts(n: usize) -> Vec<Vec<f64>> {
     let total = (per as u64).pow(n as u32).min(600) as usize;
     let mut out = vec![];
     for idx in 0..total {
-        let mut q = vec![0.0; n + 2];
+        let mut q = vec![0.0; n + o];
         let mut rem = idx;
         for i in 0..n {
             // Offset so that no start sits exactly on a symmetric (singular) point.
-            q[2 + i] = -PI + (rem % per) as f64 * 2.0 * PI / per as f64 + 0.1 + 0.01 * i as f64;
+            q[o + i] = -PI + (rem % per) as f64 * 2.0 * PI / per as f64 + 0.1 + 0.01 * i as f64;
             rem /= per;
         }
         out.push(q);
@@ -436,10 +438,10 @@ mod tests {
             assert!(e.residual < 1e-13, "{} residual {}", e.kind, e.residual);
         }
         // Numeric multistart on the same balancer (bypassing the closed forms).
-        for q0 in starts(p.n_balls()) {
+        for q0 in starts(p.n_balls(), 2) {
             if let Some(q) = newton_static(&p, &q0) {
                 assert!(
-                    eqs.iter().any(|e| same_equilibrium(true, &e.q, &q)),
+                    eqs.iter().any(|e| same_equilibrium(true, 2, &e.q, &q)),
                     "numeric equilibrium {q:?} missing from closed forms"
                 );
             }

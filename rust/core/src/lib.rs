@@ -19,6 +19,8 @@ pub mod periodic;
 pub mod scan;
 pub mod scene;
 pub mod simulate;
+#[rustfmt::skip]
+pub mod tilt_terms;
 
 pub use error::{Error, Result};
 pub use model::{Dynamics, Planar};

@@ -51,6 +51,10 @@ pub trait Dynamics: Send + Sync {
     fn base_spin(&self) -> f64 {
         0.0
     }
+    /// Index of the first ball angle in `q` (the coordinates before it are the rotor's).
+    fn first_ball(&self) -> usize {
+        2
+    }
 }
 
 /// Planar n-ball automatic balancer on an isotropic spring–damper support.

@@ -26,8 +26,9 @@ pub fn parse_pattern(pattern: &str, n_balls: usize) -> crate::Result<Vec<bool>> 
     Ok(letters.into_iter().map(|c| c == 'R').collect())
 }
 
-pub fn pattern_string(winding: &[f64]) -> String {
-    winding[2..]
+/// The R/O pattern of the balls, which are the last `n_balls` coordinates.
+pub fn pattern_string(winding: &[f64], n_balls: usize) -> String {
+    winding[winding.len() - n_balls..]
         .iter()
         .map(|w| if *w != 0.0 { "R" } else { "O" })
         .collect::<Vec<_>>()
@@ -58,8 +59,9 @@ impl Default for GuessOptions {
 /// Deterministic initial states: at rest in the ground frame (`b_i' = -Omega`, the
 /// thesis' basin set-up) from merged, opposed and spread ball positions.
 pub fn initial_states<D: Dynamics + ?Sized>(p: &D) -> Vec<Vec<f64>> {
-    let n = p.ndof() - 2;
-    let d = n + 2;
+    let o = p.first_ball();
+    let n = p.ndof() - o;
+    let d = n + o;
     let mut configs: Vec<Vec<f64>> = vec![
         vec![0.0; n],
         vec![PI / 2.0; n],
@@ -84,8 +86,8 @@ pub fn initial_states<D: Dynamics + ?Sized>(p: &D) -> Vec<Vec<f64>> {
         for b in &configs {
             let mut y = vec![0.0; 2 * d];
             for i in 0..n {
-                y[2 + i] = b[i];
-                y[d + 2 + i] = rate;
+                y[o + i] = b[i];
+                y[d + o + i] = rate;
             }
             out.push(y);
         }
@@ -106,7 +108,8 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     g: &GuessOptions,
 ) -> Option<HbSolution> {
     let d = model.ndof();
-    let n = d - 2;
+    let o = model.first_ball();
+    let n = d - o;
     let opts = Options::new(g.rtol, g.atol);
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
     let mut solver = Dopri5::new(2 * d);
@@ -146,13 +149,13 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
                 dense.eval(t, &mut tmp);
                 for (i, c) in crossings.iter_mut().enumerate() {
                     let (a, b) = (
-                        (y_prev[2 + i] / (2.0 * PI)).floor(),
-                        (tmp[2 + i] / (2.0 * PI)).floor(),
+                        (y_prev[o + i] / (2.0 * PI)).floor(),
+                        (tmp[o + i] / (2.0 * PI)).floor(),
                     );
                     if a != b {
                         // Linear interpolation of the level crossing.
                         let level = 2.0 * PI * a.max(b);
-                        let f = (level - y_prev[2 + i]) / (tmp[2 + i] - y_prev[2 + i]);
+                        let f = (level - y_prev[o + i]) / (tmp[o + i] - y_prev[o + i]);
                         c.push(t - dt + f * dt);
                     }
                 }
@@ -246,18 +249,18 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     let last = &traj[s + 1];
     let mut winding = vec![0.0; d];
     for i in 0..n {
-        winding[2 + i] = ((last[2 + i] - first[2 + i]) / (2.0 * PI)).round();
+        winding[o + i] = ((last[o + i] - first[o + i]) / (2.0 * PI)).round();
     }
-    if r.is_some() && winding[2 + r.unwrap()] == 0.0 {
+    if r.is_some() && winding[o + r.unwrap()] == 0.0 {
         return None;
     }
     // Shift angles by whole turns: the phase ball to 0, others into (-pi, pi].
     let mut shift = vec![0.0; d];
     for i in 0..n {
-        let b0 = first[2 + i];
-        shift[2 + i] = b0 - wrap(b0);
+        let b0 = first[o + i];
+        shift[o + i] = b0 - wrap(b0);
         if Some(i) == r {
-            shift[2 + i] = 2.0 * PI * (b0 / (2.0 * PI)).round();
+            shift[o + i] = 2.0 * PI * (b0 / (2.0 * PI)).round();
         }
     }
     let mut samples = vec![0.0; s * d];
@@ -470,7 +473,7 @@ pub fn no_guess<D: Dynamics + ?Sized>(p: &D, rotating: &[bool], n_harm: usize) -
     let d = p.ndof();
     let mut winding = vec![0.0; d];
     for (i, &r) in rotating.iter().enumerate() {
-        winding[2 + i] = if r { -1.0 } else { 0.0 };
+        winding[p.first_ball() + i] = if r { -1.0 } else { 0.0 };
     }
     HbSolution::start(
         f64::NAN,

@@ -23,7 +23,7 @@ use crate::error::{Error, Result};
 use crate::floquet::FloquetOptions;
 use crate::hb::{solve, HbSolution, Status};
 use crate::periodic::{finish, guess_from_state, initial_states, Periodic, PeriodicOptions};
-use crate::Planar;
+use crate::{Dynamics, Planar};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -386,7 +386,10 @@ fn scan_chunk(
             // This point's own states: "at rest in the ground frame" depends on its spin.
             let y0 = &initial_states(model)[starts[s]];
             let g = guess_from_state(model, y0, None, n_harm, &spec.opts.guess)?;
-            let rot: Vec<bool> = g.winding[2..].iter().map(|w| *w != 0.0).collect();
+            let rot: Vec<bool> = g.winding[model.first_ball()..]
+                .iter()
+                .map(|w| *w != 0.0)
+                .collect();
             let k = spec.patterns.iter().position(|r| *r == rot)?;
             let sol = solve(model, &g, &spec.opts.hb);
             if !accept(&sol, &g, spec.max_tail) {

@@ -24,10 +24,75 @@
 //! `g sin th` and `g cos th`, ball row i gains `g cos(th + b_i)`. An impulsive load on the
 //! rotor (seed 002's form) `F(t) = A exp(-s (t - t0)^2)` along the ground direction at
 //! angle `psi` enters the support rows only.
+//!
+//! Tilting disk on a flexible shaft (seed 004): coordinates `(x, y, A, B, b_1..b_n)`,
+//! where `A, B` are the disk's Euler tilts scaled by `delta` (the rim's axial
+//! displacement over `e`). The rotor and ball terms, including spin ramp and gravity,
+//! come from `scripts/derive_tilt.py`, which derives them from the Lagrangian and
+//! writes [`crate::tilt_terms`]; springs and the impulsive load are added here as for
+//! the planar disk. The shaft is massless, simply supported, the disk at distances
+//! `a`, `b` (over `r_t`) from the bearings: beam theory gives the translational
+//! stiffness `k = 3 E I (1/a^3 + 1/b^3)` (the `k` of `w_n`), the coupling
+//! `kappa_c = a b (a - b) / (a^2 - a b + b^2)` and tilt stiffness
+//! `kappa_t = a^2 b^2 / (a^2 - a b + b^2)` (over `k r_t` and `k r_t^2`). With `a = b`
+//! the coupling vanishes and a disk started flat stays flat: the planar equations.
 
+use crate::equilibria::{analyse_model, newton_static, Equilibrium};
 use crate::error::{check_range, Error, Result};
 use crate::model::{Dynamics, Planar};
+use crate::tilt_terms::{
+    ball_jacobians, ball_residual, rotor_jacobians, rotor_residual, RotorConsts,
+};
+use nalgebra::DMatrix;
 use std::f64::consts::PI;
+
+/// A disk that tilts on a flexible shaft, with gyroscopic coupling (seed 004).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tilt {
+    /// Distance of the disk from the first bearing, over the track radius.
+    pub a: f64,
+    /// Distance of the disk from the second bearing, over the track radius.
+    pub b: f64,
+    /// Transverse moment of inertia of the disk about its mass centre, over `M r_t^2`.
+    pub j_t: f64,
+    /// Polar moment of inertia of the disk, over `M r_t^2`.
+    pub j_z: f64,
+    /// Damping ratio of the tilt: `c_r / (2 sqrt(J_t k_phiphi))`, acting on the disk
+    /// normal's rate in the ground frame.
+    pub zeta_r: f64,
+}
+
+impl Tilt {
+    fn validate(&self) -> Result<()> {
+        check_range("tilt.a", self.a, 0.0, true, f64::INFINITY, true)?;
+        check_range("tilt.b", self.b, 0.0, true, f64::INFINITY, true)?;
+        check_range("tilt.j_t", self.j_t, 0.0, true, f64::INFINITY, true)?;
+        check_range("tilt.j_z", self.j_z, 0.0, false, 2.0 * self.j_t, false)
+            .map_err(|_| {
+                Error::param(
+                    "tilt.j_z",
+                    format!(
+                        "must be in [0, 2 j_t] = [0, {}] (a rigid body's polar moment is at most the sum of the other two), got {}",
+                        2.0 * self.j_t,
+                        self.j_z
+                    ),
+                )
+            })?;
+        check_range("tilt.zeta_r", self.zeta_r, 0.0, false, f64::INFINITY, true)
+    }
+
+    /// Translation–tilt coupling stiffness `kappa_c` of the simply supported shaft.
+    pub fn kappa_c(&self) -> f64 {
+        let (a, b) = (self.a, self.b);
+        a * b * (a - b) / (a * a - a * b + b * b)
+    }
+
+    /// Tilt stiffness `kappa_t` of the simply supported shaft.
+    pub fn kappa_t(&self) -> f64 {
+        let (a, b) = (self.a, self.b);
+        a * a * b * b / (a * a - a * b + b * b)
+    }
+}
 
 /// A change of spin speed from the scene's `Omega` to `to`, linear over `duration`
 /// starting at `start` (a run-up, or seed 001's speed disturbance).
@@ -56,6 +121,8 @@ pub struct Scene {
     /// `g / (e w_n^2)`; 0 for a vertical spin axis.
     pub gravity: f64,
     pub impulse: Option<Impulse>,
+    pub tilt: Option<Tilt>,
+    consts: Option<RotorConsts>,
 }
 
 impl Scene {
@@ -65,6 +132,7 @@ impl Scene {
         ramp: Option<Ramp>,
         gravity: f64,
         impulse: Option<Impulse>,
+        tilt: Option<Tilt>,
     ) -> Result<Self> {
         check_range("springs", springs, 0.0, false, f64::INFINITY, true)?;
         if springs > 0.0 && planar.n_balls() < 2 {
@@ -103,13 +171,110 @@ impl Scene {
                 true,
             )?;
         }
+        let consts = match &tilt {
+            None => None,
+            Some(tl) => {
+                tl.validate()?;
+                let p = &planar;
+                let balls: f64 = (0..p.n_balls()).map(|i| p.m(i)).sum::<f64>() / p.delta;
+                let kt = tl.kappa_t();
+                Some(RotorConsts {
+                    mh: (1.0 - p.mu - balls).max(0.0),
+                    mu: p.mu,
+                    dl: p.delta,
+                    idl: 1.0 / p.delta,
+                    jt: tl.j_t,
+                    jz: tl.j_z,
+                    kc: tl.kappa_c(),
+                    kt,
+                    cr: 2.0 * tl.zeta_r * (kt * tl.j_t).sqrt(),
+                    zeta: p.zeta,
+                    g: gravity,
+                })
+            }
+        };
         Ok(Scene {
             planar,
             springs,
             ramp,
             gravity,
             impulse,
+            tilt,
+            consts,
         })
+    }
+
+    /// The balanced state and its stability (seed 004's "stable balanced region"): the
+    /// equilibrium that continues the planar balancer's perfect balance (`x = y = 0`,
+    /// balls cancelling the unbalance) to this scene. Springs whose rest spacing differs
+    /// from the balancing positions shift it to a nearly balanced state with a residual
+    /// whirl `hypot(x, y)`; it is followed from zero spring stiffness in steps. `None`
+    /// when the balls cannot balance the disk or the continuation fails.
+    pub fn balanced_state(&self) -> Option<Equilibrium> {
+        if self.time_dependence().is_some() {
+            return None;
+        }
+        let p = &self.planar;
+        let (n, o) = (p.n_balls(), self.off());
+        // Planar perfect balance: equal pairs have a closed form, otherwise Newton from
+        // balls fanned out opposite the unbalance.
+        let mut q = vec![0.0; n + 2];
+        if n == 2 && p.eta[0] == p.eta[1] {
+            if p.eta[0] < 0.5 {
+                return None;
+            }
+            let b = (-1.0 / (2.0 * p.eta[0])).acos();
+            // balls in track order, b_1 < b_2 < b_1 + 2 pi: springs unwound
+            q[2] = b;
+            q[3] = 2.0 * PI - b;
+        } else {
+            for i in 0..n {
+                q[2 + i] = PI + 1.6 * (i as f64 - (n as f64 - 1.0) / 2.0) / n as f64;
+            }
+            q = newton_static(p, &q)?;
+            if q[0].hypot(q[1]) > 1e-8 {
+                return None;
+            }
+        }
+        let mut start = vec![0.0; self.ndof()];
+        start[o..].copy_from_slice(&q[2..]);
+        let kind = if self.springs > 0.0 {
+            "balanced"
+        } else {
+            "perfect_balance"
+        };
+        let q = if self.springs > 0.0 {
+            self.spring_homotopy(start)?
+        } else {
+            newton_static(self, &start)?
+        };
+        Some(analyse_model(self, &q, kind, self.springs == 0.0))
+    }
+
+    /// Newton along spring stiffness `0 -> self.springs`, halving steps that fail.
+    fn spring_homotopy(&self, mut q: Vec<f64>) -> Option<Vec<f64>> {
+        let mut at: f64 = 0.0;
+        let mut step: f64 = 0.125;
+        while at < 1.0 {
+            let next = (at + step).min(1.0);
+            let mut sc = self.clone();
+            sc.springs = self.springs * next;
+            match newton_static(&sc, &q) {
+                // a continuation step must not jump to another winding of the springs
+                Some(qn) if qn.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1.0) => {
+                    q = qn;
+                    at = next;
+                    step = (step * 2.0).min(0.25);
+                }
+                _ => {
+                    step /= 2.0;
+                    if step < 1e-3 {
+                        return None;
+                    }
+                }
+            }
+        }
+        Some(q)
     }
 
     /// `(Omega(t), Omega'(t), theta(t))`, with `theta(0) = 0`.
@@ -146,16 +311,175 @@ impl Scene {
         }
     }
 
+    /// Index of the first ball angle in `q`.
+    #[inline]
+    fn off(&self) -> usize {
+        if self.tilt.is_some() {
+            4
+        } else {
+            2
+        }
+    }
+
     /// Spring spacing of spring `j` (ball j to ball j + 1, the last one closing the ring).
     #[inline]
     fn spacing(&self, q: &[f64], j: usize) -> f64 {
         let n = self.planar.n_balls();
+        let o = self.off();
         let rest = 2.0 * PI / n as f64;
         if j + 1 < n {
-            q[3 + j] - q[2 + j] - rest
+            q[o + 1 + j] - q[o + j] - rest
         } else {
-            q[2] + 2.0 * PI - q[2 + j] - rest
+            q[o] + 2.0 * PI - q[o + j] - rest
         }
+    }
+
+    fn add_springs(&self, q: &[f64], out: &mut [f64]) {
+        let p = &self.planar;
+        let (n, o) = (p.n_balls(), self.off());
+        let kd = self.springs * p.delta * p.delta;
+        for j in 0..n {
+            let f = kd * self.spacing(q, j);
+            let b = (j + 1) % n;
+            // dV/db_j = -k s_j, dV/db_{j+1} = +k s_j
+            out[o + j] -= f / p.m(j);
+            out[o + b] += f / p.m(b);
+        }
+    }
+
+    fn add_spring_jacobian(&self, k: &mut [f64]) {
+        let p = &self.planar;
+        let (n, o, d) = (p.n_balls(), self.off(), self.ndof());
+        let kd = self.springs * p.delta * p.delta;
+        for jj in 0..n {
+            let b = (jj + 1) % n;
+            let (ra, rb) = (o + jj, o + b);
+            // Hessian of kd/2 (b_b - b_a - rest)^2, rows divided by the ball's m.
+            let (ma, mb) = (p.m(jj), p.m(b));
+            k[ra * d + ra] += kd / ma;
+            k[ra * d + rb] -= kd / ma;
+            k[rb * d + rb] += kd / mb;
+            k[rb * d + ra] -= kd / mb;
+        }
+    }
+
+    /// The seed-002 load on the disk centre, turned into the rotating frame.
+    fn add_load(&self, t: f64, th: f64, out: &mut [f64]) {
+        let (lx, ly) = self.load(t);
+        if lx != 0.0 || ly != 0.0 {
+            let (sn, cs) = th.sin_cos();
+            out[0] -= cs * lx + sn * ly;
+            out[1] -= -sn * lx + cs * ly;
+        }
+    }
+
+    /// One ball's `(x, y, A, B, b_i)` slice of a tilting state.
+    #[inline]
+    fn ball_view(x: &[f64], i: usize) -> [f64; 5] {
+        [x[0], x[1], x[2], x[3], x[4 + i]]
+    }
+
+    fn tilt_residual(
+        &self,
+        c: &RotorConsts,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        out: &mut [f64],
+    ) {
+        let p = &self.planar;
+        let spin = self.spin(t);
+        rotor_residual(c, spin, q, v, a, out);
+        let mut r = [0.0; 5];
+        for i in 0..p.n_balls() {
+            let (qb, vb, ab) = (
+                Self::ball_view(q, i),
+                Self::ball_view(v, i),
+                Self::ball_view(a, i),
+            );
+            ball_residual(c, p.zeta_b[i], spin, &qb, &vb, &ab, &mut r);
+            let mi = p.m(i);
+            for (o, ri) in out[..4].iter_mut().zip(&r[..4]) {
+                *o += mi * ri;
+            }
+            out[4 + i] = r[4];
+        }
+        if self.springs > 0.0 {
+            self.add_springs(q, out);
+        }
+        self.add_load(t, spin.2, out);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn tilt_jacobians(
+        &self,
+        cn: &RotorConsts,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        let p = &self.planar;
+        let d = self.ndof();
+        let spin = self.spin(t);
+        k.fill(0.0);
+        c.fill(0.0);
+        m.fill(0.0);
+        let (mut rk, mut rc, mut rm) = ([0.0; 16], [0.0; 16], [0.0; 16]);
+        rotor_jacobians(cn, spin, q, v, a, &mut rk, &mut rc, &mut rm);
+        for i in 0..4 {
+            for j in 0..4 {
+                k[i * d + j] = rk[i * 4 + j];
+                c[i * d + j] = rc[i * 4 + j];
+                m[i * d + j] = rm[i * 4 + j];
+            }
+        }
+        let (mut bk, mut bc, mut bm) = ([0.0; 25], [0.0; 25], [0.0; 25]);
+        for i in 0..p.n_balls() {
+            let (qb, vb, ab) = (
+                Self::ball_view(q, i),
+                Self::ball_view(v, i),
+                Self::ball_view(a, i),
+            );
+            ball_jacobians(
+                cn,
+                p.zeta_b[i],
+                spin,
+                &qb,
+                &vb,
+                &ab,
+                &mut bk,
+                &mut bc,
+                &mut bm,
+            );
+            let mi = p.m(i);
+            let idx = [0, 1, 2, 3, 4 + i];
+            for (r, &row) in idx.iter().enumerate() {
+                let scale = if r < 4 { mi } else { 1.0 };
+                for (s, &col) in idx.iter().enumerate() {
+                    k[row * d + col] += scale * bk[r * 5 + s];
+                    c[row * d + col] += scale * bc[r * 5 + s];
+                    m[row * d + col] += scale * bm[r * 5 + s];
+                }
+            }
+        }
+        if self.springs > 0.0 {
+            self.add_spring_jacobian(k);
+        }
+    }
+
+    /// The tilting model's mass matrix `dF/da` (it depends on `q` only).
+    fn tilt_mass(&self, t: f64, q: &[f64]) -> DMatrix<f64> {
+        let d = self.ndof();
+        let z = vec![0.0; d];
+        let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        let cn = self.consts.as_ref().expect("tilting scene");
+        self.tilt_jacobians(cn, t, q, &z, &z, &mut k, &mut c, &mut m);
+        DMatrix::from_row_slice(d, d, &m)
     }
 
     fn add_effects(&self, t: f64, q: &[f64], out: &mut [f64]) {
@@ -175,25 +499,15 @@ impl Scene {
             }
         }
         if self.springs > 0.0 {
-            let kd = self.springs * p.delta * p.delta;
-            for j in 0..n {
-                let f = kd * self.spacing(q, j);
-                let b = (j + 1) % n;
-                // dV/db_j = -k s_j, dV/db_{j+1} = +k s_j
-                out[2 + j] -= f / p.m(j);
-                out[2 + b] += f / p.m(b);
-            }
+            self.add_springs(q, out);
         }
-        let (lx, ly) = self.load(t);
-        if self.gravity != 0.0 || lx != 0.0 || ly != 0.0 {
+        self.add_load(t, th, out);
+        if self.gravity != 0.0 {
             let (sn, cs) = th.sin_cos();
-            let (fx, fy) = (lx, ly - self.gravity);
-            out[0] -= cs * fx + sn * fy;
-            out[1] -= -sn * fx + cs * fy;
-            if self.gravity != 0.0 {
-                for i in 0..n {
-                    out[2 + i] += self.gravity * (th + q[2 + i]).cos();
-                }
+            out[0] += sn * self.gravity;
+            out[1] += cs * self.gravity;
+            for i in 0..n {
+                out[2 + i] += self.gravity * (th + q[2 + i]).cos();
             }
         }
     }
@@ -201,10 +515,17 @@ impl Scene {
 
 impl Dynamics for Scene {
     fn ndof(&self) -> usize {
-        self.planar.ndof()
+        self.planar.ndof() + if self.tilt.is_some() { 2 } else { 0 }
+    }
+
+    fn first_ball(&self) -> usize {
+        self.off()
     }
 
     fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+        if let Some(c) = &self.consts {
+            return self.tilt_residual(c, t, q, v, a, out);
+        }
         let (om, _, _) = self.spin(t);
         self.planar.forces_at(om, q, v, out);
         self.planar.add_inertia(q, a, out);
@@ -221,6 +542,9 @@ impl Dynamics for Scene {
         c: &mut [f64],
         m: &mut [f64],
     ) {
+        if let Some(cn) = &self.consts {
+            return self.tilt_jacobians(cn, t, q, v, a, k, c, m);
+        }
         let p = &self.planar;
         let (om, dom, th) = self.spin(t);
         p.jacobians_at(om, q, v, a, k, c, m);
@@ -241,17 +565,7 @@ impl Dynamics for Scene {
             }
         }
         if self.springs > 0.0 {
-            let kd = self.springs * p.delta * p.delta;
-            for jj in 0..n {
-                let b = (jj + 1) % n;
-                let (ra, rb) = (2 + jj, 2 + b);
-                // Hessian of kd/2 (b_b - b_a - rest)^2, rows divided by the ball's m.
-                let (ma, mb) = (p.m(jj), p.m(b));
-                k[ra * d + ra] += kd / ma;
-                k[ra * d + rb] -= kd / ma;
-                k[rb * d + rb] += kd / mb;
-                k[rb * d + ra] -= kd / mb;
-            }
+            self.add_spring_jacobian(k);
         }
         if self.gravity != 0.0 {
             for i in 0..n {
@@ -262,11 +576,25 @@ impl Dynamics for Scene {
     }
 
     fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]) {
-        self.planar.solve_mass(t, q, rhs);
+        if self.tilt.is_none() {
+            return self.planar.solve_mass(t, q, rhs);
+        }
+        let lu = self.tilt_mass(t, q).lu();
+        let mut b = nalgebra::DVector::from_column_slice(rhs);
+        // M is the kinetic-energy Hessian with rows scaled: never singular.
+        lu.solve_mut(&mut b);
+        rhs.copy_from_slice(b.as_slice());
     }
 
     fn solve_mass_columns(&self, t: f64, q: &[f64], cols: &mut [f64]) {
-        self.planar.solve_mass_columns(t, q, cols);
+        if self.tilt.is_none() {
+            return self.planar.solve_mass_columns(t, q, cols);
+        }
+        let d = self.ndof();
+        let lu = self.tilt_mass(t, q).lu();
+        let mut b = DMatrix::from_column_slice(d, cols.len() / d, cols);
+        lu.solve_mut(&mut b);
+        cols.copy_from_slice(b.as_slice());
     }
 
     fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
@@ -283,7 +611,7 @@ impl Dynamics for Scene {
         for o in out.iter_mut() {
             *o = -*o;
         }
-        self.planar.solve_mass(t, q, out);
+        self.solve_mass(t, q, out);
     }
 
     fn time_dependence(&self) -> Option<String> {
@@ -334,7 +662,7 @@ mod tests {
             sharpness: 3.0,
             angle: 0.4,
         });
-        let s = Scene::new(p.clone(), 0.0, ramp, 0.0, imp).unwrap();
+        let s = Scene::new(p.clone(), 0.0, ramp, 0.0, imp, None).unwrap();
         let (mut r1, mut r2) = ([0.0; 5], [0.0; 5]);
         for t in [0.0, 1.0, 2.5, 7.0] {
             p.residual(t, &q, &v, &a, &mut r1);
@@ -345,9 +673,8 @@ mod tests {
         }
     }
 
-    #[test]
-    fn jacobians_match_finite_differences() {
-        let s = Scene::new(
+    fn all_effects(tilt: Option<Tilt>) -> Scene {
+        Scene::new(
             planar(),
             0.3,
             Some(Ramp {
@@ -362,35 +689,36 @@ mod tests {
                 sharpness: 2.0,
                 angle: 0.3,
             }),
+            tilt,
         )
-        .unwrap();
-        let (q, v, a) = state();
+        .unwrap()
+    }
+
+    fn tilt() -> Tilt {
+        Tilt {
+            a: 1.5,
+            b: 2.5,
+            j_t: 0.3,
+            j_z: 0.5,
+            zeta_r: 0.05,
+        }
+    }
+
+    fn check_jacobians(s: &Scene, q: &[f64], v: &[f64], a: &[f64]) {
         let t = 0.8;
-        let d = 5;
-        let (mut k, mut c, mut m) = (vec![0.0; 25], vec![0.0; 25], vec![0.0; 25]);
-        s.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
-        let h = 1e-6;
+        let d = s.ndof();
+        let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        s.jacobians(t, q, v, a, &mut k, &mut c, &mut m);
+        let h = 1e-5;
         for (which, jac) in [(0, &k), (1, &c), (2, &m)] {
             for j in 0..d {
-                let (mut qp, mut vp, mut ap) = (q, v, a);
-                let (mut qm, mut vm, mut am) = (q, v, a);
-                match which {
-                    0 => {
-                        qp[j] += h;
-                        qm[j] -= h;
-                    }
-                    1 => {
-                        vp[j] += h;
-                        vm[j] -= h;
-                    }
-                    _ => {
-                        ap[j] += h;
-                        am[j] -= h;
-                    }
-                }
-                let (mut rp, mut rm) = ([0.0; 5], [0.0; 5]);
-                s.residual(t, &qp, &vp, &ap, &mut rp);
-                s.residual(t, &qm, &vm, &am, &mut rm);
+                let mut plus = [q.to_vec(), v.to_vec(), a.to_vec()];
+                let mut minus = plus.clone();
+                plus[which][j] += h;
+                minus[which][j] -= h;
+                let (mut rp, mut rm) = (vec![0.0; d], vec![0.0; d]);
+                s.residual(t, &plus[0], &plus[1], &plus[2], &mut rp);
+                s.residual(t, &minus[0], &minus[1], &minus[2], &mut rm);
                 for i in 0..d {
                     let fd = (rp[i] - rm[i]) / (2.0 * h);
                     assert!(
@@ -404,6 +732,66 @@ mod tests {
     }
 
     #[test]
+    fn jacobians_match_finite_differences() {
+        let (q, v, a) = state();
+        check_jacobians(&all_effects(None), &q, &v, &a);
+    }
+
+    #[test]
+    fn tilting_jacobians_match_finite_differences() {
+        let q = [0.3, -0.2, 0.8, -0.6, 0.7, -1.9, 2.4];
+        let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
+        let a = [0.05, -0.3, 0.2, -0.1, 0.2, 0.6, -0.1];
+        check_jacobians(&all_effects(Some(tilt())), &q, &v, &a);
+    }
+
+    #[test]
+    fn centred_disk_started_flat_is_the_planar_model() {
+        // a = b: no translation-tilt coupling, and nothing else tilts a flat disk.
+        let centred = Tilt {
+            a: 2.0,
+            b: 2.0,
+            ..tilt()
+        };
+        let (flat, tilting) = (all_effects(None), all_effects(Some(centred)));
+        let (q, v, a) = state();
+        let widen = |z: &[f64; 5]| vec![z[0], z[1], 0.0, 0.0, z[2], z[3], z[4]];
+        let (mut r1, mut r2) = ([0.0; 5], [0.0; 7]);
+        for t in [0.0, 0.4, 2.5] {
+            flat.residual(t, &q, &v, &a, &mut r1);
+            tilting.residual(t, &widen(&q), &widen(&v), &widen(&a), &mut r2);
+            let back = [r2[0], r2[1], r2[4], r2[5], r2[6]];
+            for (x, y) in r1.iter().zip(&back) {
+                assert!((x - y).abs() < 1e-12 * (1.0 + x.abs()), "{r1:?} {r2:?}");
+            }
+            assert!(r2[2].abs() < 1e-12 && r2[3].abs() < 1e-12, "{r2:?}");
+        }
+    }
+
+    #[test]
+    fn tilt_stiffness_is_beam_theory() {
+        // disk at mid-span of length L: k = 48 EI / L^3, k_phiphi = 12 EI / L
+        let t = Tilt {
+            a: 2.0,
+            b: 2.0,
+            ..tilt()
+        };
+        let l: f64 = 4.0;
+        assert!(t.kappa_c().abs() < 1e-15);
+        assert!((t.kappa_t() - (12.0 / l) / (48.0 / l.powi(3))).abs() < 1e-12);
+        let e = Scene::new(
+            planar(),
+            0.0,
+            None,
+            0.0,
+            None,
+            Some(Tilt { j_z: 0.7, ..tilt() }),
+        )
+        .unwrap_err();
+        assert!(e.to_string().starts_with("tilt.j_z"), "{e}");
+    }
+
+    #[test]
     fn spin_profile_is_continuous_and_integrates() {
         let s = Scene::new(
             planar(),
@@ -414,6 +802,7 @@ mod tests {
                 duration: 2.0,
             }),
             0.0,
+            None,
             None,
         )
         .unwrap();
@@ -430,17 +819,17 @@ mod tests {
 
     #[test]
     fn bad_effect_parameters_name_themselves() {
-        let e = Scene::new(planar(), -1.0, None, 0.0, None).unwrap_err();
+        let e = Scene::new(planar(), -1.0, None, 0.0, None, None).unwrap_err();
         assert!(e.to_string().starts_with("springs"), "{e}");
         let one = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.3, &[1.0]).unwrap();
-        let e = Scene::new(one, 0.5, None, 0.0, None).unwrap_err();
+        let e = Scene::new(one, 0.5, None, 0.0, None, None).unwrap_err();
         assert!(e.to_string().starts_with("springs"), "{e}");
         let r = Some(Ramp {
             to: 1.0,
             start: 0.0,
             duration: 0.0,
         });
-        let e = Scene::new(planar(), 0.0, r, 0.0, None).unwrap_err();
+        let e = Scene::new(planar(), 0.0, r, 0.0, None, None).unwrap_err();
         assert!(e.to_string().starts_with("ramp.duration"), "{e}");
     }
 }

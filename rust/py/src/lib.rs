@@ -2,7 +2,7 @@
 //! numerical work and turns core errors into `ValueError`; a Rust panic is caught and
 //! raised as `RuntimeError` so that it never unwinds into Python.
 
-use ballbal_core::equilibria::equilibria as core_equilibria;
+use ballbal_core::equilibria::{equilibria as core_equilibria, equilibria_of, Equilibrium};
 use ballbal_core::floquet::FloquetOptions;
 use ballbal_core::hb::{HbOptions, HbSolution, Status};
 use ballbal_core::ode::Options;
@@ -58,17 +58,19 @@ fn planar(
 }
 
 /// Effects of a scene: `(springs, ramp (to, start, duration), gravity, impulse
-/// (amplitude, t0, sharpness, angle))`; `None` for the plain planar balancer.
+/// (amplitude, t0, sharpness, angle), tilt (a, b, j_t, j_z, zeta_r))`; `None` for the
+/// plain planar balancer.
 type Effects = Option<(
     f64,
     Option<(f64, f64, f64)>,
     f64,
     Option<(f64, f64, f64, f64)>,
+    Option<(f64, f64, f64, f64, f64)>,
 )>;
 
 fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
-    use ballbal_core::scene::{Impulse, Ramp};
-    let Some((springs, ramp, gravity, impulse)) = effects else {
+    use ballbal_core::scene::{Impulse, Ramp, Tilt};
+    let Some((springs, ramp, gravity, impulse, tilt)) = effects else {
         return Ok(None);
     };
     Scene::new(
@@ -85,6 +87,13 @@ fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
             t0,
             sharpness,
             angle,
+        }),
+        tilt.map(|(a, b, j_t, j_z, zeta_r)| Tilt {
+            a,
+            b,
+            j_t,
+            j_z,
+            zeta_r,
         }),
     )
     .map(Some)
@@ -164,18 +173,61 @@ fn equilibria<'py>(
     effects: Effects,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
-    if autonomous_scene(&p, effects, "equilibria")?.is_some() {
+    let sc = autonomous_scene(&p, effects, "equilibria")?;
+    if sc.as_ref().is_some_and(|s| s.springs > 0.0) {
         // Newton finds them (equilibria_of), but with springs angles that differ by whole
         // turns are different spring windings, many of them balls passing each other:
         // that needs ordered starts and a winding-aware identity first.
         return Err(PyValueError::new_err(
-            "springs: equilibria of scenes with ball springs are not available yet \
-             (time simulation and periodic solutions are)",
+            "springs: the full set of equilibria of scenes with ball springs is not \
+             available yet; balanced_state() gives the balanced one",
         ));
     }
-    let eqs = guarded(py, || Ok(core_equilibria(&p)))?;
-    let mut out = vec![];
-    for e in eqs {
+    let equal = p.eta.windows(2).all(|w| w[0] == w[1]);
+    let eqs = guarded(py, || {
+        Ok(match &sc {
+            Some(s) if s.tilt.is_some() => equilibria_of(s, equal, true),
+            _ => core_equilibria(&p),
+        })
+    })?;
+    eqs.into_iter().map(|e| equilibrium_dict(py, e)).collect()
+}
+
+/// The balanced state of each scene (planar parameters, effects), in parallel: a dict
+/// like `equilibria`'s, or `None` where the balls cannot balance the disk.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn balanced_states<'py>(
+    py: Python<'py>,
+    points: Vec<((f64, f64, Vec<f64>, f64, f64, Vec<f64>), Effects)>,
+) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
+    use rayon::prelude::*;
+    let mut scenes = Vec::with_capacity(points.len());
+    for ((mu, zeta, zeta_b, delta, omega, eta), effects) in points {
+        let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+        let sc = match scene(&p, effects)? {
+            Some(s) => s,
+            None => Scene::new(p, 0.0, None, 0.0, None, None).map_err(to_py)?,
+        };
+        require_autonomous(&sc)
+            .map_err(|e| PyValueError::new_err(format!("balanced_state: {e}")))?;
+        scenes.push(sc);
+    }
+    // Each point is solved on its own from the planar perfect balance, so the result
+    // does not depend on the thread count.
+    let eqs = guarded(py, || {
+        Ok(scenes
+            .par_iter()
+            .map(|s| s.balanced_state())
+            .collect::<Vec<_>>())
+    })?;
+    eqs.into_iter()
+        .map(|e| e.map(|e| equilibrium_dict(py, e)).transpose())
+        .collect()
+}
+
+fn equilibrium_dict(py: Python<'_>, e: Equilibrium) -> PyResult<Bound<'_, PyDict>> {
+    {
         let d = PyDict::new(py);
         d.set_item("kind", e.kind)?;
         d.set_item("q", PyArray1::from_vec(py, e.q))?;
@@ -193,14 +245,14 @@ fn equilibria<'py>(
         d.set_item("neutral", e.neutral)?;
         d.set_item("routh_hurwitz", e.routh_hurwitz)?;
         d.set_item("char_poly", PyArray1::from_vec(py, e.char_poly))?;
-        out.push(d);
+        Ok(d)
     }
-    Ok(out)
 }
 
 fn solution_dict<'py>(
     py: Python<'py>,
     r: ballbal_core::periodic::Periodic,
+    n_balls: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("target_met", r.target_met)?;
@@ -220,7 +272,7 @@ fn solution_dict<'py>(
     d.set_item("tail", s.tail_ratio())?;
     let ok = s.status == Status::Converged;
     d.set_item("status", s.status.as_str())?;
-    d.set_item("type", pattern_string(&s.winding))?;
+    d.set_item("type", pattern_string(&s.winding, n_balls))?;
     d.set_item("omega", if ok { Some(s.omega) } else { None })?;
     d.set_item("last_omega", s.omega)?;
     let l = 2 * s.n_harm + 1;
@@ -393,13 +445,16 @@ fn periodic<'py>(
         n_max,
         hill,
     )?;
-    let d = p.ndof();
+    let (d, o) = match &sc {
+        Some(s) => (s.ndof(), s.first_ball()),
+        None => (p.ndof(), 2),
+    };
     let guess = match (guess_omega, guess_coeffs) {
         (Some(w), Some(c)) => {
             let c = slice(&c, "guess coefficients")?.to_vec();
             if c.len() % d != 0 || (c.len() / d) % 2 != 1 {
                 return Err(PyValueError::new_err(format!(
-                    "guess coefficients: need shape (n + 2, 2 N + 1) = ({d}, odd), got {} values",
+                    "guess coefficients: need shape (coordinates, 2 N + 1) = ({d}, odd), got {} values",
                     c.len()
                 )));
             }
@@ -410,7 +465,7 @@ fn periodic<'py>(
             }
             let mut winding = vec![0.0; d];
             for (i, &r) in rotating.iter().enumerate() {
-                winding[2 + i] = if r { -1.0 } else { 0.0 };
+                winding[o + i] = if r { -1.0 } else { 0.0 };
             }
             let nh = (c.len() / d - 1) / 2;
             Some(HbSolution::start(w, c, winding, nh, Status::NoGuess))
@@ -428,7 +483,7 @@ fn periodic<'py>(
             Some(sc) => core_periodic(sc, &rotating, guess.as_ref(), &opts),
         })
     })?;
-    solution_dict(py, r)
+    solution_dict(py, r, p.n_balls())
 }
 
 /// The "NI" check: max distance after one simulated period from the orbit's own state.
@@ -740,6 +795,7 @@ fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(equilibria, m)?)?;
+    m.add_function(wrap_pyfunction!(balanced_states, m)?)?;
     m.add_function(wrap_pyfunction!(periodic, m)?)?;
     m.add_function(wrap_pyfunction!(orbit_closure, m)?)?;
     m.add_function(wrap_pyfunction!(scan, m)?)?;

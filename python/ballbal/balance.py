@@ -1,0 +1,104 @@
+"""The balanced state of a scene and where it is stable (seed 004's stability maps)."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+from . import _native
+from .analysis import Equilibrium, _equilibrium
+from .model import Balancer
+from .scene import Scene
+
+
+def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
+    """The equilibrium that continues the planar perfect balance to ``model``, with its
+    eigenvalues and stability; ``None`` if the balls cannot balance the disk.
+
+    Without springs it is the perfect balance (``x = y = 0``, a flat disk). Springs whose
+    rest spacing is not the balancing spacing leave a nearly balanced state whose
+    residual whirl is ``hypot(x, y)`` (in units of ``e``); it is followed from zero
+    spring stiffness. Needs an autonomous scene."""
+    d = _native.balanced_states([(model.native_args(), model.native_effects())])[0]
+    return None if d is None else _equilibrium(d)
+
+
+def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -> pl.DataFrame:
+    """The balanced state's stability over a grid: one row per point of the product of
+    ``axes`` (parameter name = values; balancer fields such as ``Omega``, ``eta``,
+    ``zeta_b``, ``zeta``, the scene's ``springs`` and tilt fields ``j_t``, ``j_z``,
+    ``zeta_r``, ``a``, ``b``). Points are solved in parallel in the core, each on its own,
+    so the table does not depend on the thread count.
+
+    Columns: the axes, ``status`` (``"ok"`` or ``"no_balance"``), ``stability``,
+    ``index`` (largest real part of the eigenvalues, seed 001's relative-stability
+    index), ``whirl`` (residual ``hypot(x, y)``), ``tilt`` (residual ``hypot(A, B)``,
+    0 for a planar disk), ``residual`` (of the equilibrium equations)."""
+    if not axes:
+        raise ValueError("axes: give at least one parameter to vary, e.g. Omega=[...]")
+    scene = model if isinstance(model, Scene) else Scene(balancer=model)
+    names = list(axes)
+    values: list[list[float]] = []
+    for name in names:
+        v = np.atleast_1d(np.asarray(axes[name], dtype=float))
+        if v.ndim != 1 or v.size == 0 or not np.all(np.isfinite(v)):
+            raise ValueError(f"{name}: needs a non-empty list of finite numbers")
+        values.append([float(x) for x in v])
+    points: list[Any] = []
+    grid = list(itertools.product(*values))
+    for combo in grid:
+        try:
+            sc = scene.replace(**dict(zip(names, combo, strict=True)))
+        except TypeError as e:
+            raise ValueError(f"axes: {e}; allowed: balancer fields, springs, tilt fields") from e
+        points.append((sc.native_args(), sc.native_effects()))
+    results = _native.balanced_states(points)
+    n_rotor = len(scene.coordinates) - scene.n_balls
+    cols: dict[str, list[Any]] = {n: [] for n in names}
+    for key in ("status", "stability", "index", "whirl", "tilt", "residual"):
+        cols[key] = []
+    for combo, d in zip(grid, results, strict=True):
+        for n, v in zip(names, combo, strict=True):
+            cols[n].append(v)
+        if d is None:
+            for key in ("stability", "index", "whirl", "tilt", "residual"):
+                cols[key].append(None)
+            cols["status"].append("no_balance")
+            continue
+        q = d["q"]
+        cols["status"].append("ok")
+        cols["stability"].append(d["stability"])
+        cols["index"].append(float(d["index"]))
+        cols["whirl"].append(float(np.hypot(q[0], q[1])))
+        cols["tilt"].append(float(np.hypot(q[2], q[3])) if n_rotor == 4 else 0.0)
+        cols["residual"].append(float(d["residual"]))
+    schema = {n: pl.Float64 for n in names} | {
+        "status": pl.String, "stability": pl.String, "index": pl.Float64,
+        "whirl": pl.Float64, "tilt": pl.Float64, "residual": pl.Float64}
+    return pl.DataFrame(cols, schema=schema)
+
+
+def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: str = "") -> Any:
+    """Stable balanced region of a :func:`balance_map` in the ``(x, y)`` plane: filled
+    where stable, hatched where no balance exists."""
+    import matplotlib.pyplot as plt
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5, 4))
+    xs = np.unique(df[x].to_numpy())
+    ys = np.unique(df[y].to_numpy())
+    grid = np.full((ys.size, xs.size), np.nan)
+    for row in df.iter_rows(named=True):
+        i, j = np.searchsorted(ys, row[y]), np.searchsorted(xs, row[x])
+        grid[i, j] = {"stable": 1.0, "unstable": 0.0}.get(row["stability"] or "", np.nan)
+    ax.contourf(xs, ys, grid, levels=[0.5, 1.5], colors=["tab:green"], alpha=0.35)
+    ax.contour(xs, ys, grid, levels=[0.5], colors=["tab:green"])
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    if label:
+        ax.set_title(label)
+    return ax
