@@ -27,5 +27,6 @@ stamp "install $(basename "$wheel") into a clean venv"
 
 stamp "pytest against the installed package"
 cp -r tests "$work/tests"
+export BALLBAL_REPO="$root"
 cd "$work"
 "$work/venv/bin/python" -m pytest -q -p no:cacheprovider tests "$@"

@@ -210,6 +210,11 @@ def test_scene_files_round_trip(tmp_path):
     ("[balancer]\neta = [1.0]\n[springs]\nstiffness = 0.1\n", "springs"),
     ("mu = 0.2\n[balancer]\nzeta = 0.1\n", "outside a table"),
     ("mu = = 1\n", "not valid TOML"),
+    ("[balancer]\nmu = 0.2\n[tilt]\na = 1.0\nb = 2.0\nj_t = 0.3\nj_z = 0.7\n", "tilt.j_z"),
+    ("[balancer]\nmu = 0.2\n[tilt]\na = 0.0\nb = 2.0\nj_t = 0.3\nj_z = 0.1\n", "tilt.a"),
+    ("[balancer]\nmu = 0.2\n[tilt]\na = 1.0\nb = 2.0\nj_t = 0.3\n", "incomplete"),
+    ("[balancer]\nmu = 0.2\n[tilt]\na = 1.0\nb = 2.0\nj_t = 0.3\nj_z = 0.1\nJ = 1\n",
+     "tilt: unknown key"),
 ])
 def test_malformed_scene_files_say_what_is_wrong(tmp_path, text, message):
     p = tmp_path / "bad.toml"
@@ -221,10 +226,12 @@ def test_malformed_scene_files_say_what_is_wrong(tmp_path, text, message):
 values = st.one_of(st.floats(allow_nan=True), st.integers(-3, 3), st.text(max_size=3),
                    st.booleans(), st.lists(st.floats(0.1, 2.0), max_size=3))
 keys = st.sampled_from(["mu", "zeta", "zeta_b", "delta", "Omega", "eta", "balls", "k", "x"])
-tables = st.sampled_from(["springs", "ramp", "gravity", "impulse", "balancer", "bearing"])
+tables = st.sampled_from(["springs", "ramp", "gravity", "impulse", "tilt", "balancer",
+                          "bearing"])
 inner = st.dictionaries(st.sampled_from(["stiffness", "to", "start", "duration", "g",
-                                         "amplitude", "t0", "sharpness", "angle", "mu", "q"]),
-                        values, max_size=4)
+                                         "amplitude", "t0", "sharpness", "angle", "a", "b",
+                                         "j_t", "j_z", "zeta_r", "mu", "q"]),
+                        values, max_size=5)
 
 
 @settings(max_examples=150, deadline=None)

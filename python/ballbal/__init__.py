@@ -13,7 +13,13 @@ from .balance import balance_map, balanced_state, plot_balance_map
 from .model import Balancer, from_seed003, zeta_from_log_decrement
 from .scan import ScanInterrupted, read_scan, scan, scan_meta
 from .scene import Impulse, Ramp, Scene, Tilt, load_scene
-from .transient import DisturbanceResponse, disturbance_response, track_damping_study
+from .transient import (
+    DisturbanceResponse,
+    RunUp,
+    disturbance_response,
+    run_up,
+    track_damping_study,
+)
 
 __all__ = [
     "Balancer",
@@ -23,6 +29,7 @@ __all__ = [
     "ScanInterrupted",
     "PeriodicSolution",
     "Ramp",
+    "RunUp",
     "Scene",
     "Tilt",
     "__version__",
@@ -37,6 +44,7 @@ __all__ = [
     "plot_accuracy_cost",
     "plot_balance_map",
     "read_scan",
+    "run_up",
     "scan",
     "scan_meta",
     "simulate",

@@ -34,7 +34,9 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     ``zeta_r``, ``a``, ``b``). Points are solved in parallel in the core, each on its own,
     so the table does not depend on the thread count.
 
-    Columns: the axes, ``status`` (``"ok"`` or ``"no_balance"``), ``stability``,
+    Columns: the axes, ``status`` (``"ok"``; ``"no_balance"`` where the balls cannot
+    balance the disk; ``"not_converged"`` where the continuation from the planar
+    balancer's perfect balance failed, e.g. springs near the critical speed), ``stability``,
     ``index`` (largest real part of the eigenvalues, seed 001's relative-stability
     index), ``whirl`` (residual ``hypot(x, y)``), ``tilt`` (residual ``hypot(A, B)``,
     0 for a planar disk), ``residual`` (of the equilibrium equations)."""
@@ -57,17 +59,21 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
             raise ValueError(f"axes: {e}; allowed: balancer fields, springs, tilt fields") from e
         points.append((sc.native_args(), sc.native_effects()))
     results = _native.balanced_states(points)
+    # Tell "the balls cannot balance the disk" from "the continuation to this scene failed".
+    missing = [i for i, d in enumerate(results) if d is None]
+    planar_ok = _native.balanced_states([(points[i][0], None) for i in missing])
+    failed = {i for i, d in zip(missing, planar_ok, strict=True) if d is not None}
     n_rotor = len(scene.coordinates) - scene.n_balls
     cols: dict[str, list[Any]] = {n: [] for n in names}
     for key in ("status", "stability", "index", "whirl", "tilt", "residual"):
         cols[key] = []
-    for combo, d in zip(grid, results, strict=True):
+    for i, (combo, d) in enumerate(zip(grid, results, strict=True)):
         for n, v in zip(names, combo, strict=True):
             cols[n].append(v)
         if d is None:
             for key in ("stability", "index", "whirl", "tilt", "residual"):
                 cols[key].append(None)
-            cols["status"].append("no_balance")
+            cols["status"].append("not_converged" if i in failed else "no_balance")
             continue
         q = d["q"]
         cols["status"].append("ok")

@@ -4,7 +4,7 @@ time to settle inside a band, and the track damping that trades the two off."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -102,3 +102,58 @@ def track_damping_study(
     df = df.with_columns(index=pl.col("peak") * scale + pl.col("settle_time"))
     best = df["index"].arg_min()
     return df.with_columns(optimal=pl.Series([i == best for i in range(df.height)]))
+
+
+@dataclass(frozen=True)
+class RunUp:
+    """A run-up transient: peak and final whirl ``hypot(x, y)`` (units of ``e``) and, for
+    a tilting disk, peak and final tilt ``hypot(A, B)`` (units of ``e / r_t``; radians
+    are these over ``delta``); ``peak_Omega`` is the spin at the peak whirl."""
+
+    peak_whirl: float
+    peak_Omega: float
+    final_whirl: float
+    peak_tilt: float
+    final_tilt: float
+    trajectory: pl.DataFrame
+
+
+def run_up(
+    scene: Scene,
+    to: float,
+    duration: float,
+    *,
+    balls: Sequence[float] | None = None,
+    settle: float = 600.0,
+    dt: float = 0.5,
+    rtol: float = 1e-8,
+) -> RunUp:
+    """Spin the scene's rotor up from ``scene.Omega`` to ``to`` over ``duration`` (seed
+    004's run-up) and measure the whirl and tilt. The rotor starts centred and flat, the
+    balls at rest relative to the disk at angles ``balls``, in track order (default:
+    spread over +-1 rad about the unbalance, where a classic balancer's balls make the
+    resonance worst)."""
+    if not duration > 0:
+        raise ValueError(f"duration: must be > 0, got {duration}")
+    if not settle >= 0:
+        raise ValueError(f"settle: must be >= 0, got {settle}")
+    n = scene.n_balls
+    if balls is None:
+        balls = list(np.linspace(-1.0, 1.0, n)) if n > 1 else [1.0]
+    if len(balls) != n:
+        raise ValueError(f"balls: needs {n} angles, got {len(balls)}")
+    sc = replace(scene, ramp=Ramp(to=to, start=0.0, duration=duration))
+    d = len(sc.coordinates)
+    y0 = np.zeros(2 * d)
+    y0[d - n : d] = balls
+    t = np.arange(0.0, duration + settle + dt / 2, dt)
+    df = simulate(sc, y0, t, rtol=rtol, atol=rtol * 1e-2)
+    r = np.hypot(df["x"].to_numpy(), df["y"].to_numpy())
+    if "A" in df.columns:
+        tilt = np.hypot(df["A"].to_numpy(), df["B"].to_numpy())
+    else:
+        tilt = np.zeros_like(r)
+    k = int(r.argmax())
+    om = scene.Omega + (to - scene.Omega) * min(t[k] / duration, 1.0)
+    return RunUp(peak_whirl=float(r[k]), peak_Omega=float(om), final_whirl=float(r[-1]),
+                 peak_tilt=float(tilt.max()), final_tilt=float(tilt[-1]), trajectory=df)

@@ -125,7 +125,13 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
         kind: kind.to_string(),
         q: q.iter()
             .enumerate()
-            .map(|(i, &v)| if i >= o { wrap(v) } else { v })
+            .map(|(i, &v)| {
+                if i >= o && p.angles_modulo_turns() {
+                    wrap(v)
+                } else {
+                    v
+                }
+            })
             .collect(),
         residual,
         eigenvalues: ev,

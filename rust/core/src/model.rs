@@ -55,6 +55,11 @@ pub trait Dynamics: Send + Sync {
     fn first_ball(&self) -> usize {
         2
     }
+    /// Whether ball angles that differ by whole turns are the same state (not so when
+    /// springs count the turns).
+    fn angles_modulo_turns(&self) -> bool {
+        true
+    }
 }
 
 /// Planar n-ball automatic balancer on an isotropic spring–damper support.

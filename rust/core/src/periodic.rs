@@ -131,7 +131,7 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     let mut t_prev = g.settle;
     let mut y_prev = ys.clone();
     let mut crossings: Vec<Vec<f64>> = vec![vec![]; n];
-    let start_b: Vec<f64> = ys[2..d].to_vec();
+    let start_b: Vec<f64> = ys[o..d].to_vec();
     let mut end_b = start_b.clone();
     let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
     let mut tmp = vec![0.0; 2 * d];
@@ -164,7 +164,7 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
                 t_prev = t;
                 t += dt;
             }
-            end_b.copy_from_slice(&y_prev[2..d]);
+            end_b.copy_from_slice(&y_prev[o..d]);
             // Enough turns of some ball to measure a period: a rotating motion.
             crossings.iter().all(|c| c.len() < need)
         },

@@ -522,6 +522,10 @@ impl Dynamics for Scene {
         self.off()
     }
 
+    fn angles_modulo_turns(&self) -> bool {
+        self.springs == 0.0
+    }
+
     fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
         if let Some(c) = &self.consts {
             return self.tilt_residual(c, t, q, v, a, out);
