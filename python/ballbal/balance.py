@@ -88,9 +88,11 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     return pl.DataFrame(cols, schema=schema)
 
 
-def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: str = "") -> Any:
-    """Stable balanced region of a :func:`balance_map` in the ``(x, y)`` plane: filled
-    where stable, hatched where no balance exists."""
+def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: str = "",
+                     max_whirl: float | None = None) -> Any:
+    """Stable balanced region of a :func:`balance_map` in the ``(x, y)`` plane, filled.
+    With ``max_whirl``, a stable state whose residual whirl exceeds it (springs at low
+    speed hold the balls apart without balancing) is drawn apart, in grey."""
     import matplotlib.pyplot as plt
 
     if ax is None:
@@ -100,9 +102,13 @@ def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: st
     grid = np.full((ys.size, xs.size), np.nan)
     for row in df.iter_rows(named=True):
         i, j = np.searchsorted(ys, row[y]), np.searchsorted(xs, row[x])
-        grid[i, j] = {"stable": 1.0, "unstable": 0.0}.get(row["stability"] or "", np.nan)
-    ax.contourf(xs, ys, grid, levels=[0.5, 1.5], colors=["tab:green"], alpha=0.35)
-    ax.contour(xs, ys, grid, levels=[0.5], colors=["tab:green"])
+        v = {"stable": 1.0, "unstable": 0.0}.get(row["stability"] or "", np.nan)
+        if v == 1.0 and max_whirl is not None and row["whirl"] > max_whirl:
+            v = 2.0
+        grid[i, j] = v
+    ax.contourf(xs, ys, grid, levels=[0.5, 1.5, 2.5], colors=["tab:green", "0.6"],
+                alpha=0.35)
+    ax.contour(xs, ys, np.where(grid == 1.0, 1.0, 0.0), levels=[0.5], colors=["tab:green"])
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     if label:

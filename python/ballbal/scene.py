@@ -172,8 +172,11 @@ class Scene:
 
     def replace(self, **changes: Any) -> Scene:
         """A copy with fields changed; balancer fields (``Omega``, ``eta``, ...) and tilt
-        fields (``j_t``, ``a``, ...) may be given directly."""
+        fields (``j_t``, ``a``, ...) may be given directly; a single ``eta`` sets every
+        ball's."""
         bal = {k: changes.pop(k) for k in list(changes) if k in _BALANCER_FIELDS}
+        if "eta" in bal and _is_number(bal["eta"]):
+            bal["eta"] = (bal["eta"],) * self.n_balls  # one value: every ball, as in scans
         tl = {k: changes.pop(k) for k in list(changes) if k in _TILT_FIELDS}
         if bal:
             changes["balancer"] = self.balancer.replace(**bal).validate()
