@@ -18,7 +18,7 @@ def simulate(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     y0: npt.NDArray[np.float64], t0: float, t_eval: npt.NDArray[np.float64], rtol: float,
     atol: list[float], effects: Effects = None,
-) -> tuple[npt.NDArray[np.float64], int, int, int]: ...
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
 def equilibria(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     effects: Effects = None,

@@ -42,7 +42,8 @@ def simulate(
     rest in the ground frame, balls spread over half the track. The
     state is given at ``t0`` (default ``t_span[0]``, else 0). Give output times ``t_eval``
     (strictly monotone, not before ``t0``) or ``t_span`` for 1001 evenly spaced outputs.
-    Returns columns ``t``, the state, and ``X, Y``: the disk centre in the fixed frame.
+    Returns columns ``t``, the state, ``theta`` (the disk's angle, 0 at t = 0) and ``X,
+    Y``: the disk centre in the fixed frame.
     """
     n = balancer.n_balls
     d = len(balancer.coordinates)
@@ -63,14 +64,14 @@ def simulate(
         raise ValueError("t_eval: must hold at least one time")
     if t0 is None:
         t0 = float(t_span[0]) if t_span is not None else 0.0
-    y, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol), _atol(atol),
-                             balancer.native_effects())
+    y, theta, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol),
+                                    _atol(atol), balancer.native_effects())
     cols: dict[str, Any] = {"t": t}
     for name, col in zip(_state_names(balancer), np.asarray(y).T, strict=True):
         cols[name] = col
-    ph = balancer.theta(t)
-    cols["X"] = cols["x"] * np.cos(ph) - cols["y"] * np.sin(ph)
-    cols["Y"] = cols["x"] * np.sin(ph) + cols["y"] * np.cos(ph)
+    cols["theta"] = theta
+    cols["X"] = cols["x"] * np.cos(theta) - cols["y"] * np.sin(theta)
+    cols["Y"] = cols["x"] * np.sin(theta) + cols["y"] * np.cos(theta)
     return pl.DataFrame(cols)
 
 

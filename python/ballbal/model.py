@@ -73,12 +73,6 @@ class Balancer:
         """A plain balancer has no effects (see :class:`ballbal.scene.Scene`)."""
         return None
 
-    def theta(self, t: Any) -> Any:
-        """The disk's angle at time(s) t."""
-        import numpy as np
-
-        return self.Omega * np.asarray(t, dtype=float)
-
     def replace(self, **changes: Any) -> Balancer:
         return replace(self, **changes)
 

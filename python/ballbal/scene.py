@@ -208,21 +208,6 @@ class Scene:
             return "impulse"
         return None
 
-    def theta(self, t: Any) -> Any:
-        """The disk's angle at time(s) t (0 at t = 0)."""
-        import numpy as np
-
-        t = np.asarray(t, dtype=float)
-        w0 = self.Omega
-        if self.ramp is None:
-            return w0 * t
-        r = self.ramp
-        rate = (r.to - w0) / r.duration
-        end = r.start + r.duration
-        u = np.clip(t - r.start, 0.0, r.duration)
-        after = np.maximum(t - end, 0.0)
-        return w0 * (t - after) + 0.5 * rate * u * u + r.to * after
-
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"balancer": asdict(self.balancer)}
         b = d["balancer"]

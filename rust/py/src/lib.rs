@@ -114,8 +114,8 @@ fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]
         .map_err(|_| PyValueError::new_err(format!("{name}: must be a contiguous float64 array")))
 }
 
-/// Integrates from `y0` and returns `(y, accepted_steps, rejected_steps, rhs_evals)`,
-/// `y` of shape `(len(t_eval), 2 (n + 2))`.
+/// Integrates from `y0` and returns `(y, theta, accepted_steps, rejected_steps,
+/// rhs_evals)`, `y` of shape `(len(t_eval), 2 d)`, `theta` the disk's angle at `t_eval`.
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, y0, t0, t_eval, rtol, atol, effects=None))]
 #[allow(clippy::too_many_arguments)]
@@ -133,7 +133,13 @@ fn simulate<'py>(
     rtol: f64,
     atol: Vec<f64>,
     effects: Effects,
-) -> PyResult<(Bound<'py, PyAny>, usize, usize, usize)> {
+) -> PyResult<(
+    Bound<'py, PyAny>,
+    Bound<'py, PyArray1<f64>>,
+    usize,
+    usize,
+    usize,
+)> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let sc = scene(&p, effects)?;
     let y0 = slice(&y0, "y0")?.to_vec();
@@ -150,8 +156,16 @@ fn simulate<'py>(
     let cols = y0.len();
     let flat: Vec<f64> = traj.y.into_iter().flatten().collect();
     let arr = PyArray1::from_vec(py, flat).reshape([te.len(), cols])?;
+    let theta: Vec<f64> = te
+        .iter()
+        .map(|&t| match &sc {
+            Some(s) => s.spin(t).2,
+            None => p.omega_s * t,
+        })
+        .collect();
     Ok((
         arr.into_any(),
+        PyArray1::from_vec(py, theta),
         traj.stats.accepted,
         traj.stats.rejected,
         traj.stats.rhs_evals,
