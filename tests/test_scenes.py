@@ -16,6 +16,8 @@ from ballbal.scene import scene_from_dict
 from reference import jacobi_integral
 
 
+NOT_STATE = ["t", "theta", "X", "Y"]  # simulate() columns besides the state
+
 def ground_rhs(scene, t, s):
     """Equations of motion in the ground frame: rotor centre (X, Y), absolute ball angles
     phi_i, disk angle theta(t) prescribed. From T = sum of m |v|^2 / 2 over rotor, the
@@ -144,7 +146,7 @@ def test_spring_potential_joins_the_jacobi_integral():
     sc = ballbal.Scene(balancer=b, springs=k)
     y0 = np.array([0.2, -0.1, 0.0, 2.0, 4.0, 0.05, 0.1, -0.3, 0.2, 0.1])
     t = np.linspace(0, 200, 401)
-    s = ballbal.simulate(sc, y0, t, rtol=1e-10, atol=1e-12).drop(["t", "theta", "X", "Y"]).to_numpy()
+    s = ballbal.simulate(sc, y0, t, rtol=1e-10, atol=1e-12).drop(NOT_STATE).to_numpy()
     beta = s[:, 2:5]
     sp = np.stack([beta[:, 1] - beta[:, 0], beta[:, 2] - beta[:, 1],
                    beta[:, 0] + 2 * np.pi - beta[:, 2]], axis=1) - 2 * np.pi / 3

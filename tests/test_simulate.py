@@ -9,6 +9,8 @@ import ballbal
 from reference import jacobi_integral, rhs
 
 
+NOT_STATE = ["t", "theta", "X", "Y"]  # simulate() columns besides the state
+
 def test_installed_not_source_tree():
     # The suite must exercise the built wheel, not python/ballbal in the checkout.
     assert "site-packages" in ballbal.__file__ or "dist-packages" in ballbal.__file__
@@ -35,7 +37,7 @@ def test_same_tolerances_as_scipy_rk45_give_same_accuracy_class():
     for rtol in (1e-5, 1e-7):
         sp = solve_ivp(lambda tt, s: rhs(b, tt, s), (0, 50), y0, t_eval=t, rtol=rtol,
                        atol=rtol * 1e-3, method="RK45").y[:, -1]
-        ours = ballbal.simulate(b, y0, t, rtol=rtol, atol=rtol * 1e-3).drop(["t", "theta", "X", "Y"])
+        ours = ballbal.simulate(b, y0, t, rtol=rtol, atol=rtol * 1e-3).drop(NOT_STATE)
         e_sp = np.max(np.abs(sp - exact))
         e_us = np.max(np.abs(ours.to_numpy()[-1] - exact))
         # Same method and step control: errors of the same order of magnitude.
@@ -49,13 +51,13 @@ def test_jacobi_integral_conserved_without_damping():
     t = np.linspace(0, 200, 401)
     for rtol, bound in ((1e-6, 1e-3), (1e-10, 1e-7)):
         df = ballbal.simulate(b, y0, t, rtol=rtol, atol=rtol * 1e-2)
-        s = df.drop(["t", "theta", "X", "Y"]).to_numpy()
+        s = df.drop(NOT_STATE).to_numpy()
         h = jacobi_integral(b, s)
         drift = np.max(np.abs(h - h[0]))
         assert drift < bound, (rtol, drift)
     # With damping it is no longer an integral: a check that the test can fail.
     bd = b.replace(zeta=0.05)
-    s = ballbal.simulate(bd, y0, t, rtol=1e-10, atol=1e-12).drop(["t", "theta", "X", "Y"]).to_numpy()
+    s = ballbal.simulate(bd, y0, t, rtol=1e-10, atol=1e-12).drop(NOT_STATE).to_numpy()
     hd = jacobi_integral(bd, s)
     assert np.max(np.abs(hd - hd[0])) > 1e-2
 
