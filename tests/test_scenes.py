@@ -15,7 +15,6 @@ from ballbal.scene import scene_from_dict
 
 from reference import jacobi_integral
 
-
 NOT_STATE = ["t", "theta", "X", "Y"]  # simulate() columns besides the state
 
 def ground_rhs(scene, t, s):

@@ -8,7 +8,6 @@ import ballbal
 
 from reference import jacobi_integral, rhs
 
-
 NOT_STATE = ["t", "theta", "X", "Y"]  # simulate() columns besides the state
 
 def test_installed_not_source_tree():
