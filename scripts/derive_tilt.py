@@ -232,6 +232,14 @@ pub struct RotorConsts {
             [("k", rk), ("c", rc), ("m", rm)],
         ),
         rust_fn(
+            "rotor_mass",
+            "The `m` of [`rotor_jacobians`] alone (it depends on `q` only): what a "
+            "right-hand side evaluation needs.",
+            "p: &RotorConsts, q: &[f64], m: &mut [f64; 16]",
+            p_unpack[:1] + ["let (x, y, A, B) = (q[0], q[1], q[2], q[3]);"],
+            [("m", rm)],
+        ),
+        rust_fn(
             "ball_residual",
             "One ball of unit mass factor: rows x, y, A, B (to be scaled by the ball's "
             "mass) and its own row (already over its mass); `q = (x, y, A, B, phi)`.",
@@ -245,6 +253,14 @@ pub struct RotorConsts {
             b_args + ", k: &mut [f64; 25], c: &mut [f64; 25], m: &mut [f64; 25]",
             b_unpack,
             [("k", bk), ("c", bc), ("m", bm)],
+        ),
+        rust_fn(
+            "ball_mass",
+            "The `m` of [`ball_jacobians`] alone (it depends on `q` only).",
+            "p: &RotorConsts, q: &[f64; 5], m: &mut [f64; 25]",
+            ["let (dl, idl) = (p.dl, p.idl);",
+             "let (x, y, A, B, phi) = (q[0], q[1], q[2], q[3], q[4]);"],
+            [("m", bm)],
         ),
     ]
     text = "\n\n".join(parts) + "\n"

@@ -41,7 +41,8 @@ use crate::equilibria::{analyse_model, newton_static, Equilibrium};
 use crate::error::{check_range, Error, Result};
 use crate::model::{Dynamics, Planar};
 use crate::tilt_terms::{
-    ball_jacobians, ball_residual, rotor_jacobians, rotor_residual, RotorConsts,
+    ball_jacobians, ball_mass, ball_residual, rotor_jacobians, rotor_mass, rotor_residual,
+    RotorConsts,
 };
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
@@ -431,12 +432,8 @@ impl Scene {
         m.fill(0.0);
         let (mut rk, mut rc, mut rm) = ([0.0; 16], [0.0; 16], [0.0; 16]);
         rotor_jacobians(cn, spin, q, v, a, &mut rk, &mut rc, &mut rm);
-        for i in 0..4 {
-            for j in 0..4 {
-                k[i * d + j] = rk[i * 4 + j];
-                c[i * d + j] = rc[i * 4 + j];
-                m[i * d + j] = rm[i * 4 + j];
-            }
+        for (big, block) in [(&mut *k, &rk), (&mut *c, &rc), (&mut *m, &rm)] {
+            Self::set_rotor_block(d, block, big);
         }
         let (mut bk, mut bc, mut bm) = ([0.0; 25], [0.0; 25], [0.0; 25]);
         for i in 0..p.n_balls() {
@@ -456,15 +453,8 @@ impl Scene {
                 &mut bc,
                 &mut bm,
             );
-            let mi = p.m(i);
-            let idx = [0, 1, 2, 3, 4 + i];
-            for (r, &row) in idx.iter().enumerate() {
-                let scale = if r < 4 { mi } else { 1.0 };
-                for (s, &col) in idx.iter().enumerate() {
-                    k[row * d + col] += scale * bk[r * 5 + s];
-                    c[row * d + col] += scale * bc[r * 5 + s];
-                    m[row * d + col] += scale * bm[r * 5 + s];
-                }
+            for (big, block) in [(&mut *k, &bk), (&mut *c, &bc), (&mut *m, &bm)] {
+                self.add_ball_block(i, block, big);
             }
         }
         if self.springs > 0.0 {
@@ -472,13 +462,40 @@ impl Scene {
         }
     }
 
-    /// The tilting model's mass matrix `dF/da` (it depends on `q` only).
-    fn tilt_mass(&self, t: f64, q: &[f64]) -> DMatrix<f64> {
+    /// Copies the rotor's 4 x 4 block into the top left of a `d x d` matrix.
+    fn set_rotor_block(d: usize, block: &[f64; 16], big: &mut [f64]) {
+        for i in 0..4 {
+            big[i * d..i * d + 4].copy_from_slice(&block[i * 4..i * 4 + 4]);
+        }
+    }
+
+    /// Adds ball `i`'s 5 x 5 block (rows and columns x, y, A, B, b_i) to a `d x d`
+    /// matrix, its rotor rows scaled by the ball's mass (its own row is already over it).
+    fn add_ball_block(&self, i: usize, block: &[f64; 25], big: &mut [f64]) {
         let d = self.ndof();
-        let z = vec![0.0; d];
-        let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        let mi = self.planar.m(i);
+        let idx = [0, 1, 2, 3, 4 + i];
+        for (r, &row) in idx.iter().enumerate() {
+            let scale = if r < 4 { mi } else { 1.0 };
+            for (s, &col) in idx.iter().enumerate() {
+                big[row * d + col] += scale * block[r * 5 + s];
+            }
+        }
+    }
+
+    /// The tilting model's mass matrix `dF/da` (it depends on `q` only).
+    fn tilt_mass(&self, q: &[f64]) -> DMatrix<f64> {
+        let d = self.ndof();
         let cn = self.consts.as_ref().expect("tilting scene");
-        self.tilt_jacobians(cn, t, q, &z, &z, &mut k, &mut c, &mut m);
+        let mut m = vec![0.0; d * d];
+        let mut rm = [0.0; 16];
+        rotor_mass(cn, q, &mut rm);
+        Self::set_rotor_block(d, &rm, &mut m);
+        let mut bm = [0.0; 25];
+        for i in 0..self.planar.n_balls() {
+            ball_mass(cn, &Self::ball_view(q, i), &mut bm);
+            self.add_ball_block(i, &bm, &mut m);
+        }
         DMatrix::from_row_slice(d, d, &m)
     }
 
@@ -583,7 +600,7 @@ impl Dynamics for Scene {
         if self.tilt.is_none() {
             return self.planar.solve_mass(t, q, rhs);
         }
-        let lu = self.tilt_mass(t, q).lu();
+        let lu = self.tilt_mass(q).lu();
         let mut b = nalgebra::DVector::from_column_slice(rhs);
         // M is the kinetic-energy Hessian with rows scaled: never singular.
         lu.solve_mut(&mut b);
@@ -595,7 +612,7 @@ impl Dynamics for Scene {
             return self.planar.solve_mass_columns(t, q, cols);
         }
         let d = self.ndof();
-        let lu = self.tilt_mass(t, q).lu();
+        let lu = self.tilt_mass(q).lu();
         let mut b = DMatrix::from_column_slice(d, cols.len() / d, cols);
         lu.solve_mut(&mut b);
         cols.copy_from_slice(b.as_slice());
@@ -747,6 +764,21 @@ mod tests {
         let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
         let a = [0.05, -0.3, 0.2, -0.1, 0.2, 0.6, -0.1];
         check_jacobians(&all_effects(Some(tilt())), &q, &v, &a);
+    }
+
+    #[test]
+    fn tilting_mass_matrix_is_the_jacobians_m() {
+        let s = all_effects(Some(tilt()));
+        let q = [0.3, -0.2, 0.8, -0.6, 0.7, -1.9, 2.4];
+        let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
+        let (mut k, mut c, mut m) = (vec![0.0; 49], vec![0.0; 49], vec![0.0; 49]);
+        s.jacobians(0.8, &q, &v, &v, &mut k, &mut c, &mut m);
+        let alone = s.tilt_mass(&q);
+        for i in 0..7 {
+            for j in 0..7 {
+                assert!((alone[(i, j)] - m[i * 7 + j]).abs() < 1e-14, "[{i}][{j}]");
+            }
+        }
     }
 
     #[test]

@@ -329,6 +329,48 @@ pub fn rotor_jacobians(p: &RotorConsts, spin: (f64, f64, f64), q: &[f64], v: &[f
     m[15] = t36*(mu*(t139 + t49 + t90) + t130.powi(2)*t131);
 }
 
+/// The `m` of [`rotor_jacobians`] alone (it depends on `q` only): what a right-hand side evaluation needs.
+#[allow(clippy::all, unused_variables, non_snake_case)]
+pub fn rotor_mass(p: &RotorConsts, q: &[f64], m: &mut [f64; 16]) {
+    let RotorConsts { mh, mu, dl, idl, jt, jz, kc, kt, cr, zeta, g } = *p;
+    let (x, y, A, B) = (q[0], q[1], q[2], q[3]);
+    let t0 = mh + mu;
+    let t1 = B*idl;
+    let t2 = t1.sin();
+    let t3 = idl*mu;
+    let t4 = t2*t3;
+    let t5 = -t4;
+    let t6 = A*idl;
+    let t7 = t6.cos();
+    let t8 = t4*t7;
+    let t9 = t1.cos();
+    let t10 = t6.sin();
+    let t11 = t10*t3*t9;
+    let t12 = idl.powi(2);
+    let t13 = t10.powi(2);
+    let t14 = t7.powi(2);
+    let t15 = t13 + t14;
+    let t16 = t2.powi(2);
+    let t17 = dl.powi(2);
+    let t18 = t9.powi(2);
+    m[0] = t0;
+    m[1] = 0.0;
+    m[2] = 0.0;
+    m[3] = t5;
+    m[4] = 0.0;
+    m[5] = t0;
+    m[6] = t8;
+    m[7] = t11;
+    m[8] = 0.0;
+    m[9] = t8;
+    m[10] = t12*t15*(mu*t16 + t15*t17*(jt*t18 + jz*t16));
+    m[11] = 0.0;
+    m[12] = t5;
+    m[13] = t11;
+    m[14] = 0.0;
+    m[15] = t12*(jt*t17*(t13*t16 + t14*t16 + t18).powi(2) + mu*(t13*t18 + t14*t18 + t16));
+}
+
 /// One ball of unit mass factor: rows x, y, A, B (to be scaled by the ball's mass) and its own row (already over its mass); `q = (x, y, A, B, phi)`.
 #[allow(clippy::all, unused_variables, non_snake_case)]
 pub fn ball_residual(p: &RotorConsts, zb: f64, spin: (f64, f64, f64), q: &[f64; 5], v: &[f64; 5], a: &[f64; 5], out: &mut [f64; 5]) {
@@ -783,4 +825,63 @@ pub fn ball_jacobians(p: &RotorConsts, zb: f64, spin: (f64, f64, f64), q: &[f64;
     m[22] = t278;
     m[23] = t279;
     m[24] = dl*(t20.powi(2) + t205*t237 + t67.powi(2));
+}
+
+/// The `m` of [`ball_jacobians`] alone (it depends on `q` only).
+#[allow(clippy::all, unused_variables, non_snake_case)]
+pub fn ball_mass(p: &RotorConsts, q: &[f64; 5], m: &mut [f64; 25]) {
+    let (dl, idl) = (p.dl, p.idl);
+    let (x, y, A, B, phi) = (q[0], q[1], q[2], q[3], q[4]);
+    let t0 = dl.recip();
+    let t1 = B*idl;
+    let t2 = t1.sin();
+    let t3 = phi.cos();
+    let t4 = idl*t3;
+    let t5 = -t2*t4;
+    let t6 = phi.sin();
+    let t7 = t1.cos();
+    let t8 = -t6*t7;
+    let t9 = A*idl;
+    let t10 = t9.sin();
+    let t11 = t10*t6;
+    let t12 = t9.cos();
+    let t13 = t11 - t12*t2*t3;
+    let t14 = -idl*t13;
+    let t15 = t10*t3;
+    let t16 = idl*t15*t7;
+    let t17 = t11*t2 - t12*t3;
+    let t18 = -t17;
+    let t19 = t12*t6;
+    let t20 = t15*t2 + t19;
+    let t21 = dl*idl.powi(2);
+    let t22 = -t21*t3*t7*(t10*t13 + t12*t20);
+    let t23 = t15 + t19*t2;
+    let t24 = dl*idl*(t13*t17 + t20*t23);
+    let t25 = t7.powi(2);
+    let t26 = -dl*t4*t7*(t10*t17 + t12*t23 - t2*t6);
+    m[0] = t0;
+    m[1] = 0.0;
+    m[2] = 0.0;
+    m[3] = t5;
+    m[4] = t8;
+    m[5] = 0.0;
+    m[6] = t0;
+    m[7] = t14;
+    m[8] = t16;
+    m[9] = t18;
+    m[10] = 0.0;
+    m[11] = t14;
+    m[12] = t21*(t13.powi(2) + t20.powi(2));
+    m[13] = t22;
+    m[14] = t24;
+    m[15] = t5;
+    m[16] = t16;
+    m[17] = t22;
+    m[18] = t21*t3.powi(2)*(t10.powi(2)*t25 + t12.powi(2)*t25 + t2.powi(2));
+    m[19] = t26;
+    m[20] = t8;
+    m[21] = t18;
+    m[22] = t24;
+    m[23] = t26;
+    m[24] = dl*(t17.powi(2) + t23.powi(2) + t25*t6.powi(2));
 }
