@@ -114,6 +114,15 @@ fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]
         .map_err(|_| PyValueError::new_err(format!("{name}: must be a contiguous float64 array")))
 }
 
+/// `(y, theta, accepted_steps, rejected_steps, rhs_evals)` of [`simulate`].
+type Simulated<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyArray1<f64>>,
+    usize,
+    usize,
+    usize,
+);
+
 /// Integrates from `y0` and returns `(y, theta, accepted_steps, rejected_steps,
 /// rhs_evals)`, `y` of shape `(len(t_eval), 2 d)`, `theta` the disk's angle at `t_eval`.
 #[pyfunction]
@@ -133,13 +142,7 @@ fn simulate<'py>(
     rtol: f64,
     atol: Vec<f64>,
     effects: Effects,
-) -> PyResult<(
-    Bound<'py, PyAny>,
-    Bound<'py, PyArray1<f64>>,
-    usize,
-    usize,
-    usize,
-)> {
+) -> PyResult<Simulated<'py>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let sc = scene(&p, effects)?;
     let y0 = slice(&y0, "y0")?.to_vec();
