@@ -63,7 +63,6 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     missing = [i for i, d in enumerate(results) if d is None]
     planar_ok = _native.balanced_states([(points[i][0], None) for i in missing])
     failed = {i for i, d in zip(missing, planar_ok, strict=True) if d is not None}
-    n_rotor = len(scene.coordinates) - scene.n_balls
     cols: dict[str, list[Any]] = {n: [] for n in names}
     for key in ("status", "stability", "index", "whirl", "tilt", "residual"):
         cols[key] = []
@@ -80,7 +79,7 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
         cols["stability"].append(d["stability"])
         cols["index"].append(float(d["index"]))
         cols["whirl"].append(float(np.hypot(q[0], q[1])))
-        cols["tilt"].append(float(np.hypot(q[2], q[3])) if n_rotor == 4 else 0.0)
+        cols["tilt"].append(float(np.hypot(q[2], q[3])) if scene.tilt is not None else 0.0)
         cols["residual"].append(float(d["residual"]))
     schema = {n: pl.Float64 for n in names} | {
         "status": pl.String, "stability": pl.String, "index": pl.Float64,
