@@ -27,6 +27,8 @@ from .model import Balancer
 from .scene import Scene
 
 SCANNABLE = ("mu", "zeta", "zeta_b", "delta", "Omega", "eta")
+#: Scene parameters a scan can vary besides the balancer's (tilt fields need a tilt).
+SCENE_SCANNABLE = ("springs", "a", "b", "j_t", "j_z", "zeta_r")
 _INDEXED = ("eta[", "zeta_b[")
 
 GridSpec = Sequence[float] | np.ndarray | tuple[float, float, float] | str
@@ -51,10 +53,11 @@ class ScanInterrupted(UserWarning):
 def grid_values(name: str, spec: GridSpec) -> np.ndarray:
     """The values of one grid axis: a sequence, an array, ``(start, stop, step)`` or
     ``"start:stop:step"`` (both ends included)."""
-    if not (name in SCANNABLE or (name.startswith(_INDEXED) and name.endswith("]"))):
+    if not (name in SCANNABLE or name in SCENE_SCANNABLE
+            or (name.startswith(_INDEXED) and name.endswith("]"))):
         raise ValueError(
             f"{name}: not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
-            "eta[i], zeta_b[i])"
+            f"eta[i], zeta_b[i]; for scenes also {', '.join(SCENE_SCANNABLE)})"
         )
     if isinstance(spec, str):
         try:
@@ -90,7 +93,7 @@ def grid_values(name: str, spec: GridSpec) -> np.ndarray:
 class _Job:
     """Everything one chunk needs: picklable, so it can travel to other processes."""
 
-    balancer: Balancer
+    model: Balancer | Scene
     names: tuple[str, ...]
     values: tuple[tuple[float, ...], ...]
     patterns: tuple[str, ...]
@@ -100,13 +103,14 @@ class _Job:
     def native(self, chunks: list[int], threads: int,
                on_chunk: Callable[[int, dict[str, Any]], None]) -> None:
         o = dict(self.options)
+        effects = self.model.native_effects() if isinstance(self.model, Scene) else None
         _native.scan(
-            *self.balancer.native_args(), list(self.names), [list(v) for v in self.values],
+            *self.model.native_args(), list(self.names), [list(v) for v in self.values],
             list(self.patterns), o["N"], o["samples"], o["tol"], o["step_tol"],
             o["max_iter"], o["floquet"], o["rtol"], o["atol"], o["margin"], o["max_steps"],
             o["settle"], o["window"], o["guess_rtol"], o["auto"], o["N_max"], o["hill"],
             o["seeds"], o["starts"], self.chunk,
-            o["max_tail"], threads, chunks, on_chunk,
+            o["max_tail"], threads, chunks, on_chunk, effects,
         )
 
     def n_chunks(self) -> int:
@@ -119,7 +123,9 @@ class _Job:
 
     def meta(self) -> dict[str, Any]:
         return {
-            "ballbal": _native.__version__, "balancer": asdict(self.balancer),
+            "ballbal": _native.__version__,
+            **({"scene": self.model.to_dict()} if isinstance(self.model, Scene)
+               else {"balancer": asdict(self.model)}),
             "grid": {n: list(v) for n, v in zip(self.names, self.values, strict=True)},
             "patterns": list(self.patterns), "options": dict(self.options),
             "chunk": self.chunk,
@@ -257,6 +263,12 @@ def scan(
     ``grid`` mapping (needed for ``"eta[0]"``); each is a sequence, ``(start, stop, step)``
     or ``"start:stop:step"``. Any number of axes; the first varies fastest in the table.
 
+    ``balancer`` may be an autonomous :class:`Scene` (ball springs, a tilting disk): its
+    ``springs`` and tilt fields ``a``, ``b``, ``j_t``, ``j_z``, ``zeta_r`` can be axes
+    too, and ``pb_exists``, ``pb_stable`` then describe its balanced state (see
+    :func:`balanced_state`). A scene with a ramp, gravity or an impulse is time
+    dependent and has no periodic solutions to scan: that is an error naming the effect.
+
     Each chunk of the grid (``chunk`` values of the last axis; default about 1024
     points) is solved in the Rust core on ``threads`` cores with the GIL released:
     simulated starts at ``seeds`` points per axis (and, for O-types, along the perfect
@@ -280,13 +292,9 @@ def scan(
     ``f(done_points, total_points)``. Ctrl-C stops the scan and returns the finished
     chunks with a :class:`ScanInterrupted` warning.
     """
-    if isinstance(balancer, Scene):
-        if balancer.native_effects() is not None:
-            raise ValueError(
-                "scene: scans of scenes with effects (springs, ramp, gravity, impulse) are "
-                "not available yet; scan the plain balancer, or simulate the scene"
-            )
-        balancer = balancer.balancer
+    model: Balancer | Scene = balancer
+    if isinstance(model, Scene) and model.native_effects() is None:
+        model = model.balancer  # the same table, and a scan directory it can resume
     axes_all: dict[str, GridSpec] = dict(grid or {})
     for k, v in axes.items():
         if k in axes_all:
@@ -317,7 +325,7 @@ def scan(
         ("window", float(window)), ("guess_rtol", float(guess_rtol)), ("seeds", int(seeds)),
         ("starts", int(starts)), ("max_tail", float(max_tail)),
     )
-    job = _Job(balancer, names, values, tuple(str(p) for p in patterns), options, int(chunk))
+    job = _Job(model, names, values, tuple(str(p) for p in patterns), options, int(chunk))
     # Validates everything (grid values, combinations, options) before any work.
     job.native([], 1, lambda _c, _d: None)
 

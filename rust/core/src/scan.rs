@@ -18,12 +18,14 @@
 //! so the table does not depend on the thread count. Solutions that are the same orbit
 //! (shifted phase, swapped identical balls) are merged by a phase-free key.
 
-use crate::equilibria::{equilibria, Verdict};
+use crate::equilibria::{equilibria, Equilibrium, Verdict};
 use crate::error::{Error, Result};
 use crate::floquet::FloquetOptions;
 use crate::hb::{solve, HbSolution, Status};
-use crate::periodic::{finish, guess_from_state, initial_states, Periodic, PeriodicOptions};
-use crate::{Dynamics, Planar};
+use crate::periodic::{
+    finish, guess_from_state, initial_states, require_autonomous, Periodic, PeriodicOptions,
+};
+use crate::{Dynamics, Planar, Scene};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -32,6 +34,35 @@ use std::time::Instant;
 /// Most solutions of one type kept at one point: a guard against a duplicate test
 /// that a pathological orbit family might slip through.
 const MAX_PER_TYPE: usize = 4;
+
+/// A model whose parameters a scan varies: the planar balancer, or a scene.
+pub trait Family: Dynamics + Clone {
+    /// A copy with one named parameter changed, validated.
+    fn with_param(&self, name: &str, value: f64) -> Result<Self>;
+    /// The equilibrium reported beside every point (`pb_exists`, `pb_stable`): the
+    /// perfect balance, or with ball springs the balanced state that continues it.
+    fn balance(&self) -> Option<Equilibrium>;
+}
+
+impl Family for Planar {
+    fn with_param(&self, name: &str, value: f64) -> Result<Self> {
+        Planar::with_param(self, name, value)
+    }
+    fn balance(&self) -> Option<Equilibrium> {
+        equilibria(self)
+            .into_iter()
+            .find(|e| e.kind == "perfect_balance")
+    }
+}
+
+impl Family for Scene {
+    fn with_param(&self, name: &str, value: f64) -> Result<Self> {
+        Scene::with_param(self, name, value)
+    }
+    fn balance(&self) -> Option<Equilibrium> {
+        self.balanced_state()
+    }
+}
 
 #[derive(Debug, Clone)]
 pub struct ScanRow {
@@ -53,8 +84,8 @@ pub struct ScanRow {
 }
 
 #[derive(Debug, Clone)]
-pub struct ScanSpec<'a> {
-    pub base: &'a Planar,
+pub struct ScanSpec<'a, D: Family> {
+    pub base: &'a D,
     pub names: Vec<String>,
     pub values: Vec<Vec<f64>>,
     /// Rotation pattern per requested solution type.
@@ -73,9 +104,10 @@ pub struct ScanSpec<'a> {
     pub max_tail: f64,
 }
 
-impl ScanSpec<'_> {
+impl<D: Family> ScanSpec<'_, D> {
     /// Checks every value and option before any work starts.
     pub fn validate(&self) -> Result<()> {
+        require_autonomous(self.base)?;
         if self.names.is_empty() || self.names.len() != self.values.len() {
             return Err(Error::param(
                 "grid",
@@ -157,8 +189,8 @@ pub fn default_chunk(lens: &[usize]) -> usize {
 /// Runs the chunks `which` (indices into `spec.chunks()`) and hands each finished
 /// chunk's rows to `on_chunk` (from a worker thread, in completion order). Stops early,
 /// with `Error::Cancelled`, once `cancel` is set; chunks already handed over are kept.
-pub fn scan_chunks(
-    spec: &ScanSpec<'_>,
+pub fn scan_chunks<D: Family>(
+    spec: &ScanSpec<'_, D>,
     which: &[usize],
     cancel: &AtomicBool,
     on_chunk: &(dyn Fn(usize, Vec<ScanRow>) + Sync),
@@ -186,7 +218,7 @@ pub fn scan_chunks(
 
 /// The whole grid in one call; rows ordered by point (first parameter fastest), type
 /// and solution number.
-pub fn scan(spec: &ScanSpec<'_>) -> Result<Vec<ScanRow>> {
+pub fn scan<D: Family>(spec: &ScanSpec<'_, D>) -> Result<Vec<ScanRow>> {
     let n = spec.chunks().len();
     let out = std::sync::Mutex::new(vec![None; n]);
     let all: Vec<usize> = (0..n).collect();
@@ -245,7 +277,7 @@ struct Local {
 }
 
 impl Local {
-    fn new(spec: &ScanSpec<'_>, range: &Range<usize>) -> Self {
+    fn new<D: Family>(spec: &ScanSpec<'_, D>, range: &Range<usize>) -> Self {
         let mut lens: Vec<usize> = spec.values.iter().map(|v| v.len()).collect();
         *lens.last_mut().unwrap() = range.len();
         let mut strides = vec![1; lens.len()];
@@ -293,8 +325,8 @@ fn seed_positions(len: usize, seeds: usize) -> Vec<usize> {
     (s / 2..len).step_by(s).collect()
 }
 
-fn scan_chunk(
-    spec: &ScanSpec<'_>,
+fn scan_chunk<D: Family>(
+    spec: &ScanSpec<'_, D>,
     range: Range<usize>,
     cancel: &AtomicBool,
 ) -> Result<Vec<ScanRow>> {
@@ -302,7 +334,7 @@ fn scan_chunk(
     let npts = geo.size();
     let dims = spec.names.len();
     let np = spec.patterns.len();
-    let params: Vec<Planar> = (0..npts)
+    let params: Vec<D> = (0..npts)
         .map(|p| {
             let idx = geo.index(p);
             let mut q = spec.base.clone();
@@ -315,9 +347,7 @@ fn scan_chunk(
     let pb: Vec<(bool, bool)> = params
         .par_iter()
         .map(|p| {
-            let e = equilibria(p)
-                .into_iter()
-                .find(|e| e.kind == "perfect_balance");
+            let e = p.balance();
             (e.is_some(), e.is_some_and(|e| e.verdict == Verdict::Stable))
         })
         .collect();
@@ -600,7 +630,12 @@ mod tests {
     use crate::hb::HbOptions;
     use crate::periodic::GuessOptions;
 
-    fn spec<'a>(base: &'a Planar, om: &[f64], eta: &[f64], threads: usize) -> ScanSpec<'a> {
+    fn spec<'a, D: Family>(
+        base: &'a D,
+        om: &[f64],
+        eta: &[f64],
+        threads: usize,
+    ) -> ScanSpec<'a, D> {
         ScanSpec {
             base,
             names: vec!["Omega".into(), "eta".into()],
@@ -693,6 +728,65 @@ mod tests {
         assert!(e.to_string().starts_with("gravity"), "{e}");
         let e = scan(&mk("eta", vec![1.0])).err().unwrap();
         assert!(e.to_string().starts_with("eta"), "{e}");
+    }
+
+    #[test]
+    fn mid_span_tilting_scene_scans_like_the_planar_balancer() {
+        // a = b: no coupling, a flat disk stays flat; every planar orbit is an orbit of
+        // the scene with A = B = 0, and the scan must find it with the same omega.
+        let base = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let tilt = crate::scene::Tilt {
+            a: 2.0,
+            b: 2.0,
+            j_t: 0.15,
+            j_z: 0.25,
+            zeta_r: 0.05,
+        };
+        let sc = Scene::new(base.clone(), 0.0, None, 0.0, None, Some(tilt)).unwrap();
+        let om = [1.15, 1.2, 1.25];
+        let eta = [0.9, 1.0];
+        let flat = scan(&spec(&base, &om, &eta, 2)).unwrap();
+        let tilted = scan(&spec(&sc, &om, &eta, 2)).unwrap();
+        let mut matched = 0;
+        for r in flat.iter().filter(|r| r.result.is_some()) {
+            let w = r.result.as_ref().unwrap().sol.omega;
+            let twin = tilted.iter().find(|t| {
+                t.index == r.index
+                    && t.result
+                        .as_ref()
+                        .is_some_and(|x| (x.sol.omega - w).abs() < 1e-9)
+            });
+            assert!(
+                twin.is_some(),
+                "planar orbit omega {w} at {:?} missing",
+                r.index
+            );
+            assert_eq!(twin.unwrap().pb_stable, r.pb_stable);
+            matched += 1;
+        }
+        assert!(matched >= 6);
+    }
+
+    #[test]
+    fn scene_parameters_are_scanned_by_name_and_time_dependent_scenes_refused() {
+        let base = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let sc = Scene::new(base.clone(), 1e-5, None, 0.0, None, None).unwrap();
+        let s2 = Family::with_param(&sc, "springs", 2e-5).unwrap();
+        assert_eq!(s2.springs, 2e-5);
+        let e = Family::with_param(&sc, "j_t", 0.1).err().unwrap();
+        assert!(e.to_string().starts_with("j_t: is a tilt parameter"), "{e}");
+        let e = Family::with_param(&sc, "spring", 0.1).err().unwrap();
+        assert!(e.to_string().contains("parameter of the scene"), "{e}");
+        let e = Family::with_param(&sc, "springs", -1.0).err().unwrap();
+        assert!(e.to_string().starts_with("springs"), "{e}");
+        let ramp = crate::scene::Ramp {
+            to: 2.0,
+            start: 0.0,
+            duration: 10.0,
+        };
+        let sr = Scene::new(base, 0.0, Some(ramp), 0.0, None, None).unwrap();
+        let e = scan(&spec(&sr, &[1.2], &[1.0], 1)).err().unwrap();
+        assert!(e.to_string().contains("'ramp'"), "{e}");
     }
 
     #[test]

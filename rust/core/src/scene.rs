@@ -205,6 +205,59 @@ impl Scene {
         })
     }
 
+    /// Returns a copy with one named parameter changed (scans and continuation): the
+    /// planar balancer's names, `springs`, `gravity`, and the tilt's `a`, `b`, `j_t`,
+    /// `j_z`, `zeta_r`. The copy is rebuilt and revalidated, so the rotor constants
+    /// derived from the tilt follow the change.
+    pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
+        let mut planar = self.planar.clone();
+        let mut springs = self.springs;
+        let mut gravity = self.gravity;
+        let mut tilt = self.tilt.clone();
+        match name {
+            "springs" => springs = value,
+            "gravity" => gravity = value,
+            "a" | "b" | "j_t" | "j_z" | "zeta_r" => {
+                let Some(t) = tilt.as_mut() else {
+                    return Err(Error::param(
+                        name,
+                        "is a tilt parameter, and the scene has no tilting disk",
+                    ));
+                };
+                match name {
+                    "a" => t.a = value,
+                    "b" => t.b = value,
+                    "j_t" => t.j_t = value,
+                    "j_z" => t.j_z = value,
+                    _ => t.zeta_r = value,
+                }
+            }
+            _ => {
+                planar = self.planar.with_param(name, value).map_err(|e| match e {
+                    Error::InvalidParameter { name: n, message }
+                        if message.starts_with("is not a") =>
+                    {
+                        Error::param(
+                            n,
+                            "is not a parameter of the scene (mu, zeta, zeta_b, delta, Omega, \
+                             eta, eta[i], zeta_b[i], springs, gravity; with a tilting disk \
+                             a, b, j_t, j_z, zeta_r)",
+                        )
+                    }
+                    e => e,
+                })?
+            }
+        }
+        Scene::new(
+            planar,
+            springs,
+            self.ramp.clone(),
+            gravity,
+            self.impulse.clone(),
+            tilt,
+        )
+    }
+
     /// The balanced state and its stability (seed 004's "stable balanced region"): the
     /// equilibrium that continues the planar balancer's perfect balance (`x = y = 0`,
     /// balls cancelling the unbalance) to this scene. Springs whose rest spacing differs

@@ -548,7 +548,7 @@ fn orbit_closure(
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, names, values, patterns,
                     n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin,
                     max_steps, settle, window, guess_rtol, auto, n_max, hill, seeds, starts,
-                    chunk, max_tail, threads, chunks, on_chunk))]
+                    chunk, max_tail, threads, chunks, on_chunk, effects=None))]
 #[allow(clippy::too_many_arguments)]
 fn scan(
     py: Python<'_>,
@@ -584,11 +584,11 @@ fn scan(
     threads: usize,
     chunks: Vec<usize>,
     on_chunk: Bound<'_, PyAny>,
+    effects: Effects,
 ) -> PyResult<()> {
-    use ballbal_core::scan::{scan_chunks, ScanRow, ScanSpec};
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::mpsc;
+    use ballbal_core::scan::ScanSpec;
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    let sc = autonomous_scene(&p, effects, "scan")?;
     let rots = patterns
         .iter()
         .map(|s| parse_pattern(s, p.n_balls()))
@@ -614,25 +614,60 @@ fn scan(
         n_max,
         hill,
     )?;
-    let spec = ScanSpec {
-        base: &p,
-        names: names.clone(),
-        values: values.clone(),
-        patterns: rots,
-        opts,
-        seeds,
-        starts,
-        chunk,
-        threads,
-        max_tail,
+    let cols = Columns {
+        names: &names,
+        values: &values,
+        patterns: &patterns,
+        n_harm,
     };
+    macro_rules! spec {
+        ($base:expr) => {
+            ScanSpec {
+                base: $base,
+                names: names.clone(),
+                values: values.clone(),
+                patterns: rots,
+                opts,
+                seeds,
+                starts,
+                chunk,
+                threads,
+                max_tail,
+            }
+        };
+    }
+    match &sc {
+        None => run_scan(py, &spec!(&p), chunks, &cols, &on_chunk),
+        Some(s) => run_scan(py, &spec!(s), chunks, &cols, &on_chunk),
+    }
+}
+
+/// What a chunk's table needs besides its rows.
+struct Columns<'a> {
+    names: &'a [String],
+    values: &'a [Vec<f64>],
+    patterns: &'a [String],
+    n_harm: usize,
+}
+
+/// Runs `spec`'s chunks on a worker thread and hands each finished one to `on_chunk`
+/// in this thread, checking for Ctrl-C while it waits.
+fn run_scan<D: ballbal_core::scan::Family>(
+    py: Python<'_>,
+    spec: &ballbal_core::scan::ScanSpec<'_, D>,
+    chunks: Vec<usize>,
+    cols: &Columns<'_>,
+    on_chunk: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    use ballbal_core::scan::{scan_chunks, ScanRow};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::mpsc;
     let cancel = AtomicBool::new(false);
     let (tx, rx) = mpsc::channel::<(usize, Vec<ScanRow>)>();
     // `detach` needs a `Sync` capture; the receiver is only used from this thread.
     let rx = std::sync::Mutex::new(rx);
     let mut pending: Option<PyErr> = None;
     let worker = std::thread::scope(|s| {
-        let spec = &spec;
         let cancel = &cancel;
         let handle = s.spawn(move || {
             catch_unwind(AssertUnwindSafe(|| {
@@ -649,7 +684,7 @@ fn scan(
             });
             match msg {
                 Ok((c, rows)) => {
-                    let r = scan_columns(py, &names, &values, &patterns, n_harm, &rows)
+                    let r = scan_columns(py, cols, &rows)
                         .and_then(|d| on_chunk.call1((c, d)).map(|_| ()));
                     if let Err(e) = r {
                         if pending.is_none() {
@@ -684,12 +719,15 @@ fn scan(
 /// One chunk's rows as a dict of equally long lists (None where a value does not apply).
 fn scan_columns<'py>(
     py: Python<'py>,
-    names: &[String],
-    values: &[Vec<f64>],
-    patterns: &[String],
-    n_harm: usize,
+    cols: &Columns<'_>,
     rows: &[ballbal_core::scan::ScanRow],
 ) -> PyResult<Bound<'py, PyDict>> {
+    let Columns {
+        names,
+        values,
+        patterns,
+        n_harm,
+    } = *cols;
     use ballbal_core::periodic::Periodic;
     let d = PyDict::new(py);
     for (k, name) in names.iter().enumerate() {
