@@ -1,6 +1,7 @@
 """Scenes: each effect checked against a formulation written here independently (the
 Lagrangian in ground-fixed coordinates), against limits, and for clear errors."""
 
+import itertools
 import math
 
 import numpy as np
@@ -9,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
+from scipy.optimize import root
 
 import ballbal
 from ballbal.scene import scene_from_dict
@@ -185,8 +187,6 @@ def test_scene_without_effects_is_the_balancer():
     a = ballbal.scan(sc, Omega=[1.2], eta=[1.0])
     b = ballbal.scan(sc.balancer, Omega=[1.2], eta=[1.0])
     assert a.drop("seconds").equals(b.drop("seconds"))
-    with pytest.raises(ValueError, match="^springs: .*balanced_state"):
-        ballbal.equilibria(ballbal.Scene(springs=1e-3))
 
 
 def test_scene_files_round_trip(tmp_path):
@@ -277,3 +277,85 @@ def test_disturbance_needs_a_stable_perfect_balance():
     with pytest.raises(ValueError, match="^balancer: the perfect balance"):
         ballbal.disturbance_response(ballbal.Balancer(Omega=1.2), to=1.5)
 
+
+
+def steady_residual(scene, q):
+    """An equilibrium in the rotating frame is the configuration q turning rigidly at
+    Omega in the ground frame: ground_rhs must give the centripetal accelerations."""
+    n, w = scene.n_balls, scene.Omega
+    x, y = q[0], q[1]
+    s = np.concatenate([[x, y], q[2:], [-w * y, w * x], np.full(n, w)])
+    acc = ground_rhs(scene, 0.0, s)[n + 2 :]
+    return acc - np.concatenate([[-w * w * x, -w * w * y], np.zeros(n)])
+
+
+def canonical(q, equal):
+    """Balls in track order as a tuple with b_1 in [-pi, pi); identical balls: the least
+    of the cyclic relabellings round the ring."""
+    q = np.asarray(q, dtype=float)
+    n = q.size - 2
+    forms = []
+    for r in range(n if equal else 1):
+        b = np.concatenate([q[2 + r :], q[2 : 2 + r] + 2 * math.pi])
+        b = b - 2 * math.pi * math.floor((b[0] + math.pi) / (2 * math.pi))
+        forms.append(tuple(np.round(np.concatenate([q[:2], b]), 5)))
+    return min(forms)
+
+
+def reference_spring_equilibria(scene, per):
+    """The test's own search: scipy's root on steady_residual from starts in track order,
+    keeping solutions still in track order."""
+    n = scene.n_balls
+    equal = len(set(scene.balancer.eta)) == 1
+    grid = 2 * math.pi * (np.arange(per) + 0.23) / per
+    found = set()
+    for b1 in grid[::2]:
+        for offs in itertools.combinations(grid, n - 1):
+            q0 = np.concatenate([[0.0, 0.0, b1], b1 + np.array(offs)])
+            r = root(lambda q: steady_residual(scene, q), q0, tol=1e-13)
+            if not r.success or np.max(np.abs(steady_residual(scene, r.x))) > 1e-10:
+                continue
+            b = r.x[2:]
+            if np.all(np.diff(np.append(b, b[0] + 2 * math.pi)) >= -1e-9):
+                found.add(canonical(r.x, equal))
+    return found
+
+
+@pytest.mark.parametrize(("eta", "Omega", "springs", "per", "count"), [
+    ((1.0, 1.0), 1.2, 1e-5, 16, 2), ((1.0, 1.0), 1.2, 2e-2, 16, 2),
+    ((0.9, 1.1, 0.7), 1.2, 3e-2, 12, 2), ((0.9, 1.1, 0.7), 0.8, 1e-5, 12, 6),
+    ((0.9, 1.1, 0.7), 0.95, 1e-5, 12, 6),
+])
+def test_equilibria_with_springs_are_those_of_the_ground_frame_formulation(
+        eta, Omega, springs, per, count):
+    sc = ballbal.Scene(balancer=ballbal.Balancer(eta=eta, Omega=Omega), springs=springs)
+    eqs = ballbal.equilibria(sc)
+    ref = reference_spring_equilibria(sc, per)
+    got = [canonical(e.q, len(set(eta)) == 1) for e in eqs]
+    assert len(set(got)) == len(got) == len(ref) == count
+    for g in got:
+        assert any(np.max(np.abs(np.subtract(g, r))) < 1e-4 for r in ref), g
+    balanced = [e for e in eqs if e.kind == "balanced"]
+    expected = ballbal.balanced_state(sc)
+    assert len(balanced) == (expected is not None)
+    if expected is not None:
+        assert np.allclose(balanced[0].q, expected.q, atol=1e-9)
+
+
+@pytest.mark.parametrize(("Omega", "springs"), [(1.2, 1e-3), (0.8, 1e-5)])
+def test_stability_of_equilibria_with_springs_agrees_with_time_simulation(Omega, springs):
+    b = ballbal.Balancer(eta=(0.9, 1.1, 0.7), Omega=Omega)
+    sc = ballbal.Scene(balancer=b, springs=springs)
+    eqs = ballbal.equilibria(sc)
+    assert {e.stability for e in eqs} == {"stable", "unstable"}
+    d = len(sc.coordinates)
+    kick = 1e-6 * np.array([1.0, -0.7, 0.5, -0.3, 0.8])
+    for e in eqs:
+        y0 = np.concatenate([e.q + kick, np.zeros(d)])
+        t = np.linspace(0.0, 1500.0, 3)
+        df = ballbal.simulate(sc, y0, t, rtol=1e-11, atol=1e-14)
+        dev = np.max(np.abs(df[len(t) - 1].select(sc.coordinates).to_numpy()[0] - e.q))
+        if e.stability == "stable":
+            assert dev < 0.2 * 1e-6, (e.kind, dev)
+        else:
+            assert dev > 5 * 1e-6, (e.kind, dev)

@@ -92,7 +92,13 @@ class Equilibrium:
 
 def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
     """All equilibria (perfect balance first), with eigenvalues, the relative-stability
-    index (largest real part) and, where defined, the Routh–Hurwitz verdict."""
+    index (largest real part) and, where defined, the Routh–Hurwitz verdict.
+
+    With ball springs, ball angles count turns: the equilibria reported have the balls in
+    track order (``b_1 <= ... <= b_n <= b_1 + 2 pi``: balls cannot pass each other),
+    ``b_1`` in ``(-pi, pi]``, and identical balls relabelled round the ring count once;
+    the one that continues the perfect balance (:func:`balanced_state`) is ``"balanced"``.
+    Scenes with a ramp, gravity or an impulse have none (an error naming the effect)."""
     return [_equilibrium(d)
             for d in _native.equilibria(*balancer.native_args(), balancer.native_effects())]
 

@@ -33,7 +33,8 @@ impl Verdict {
 
 #[derive(Debug, Clone)]
 pub struct Equilibrium {
-    /// "perfect_balance", "together", "opposite" or "unbalanced".
+    /// "perfect_balance", "together", "opposite" or "unbalanced"; with ball springs
+    /// "balanced" for the state that continues the perfect balance.
     pub kind: String,
     /// `(x, y, b_1, ..., b_n)`, angles wrapped to `(-pi, pi]`.
     pub q: Vec<f64>,
@@ -294,13 +295,141 @@ pub fn equilibria_of<D: Dynamics + ?Sized>(p: &D, equal: bool, family: bool) -> 
     sorted_analysed(p, found, family)
 }
 
+/// Equilibria of a model whose ball angles count turns (a ring of ball springs), found
+/// by Newton from starts with the balls in track order, `b_1 <= ... <= b_n <= b_1 + 2 pi`,
+/// and kept only if they stay so: balls cannot pass each other, and a ball moved by a
+/// whole turn alone is another winding of the springs, not the same state. States that
+/// differ by a common turn of every ball are one (reported with `b_1` in `(-pi, pi]`), as
+/// are, for identical balls, states that differ by a cyclic relabelling round the ring.
+/// `extra`: further starts (e.g. a known equilibrium). Unanalysed, with kinds from their
+/// shape; see [`analyse_all`].
+pub fn equilibria_in_track_order<D: Dynamics + ?Sized>(
+    p: &D,
+    equal: bool,
+    extra: &[Vec<f64>],
+) -> Vec<(Vec<f64>, String)> {
+    let o = p.first_ball();
+    let n = p.ndof() - o;
+    let mut found: Vec<(Vec<f64>, String)> = vec![];
+    for q0 in extra.iter().cloned().chain(ordered_starts(n, o)) {
+        let Some(mut q) = newton_static(p, &q0) else {
+            continue;
+        };
+        // Identical balls near their springs' rest spacing form a nearly neutral ring:
+        // Newton stops anywhere along it with a small residual. Only points that satisfy
+        // the equations to round-off are equilibria.
+        let mut r = vec![0.0; q.len()];
+        static_residual(p, &q, &mut r);
+        if r.iter().any(|v| v.abs() > 1e-12) {
+            continue;
+        }
+        let in_order = (0..n).all(|i| {
+            let next = if i + 1 < n {
+                q[o + i + 1]
+            } else {
+                q[o] + 2.0 * PI
+            };
+            next - q[o + i] >= -1e-9
+        });
+        if !in_order {
+            continue;
+        }
+        let turn = q[o] - wrap(q[o]);
+        q[o..].iter_mut().for_each(|b| *b -= turn);
+        if !found.iter().any(|(f, _)| same_in_order(equal, o, f, &q)) {
+            let kind = classify(&q, o).to_string();
+            found.push((q, kind));
+        }
+    }
+    found
+}
+
+/// Starts in track order: the first ball at `per` angles, the others at increasing
+/// offsets from it drawn from a lattice of `m` points on `(0, 2 pi)`.
+fn ordered_starts(n: usize, o: usize) -> Vec<Vec<f64>> {
+    let (per, m) = match n {
+        1 => (24, 1),
+        2 => (12, 12),
+        3 => (6, 10),
+        4 => (4, 8),
+        _ => (2, n + 3),
+    };
+    // Offsets: all increasing (n - 1)-subsets of the lattice, in lexicographic order.
+    let lattice: Vec<f64> = (0..m)
+        .map(|k| 2.0 * PI * (k as f64 + 0.37) / m as f64)
+        .collect();
+    let mut subsets: Vec<Vec<usize>> = vec![vec![]];
+    for _ in 1..n {
+        subsets = subsets
+            .into_iter()
+            .flat_map(|s| {
+                let from = s.last().map_or(0, |&l| l + 1);
+                (from..m).map(move |k| {
+                    let mut t = s.clone();
+                    t.push(k);
+                    t
+                })
+            })
+            .collect();
+    }
+    let mut out = vec![];
+    'outer: for i in 0..per {
+        let b1 = -PI + (i as f64 + 0.1) * 2.0 * PI / per as f64;
+        for s in &subsets {
+            if out.len() >= 600 {
+                break 'outer;
+            }
+            let mut q = vec![0.0; o + n];
+            q[o] = b1;
+            for (j, &k) in s.iter().enumerate() {
+                q[o + 1 + j] = b1 + lattice[k];
+            }
+            out.push(q);
+        }
+    }
+    out
+}
+
+/// Whether two track-ordered states are one: equal up to a common whole turn of every
+/// ball, and for identical balls up to a cyclic relabelling.
+fn same_in_order(equal: bool, o: usize, a: &[f64], b: &[f64]) -> bool {
+    if (0..o).any(|i| (a[i] - b[i]).abs() > 1e-5) {
+        return false;
+    }
+    let n = a.len() - o;
+    let shifts = if equal { n } else { 1 };
+    (0..shifts).any(|r| {
+        // b relabelled: ball i is b's ball i + r, a turn further on past the ring's end
+        let bb = |i: usize| {
+            let j = i + r;
+            if j < n {
+                b[o + j]
+            } else {
+                b[o + j - n] + 2.0 * PI
+            }
+        };
+        let d0 = a[o] - bb(0);
+        let turn = d0 - wrap(d0);
+        (0..n).all(|i| (a[o + i] - bb(i) - turn).abs() < 1e-4)
+    })
+}
+
+/// Analyses found equilibria and orders them by kind and `x`.
+pub fn analyse_all<D: Dynamics + ?Sized>(
+    p: &D,
+    found: Vec<(Vec<f64>, String)>,
+    family: bool,
+) -> Vec<Equilibrium> {
+    sorted_analysed(p, found, family)
+}
+
 fn sorted_analysed<D: Dynamics + ?Sized>(
     p: &D,
     mut found: Vec<(Vec<f64>, String)>,
     family: bool,
 ) -> Vec<Equilibrium> {
     let order = |k: &str| match k {
-        "perfect_balance" => 0,
+        "perfect_balance" | "balanced" => 0,
         "together" => 1,
         "opposite" => 2,
         _ => 3,

@@ -37,7 +37,10 @@
 //! `kappa_t = a^2 b^2 / (a^2 - a b + b^2)` (over `k r_t` and `k r_t^2`). With `a = b`
 //! the coupling vanishes and a disk started flat stays flat: the planar equations.
 
-use crate::equilibria::{analyse_model, newton_static, Equilibrium};
+use crate::equilibria::{
+    analyse_all, analyse_model, equilibria, equilibria_in_track_order, equilibria_of,
+    newton_static, Equilibrium,
+};
 use crate::error::{check_range, Error, Result};
 use crate::model::{Dynamics, Planar};
 use crate::tilt_terms::{
@@ -305,6 +308,36 @@ impl Scene {
         Some(analyse_model(self, &q, kind, self.springs == 0.0))
     }
 
+    /// All equilibria found, each analysed, for an autonomous scene (empty otherwise).
+    /// Without springs as for the planar balancer; with springs those with the balls in
+    /// track order (see [`equilibria_in_track_order`]), the one that continues the
+    /// perfect balance (see [`Self::balanced_state`]) of kind `"balanced"`.
+    pub fn equilibria(&self) -> Vec<Equilibrium> {
+        if self.time_dependence().is_some() {
+            return vec![];
+        }
+        let p = &self.planar;
+        let equal = p.eta.windows(2).all(|w| w[0] == w[1]);
+        if self.springs == 0.0 {
+            return match self.tilt {
+                None => equilibria(p),
+                Some(_) => equilibria_of(self, equal, true),
+            };
+        }
+        let balanced = self.balanced_state();
+        let extra: Vec<Vec<f64>> = balanced.iter().map(|e| e.q.clone()).collect();
+        let mut found = equilibria_in_track_order(self, equal, &extra);
+        if let Some(b) = &balanced {
+            if let Some(f) = found
+                .iter_mut()
+                .find(|(q, _)| q.iter().zip(&b.q).all(|(u, v)| (u - v).abs() < 1e-6))
+            {
+                f.1 = "balanced".into();
+            }
+        }
+        analyse_all(self, found, false)
+    }
+
     /// Newton along spring stiffness `0 -> self.springs`, halving steps that fail.
     fn spring_homotopy(&self, mut q: Vec<f64>) -> Option<Vec<f64>> {
         let mut at: f64 = 0.0;
@@ -322,7 +355,7 @@ impl Scene {
                 }
                 _ => {
                     step /= 2.0;
-                    if step < 1e-3 {
+                    if step < 1e-6 {
                         return None;
                     }
                 }

@@ -2,7 +2,7 @@
 //! numerical work and turns core errors into `ValueError`; a Rust panic is caught and
 //! raised as `RuntimeError` so that it never unwinds into Python.
 
-use ballbal_core::equilibria::{equilibria as core_equilibria, equilibria_of, Equilibrium};
+use ballbal_core::equilibria::{equilibria as core_equilibria, Equilibrium};
 use ballbal_core::floquet::FloquetOptions;
 use ballbal_core::hb::{HbOptions, HbSolution, Status};
 use ballbal_core::ode::Options;
@@ -191,20 +191,10 @@ fn equilibria<'py>(
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let sc = autonomous_scene(&p, effects, "equilibria")?;
-    if sc.as_ref().is_some_and(|s| s.springs > 0.0) {
-        // Newton finds them (equilibria_of), but with springs angles that differ by whole
-        // turns are different spring windings, many of them balls passing each other:
-        // that needs ordered starts and a winding-aware identity first.
-        return Err(PyValueError::new_err(
-            "springs: the full set of equilibria of scenes with ball springs is not \
-             available yet; balanced_state() gives the balanced one",
-        ));
-    }
-    let equal = p.eta.windows(2).all(|w| w[0] == w[1]);
     let eqs = guarded(py, || {
         Ok(match &sc {
-            Some(s) if s.tilt.is_some() => equilibria_of(s, equal, true),
-            _ => core_equilibria(&p),
+            Some(s) => s.equilibria(),
+            None => core_equilibria(&p),
         })
     })?;
     eqs.into_iter().map(|e| equilibrium_dict(py, e)).collect()
