@@ -273,9 +273,32 @@ def test_track_damping_trade_off_of_seed_001():
     assert zb[0] < best < zb[-1], df
 
 
-def test_disturbance_needs_a_stable_perfect_balance():
-    with pytest.raises(ValueError, match="^balancer: the perfect balance"):
+def test_disturbance_needs_a_stable_balanced_state_and_an_autonomous_scene():
+    with pytest.raises(ValueError, match="^balancer: the balanced state must exist"):
         ballbal.disturbance_response(ballbal.Balancer(Omega=1.2), to=1.5)
+    with pytest.raises(ValueError, match="^scene: .*'gravity'"):
+        ballbal.disturbance_response(ballbal.Scene(gravity=0.1), to=1.5)
+
+
+@pytest.mark.parametrize("tilt", [None, ballbal.Tilt(a=1.8, b=2.2, j_t=0.15, j_z=0.25,
+                                                     zeta_r=0.05)])
+def test_speed_disturbance_of_a_spring_balancer_settles_in_its_balanced_state(tilt):
+    """Springs leave a residual whirl; after the disturbance the simulation must come to
+    rest in the balanced state at the new speed, computed as an equilibrium."""
+    b = ballbal.Balancer(Omega=2.0, zeta=0.05, zeta_b=0.1)
+    sc = ballbal.Scene(balancer=b, springs=1e-4, tilt=tilt)
+    res = ballbal.disturbance_response(sc, to=2.5, t_end=1500)
+    target = ballbal.balanced_state(sc.replace(Omega=2.5))
+    assert target.stability == "stable"
+    end = res.trajectory.row(-1, named=True)
+    q = np.array([end[c] for c in sc.coordinates])
+    # identical balls: the same state whichever ball is where (they may swap places)
+    o = len(sc.coordinates) - sc.n_balls
+    assert np.allclose(canonical(q, True, o), canonical(target.q, True, o), atol=1e-5)
+    assert res.final_r == pytest.approx(math.hypot(*target.q[:2]), abs=1e-6)
+    assert res.final_r > 0.1  # the springs' residual whirl, not a perfect balance
+    start = math.hypot(*ballbal.balanced_state(sc).q[:2])
+    assert res.peak > max(start, res.final_r) + 0.05  # thrown out by the disturbance
 
 
 
@@ -289,16 +312,17 @@ def steady_residual(scene, q):
     return acc - np.concatenate([[-w * w * x, -w * w * y], np.zeros(n)])
 
 
-def canonical(q, equal):
+def canonical(q, equal, rotor=2):
     """Balls in track order as a tuple with b_1 in [-pi, pi); identical balls: the least
     of the cyclic relabellings round the ring."""
     q = np.asarray(q, dtype=float)
-    n = q.size - 2
+    o = rotor
+    n = q.size - o
     forms = []
     for r in range(n if equal else 1):
-        b = np.concatenate([q[2 + r :], q[2 : 2 + r] + 2 * math.pi])
+        b = np.concatenate([q[o + r :], q[o : o + r] + 2 * math.pi])
         b = b - 2 * math.pi * math.floor((b[0] + math.pi) / (2 * math.pi))
-        forms.append(tuple(np.round(np.concatenate([q[:2], b]), 5)))
+        forms.append(tuple(np.round(np.concatenate([q[:o], b]), 5)))
     return min(forms)
 
 

@@ -262,3 +262,16 @@ def test_generated_equations_are_what_the_derivation_gives():
     out = subprocess.run([sys.executable, str(script), "--check"], capture_output=True,
                          text=True, timeout=600)
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_accuracy_cost_of_a_tilting_rotor():
+    """The accuracy study runs on a scene: its reference closes under time simulation,
+    and the error falls with the harmonics and the monodromy tolerance."""
+    sc = ballbal.Scene(tilt=ballbal.Tilt(a=1.8, b=2.2, j_t=0.15, j_z=0.25, zeta_r=0.05))
+    df = ballbal.accuracy_cost(sc, N=(2, 4, 8), samples=(4,), tol=(1e-6,),
+                               rtol=(1e-4, 1e-8), repeats=1, reference_N=24)
+    assert df["reference_closure"][0] < 1e-9
+    by_n = df.filter(df["knob"] == "N")["omega_error"].to_list()
+    assert by_n[0] > 1e-7 and by_n[0] > 1e3 * by_n[1] and by_n[1] > by_n[2]
+    by_rtol = df.filter(df["knob"] == "rtol")["multiplier_error"].to_list()
+    assert by_rtol[0] > 100 * by_rtol[1]

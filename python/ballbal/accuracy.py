@@ -13,6 +13,7 @@ import polars as pl
 
 from .analysis import PeriodicSolution, periodic
 from .model import Balancer
+from .scene import Scene
 
 
 def _match_error(a: np.ndarray, ref: np.ndarray) -> float:
@@ -36,7 +37,7 @@ def _coeff_error(c: np.ndarray, ref: np.ndarray) -> float:
 
 
 def accuracy_cost(
-    balancer: Balancer,
+    balancer: Balancer | Scene,
     pattern: str = "R-R",
     *,
     N: Sequence[int] = (1, 2, 3, 4, 5, 6, 8, 10, 12, 16),
@@ -49,7 +50,8 @@ def accuracy_cost(
     repeats: int = 5,
     guess: PeriodicSolution | None = None,
 ) -> pl.DataFrame:
-    """Error against time for each accuracy knob at one point, as a polars table.
+    """Error against time for each accuracy knob at one point, as a polars table
+    (``balancer`` may be an autonomous scene).
 
     Knobs, each varied with the others at a high-accuracy baseline (``base_N``
     harmonics, default samples, Newton tol 1e-10, RK45 rtol 1e-9): ``N``; ``samples``

@@ -11,6 +11,7 @@ import numpy as np
 import polars as pl
 
 from .analysis import equilibria, simulate
+from .balance import balanced_state
 from .model import Balancer
 from .scene import Ramp, Scene
 
@@ -28,19 +29,26 @@ class DisturbanceResponse:
     trajectory: pl.DataFrame
 
 
-def _perfect_balance(b: Balancer) -> np.ndarray:
-    for e in equilibria(b):
-        if e.kind == "perfect_balance" and e.stability == "stable":
-            return np.asarray(e.q, dtype=float)
-    raise ValueError(
-        f"balancer: the perfect balance must exist and be stable at the starting speed "
-        f"Omega = {b.Omega} (eta >= 1/2 and above the resonance), so that the disturbance "
-        "starts from rest"
-    )
+def _balanced_start(model: Balancer | Scene) -> np.ndarray:
+    """The stable balanced state at the starting speed, where the disturbance begins."""
+    if isinstance(model, Scene):
+        if model.time_dependence is not None:
+            raise ValueError(
+                f"scene: the disturbance brings its own spin change, so the scene must be "
+                f"autonomous, but it has '{model.time_dependence}'")
+        e = balanced_state(model)
+    else:
+        e = next((e for e in equilibria(model) if e.kind == "perfect_balance"), None)
+    if e is None or e.stability != "stable":
+        raise ValueError(
+            f"balancer: the balanced state must exist and be stable at the starting speed "
+            f"Omega = {model.Omega} (eta >= 1/2 and above the resonance), so that the "
+            "disturbance starts from rest")
+    return np.asarray(e.q, dtype=float)
 
 
 def disturbance_response(
-    balancer: Balancer,
+    balancer: Balancer | Scene,
     to: float,
     *,
     start: float = 10.0,
@@ -52,15 +60,20 @@ def disturbance_response(
 ) -> DisturbanceResponse:
     """Start at the stable perfect balance at ``balancer.Omega``, change the spin to
     ``to`` linearly over ``duration`` from ``start`` (seed 001: 100 rad/s in 0.11 s), and
-    measure the radial vibration. ``band`` is in units of the eccentricity ``e``."""
+    measure the radial vibration. ``band`` is in units of the eccentricity ``e``.
+
+    ``balancer`` may be an autonomous scene (ball springs, a tilting disk): it starts at
+    its stable balanced state (:func:`balanced_state`), and ``final_r`` is then that of
+    the balanced state at ``to``, not 0, where springs leave a residual whirl."""
     if not band > 0:
         raise ValueError(f"band: must be > 0, got {band}")
     if not t_end > start + duration:
         raise ValueError(f"t_end: must be after the disturbance ends ({start + duration})")
-    q = _perfect_balance(balancer)
-    n = balancer.n_balls
-    y0 = np.concatenate([q, np.zeros(n + 2)])
-    scene = Scene(balancer=balancer, ramp=Ramp(to=to, start=start, duration=duration))
+    q = _balanced_start(balancer)
+    y0 = np.concatenate([q, np.zeros(q.size)])
+    ramp = Ramp(to=to, start=start, duration=duration)
+    scene = (replace(balancer, ramp=ramp) if isinstance(balancer, Scene)
+             else Scene(balancer=balancer, ramp=ramp))
     t = np.arange(0.0, t_end + dt / 2, dt)
     df = simulate(scene, y0, t, rtol=rtol, atol=rtol * 1e-2)
     r = np.hypot(df["x"].to_numpy(), df["y"].to_numpy())
@@ -79,7 +92,7 @@ def disturbance_response(
 
 
 def track_damping_study(
-    balancer: Balancer,
+    balancer: Balancer | Scene,
     zeta_b: Sequence[float],
     to: float,
     **kw: Any,
