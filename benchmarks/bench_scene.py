@@ -69,6 +69,26 @@ def main() -> None:
               f"({thb / hb[8]:.2f} x planar)")
         print(f"  balanced state + eigenvalues:         {tmap / grid.size * 1e6:8.1f} us "
               f"a point (balance_map of {grid.size} points)")
+    if hasattr(ballbal, "Scene"):
+        # R-R scans (seeds, continuation, Floquet) over one grid, 2 threads, best of 3
+        axes = {"Omega": (1.0, 2.0, 0.05), "eta": (0.4, 1.5, 0.1)}
+        tl = ballbal.Tilt(a=1.8, b=2.2, j_t=0.35, j_z=0.55, zeta_r=0.04)
+        print("R-R scan, Omega 1.0-2.0 x eta 0.4-1.5 (21 x 12), N = 3, 2 threads:")
+        base = None
+        for label, m in [("planar", b), ("ball springs 1e-5", ballbal.Scene(balancer=b,
+                                                                              springs=1e-5)),
+                         ("tilting disk", ballbal.Scene(balancer=b, tilt=tl))]:
+            try:
+                secs = best_time(lambda m=m: ballbal.scan(m, threads=2, **axes), 3)
+            except ValueError as e:  # builds before scene scans
+                print(f"  {label:<18} not available ({e})")
+                continue
+            df = ballbal.scan(m, threads=2, **axes)
+            pts = df.select(list(axes)).unique().height
+            found = int((df["status"] == "converged").sum())
+            base = base or secs
+            print(f"  {label:<18} {secs:7.2f} s  {secs / pts * 1e3:6.2f} ms a point  "
+                  f"{found:4d} solutions  ({secs / base:.2f} x planar)")
 
 
 if __name__ == "__main__":
