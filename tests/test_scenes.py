@@ -59,11 +59,12 @@ def ground_rhs(scene, t, s):
               + np.sum(fb * dl * C * dphi**2))
     rhs[1] = (fy - 2 * z * dY - Y - g - mu * (math.cos(th) * dw - math.sin(th) * w0**2)
               + np.sum(fb * dl * S * dphi**2))
-    # ball springs: V = k dl^2 / 2 sum (phi_{j+1} - phi_j - 2 pi / n)^2, ring closed
+    # ball springs: V = k dl^2 / 2 sum (phi_{j+1} - phi_j - 2 pi / n)^2, a ring closed
+    # by ball n to ball 1, or seed 004's chain without that last spring
     dv = np.zeros(n)
     if scene.springs:
         kd = scene.springs * dl**2
-        for j in range(n):
+        for j in range(n if scene.spring_layout == "ring" else n - 1):
             nxt = (j + 1) % n
             sj = phi[nxt] - phi[j] - 2 * math.pi / n + (2 * math.pi if nxt == 0 else 0.0)
             dv[j] -= kd * sj
@@ -115,6 +116,36 @@ def test_every_effect_against_the_ground_frame_lagrangian():
     # and the effects do something: without them the motion differs
     plain = ballbal.simulate(FULL.balancer, y0, t, rtol=1e-11, atol=1e-13)
     assert np.max(np.abs(plain["x"].to_numpy() - df["x"].to_numpy())) > 1e-2
+
+
+def test_spring_chain_against_the_ground_frame_lagrangian():
+    y0 = np.array([0.2, -0.1, 0.3, 2.0, 4.5, 0.05, 0.1, -0.2, 0.1, 0.3])
+    t = np.linspace(0.0, 40.0, 81)
+    chain = FULL.replace(spring_layout="chain")
+    gap, df = ground_gap(chain, y0, t)
+    assert gap < 1e-7
+    ring = ballbal.simulate(FULL, y0, t, rtol=1e-11, atol=1e-13)
+    assert np.max(np.abs(ring["b1"].to_numpy() - df["b1"].to_numpy())) > 1e-2
+
+
+def test_two_ball_ring_is_a_chain_of_twice_the_stiffness():
+    b = ballbal.Balancer(Omega=1.3, zeta_b=0.05)
+    y0 = np.array([0.1, 0.0, 0.4, 2.9, 0.0, 0.1, -1.3, -1.0])
+    t = np.linspace(0.0, 60.0, 61)
+    ring = ballbal.simulate(ballbal.Scene(balancer=b, springs=1e-3), y0, t, rtol=1e-11,
+                            atol=1e-13)
+    chain = ballbal.simulate(ballbal.Scene(balancer=b, springs=2e-3, spring_layout="chain"),
+                             y0, t, rtol=1e-11, atol=1e-13)
+    half = ballbal.simulate(ballbal.Scene(balancer=b, springs=1e-3, spring_layout="chain"),
+                            y0, t, rtol=1e-11, atol=1e-13)
+    cols = ["x", "y", "b1", "b2"]
+    assert np.max(np.abs(ring.select(cols).to_numpy() - chain.select(cols).to_numpy())) < 1e-9
+    assert np.max(np.abs(ring.select(cols).to_numpy() - half.select(cols).to_numpy())) > 1e-3
+    eq_r = ballbal.equilibria(ballbal.Scene(balancer=b, springs=1e-3))
+    eq_c = ballbal.equilibria(ballbal.Scene(balancer=b, springs=2e-3, spring_layout="chain"))
+    assert [e.kind for e in eq_r] == [e.kind for e in eq_c]
+    for u, v in zip(eq_r, eq_c, strict=True):
+        assert np.allclose(u.q, v.q, atol=1e-9)
 
 
 @pytest.mark.parametrize("effect", ["springs", "ramp", "gravity", "impulse"])
@@ -193,6 +224,9 @@ def test_scene_files_round_trip(tmp_path):
     p = tmp_path / "full.toml"
     FULL.save(p)
     assert ballbal.load_scene(p) == FULL
+    chain = FULL.replace(spring_layout="chain")
+    chain.save(p)
+    assert ballbal.load_scene(p) == chain
     flat = tmp_path / "flat.toml"
     flat.write_text("mu = 0.2\nOmega = 1.3\neta = 0.9\nballs = 3\n")
     sc = ballbal.load_scene(flat)
@@ -203,6 +237,8 @@ def test_scene_files_round_trip(tmp_path):
     ("mu = 0.2\nzetta = 0.1\n", "unknown key"),
     ("[balancer]\nmu = 0.2\n[spring]\nstiffness = 1.0\n", "unknown table"),
     ("[balancer]\nmu = 0.2\n[springs]\nk = 1.0\n", "springs: unknown key"),
+    ("[balancer]\nmu = 0.2\n[springs]\nstiffness = 1.0\nlayout = 'star'\n",
+     "spring_layout: must be 'ring' or 'chain'"),
     ("[balancer]\nmu = 0.2\n[ramp]\nstart = 1.0\n", "incomplete"),
     ("[balancer]\nmu = 0.2\n[ramp]\nto = 2.0\nduration = 0.0\n", "ramp.duration"),
     ("[balancer]\nmu = 2.0\n", "mu"),
@@ -225,13 +261,14 @@ def test_malformed_scene_files_say_what_is_wrong(tmp_path, text, message):
 
 
 values = st.one_of(st.floats(allow_nan=True), st.integers(-3, 3), st.text(max_size=3),
+                   st.sampled_from(["ring", "chain"]),
                    st.booleans(), st.lists(st.floats(0.1, 2.0), max_size=3))
 keys = st.sampled_from(["mu", "zeta", "zeta_b", "delta", "Omega", "eta", "balls", "k", "x"])
 tables = st.sampled_from(["springs", "ramp", "gravity", "impulse", "tilt", "balancer",
                           "bearing"])
 inner = st.dictionaries(st.sampled_from(["stiffness", "to", "start", "duration", "g",
                                          "amplitude", "t0", "sharpness", "angle", "a", "b",
-                                         "j_t", "j_z", "zeta_r", "mu", "q"]),
+                                         "j_t", "j_z", "zeta_r", "mu", "q", "layout"]),
                         values, max_size=5)
 
 

@@ -7,7 +7,7 @@ import numpy.typing as npt
 Effects = (
     tuple[float, tuple[float, float, float] | None, float,
           tuple[float, float, float, float] | None,
-          tuple[float, float, float, float, float] | None]
+          tuple[float, float, float, float, float] | None, bool]
     | None
 )
 PlanarArgs = tuple[float, float, list[float], float, float, list[float]]

@@ -3,8 +3,10 @@
 A scene is a :class:`Balancer` with optional effects (``model.md`` units: lengths over
 the eccentricity ``e``, time over ``1/w_n``, forces over ``M e w_n^2``):
 
-* ``springs``: circumferential springs between neighbouring balls (a ring), stiffness
-  ``k_d / k``, rest spacing ``2 pi / n`` (seed 004's ball-spring balancer);
+* ``springs``: circumferential springs between neighbouring balls, stiffness ``k_d / k``,
+  rest spacing ``2 pi / n`` (seed 004's ball-spring balancer); ``spring_layout``
+  ``"ring"`` (n springs, ball n to ball 1 closing the ring) or ``"chain"`` (seed 004's
+  n - 1 springs, ball 1 to ball n; for two balls a ring of stiffness k is a chain of 2 k);
 * ``ramp``: the spin changes linearly from ``Omega`` to ``ramp.to`` over
   ``ramp.duration`` from ``ramp.start`` (a run-up, or seed 001's speed disturbance);
 * ``gravity``: ``g / (e w_n^2)`` for a horizontal spin axis (gravity along -Y of the
@@ -20,13 +22,12 @@ The support is the isotropic spring–damper of ``model.md`` (a fluid-film beari
 later issue: it will be one more support kind here).
 
 Every analysis accepts a scene. Time simulation works with any; periodic solutions,
-Floquet and equilibria need an autonomous scene (no ramp, gravity or impulse: asking
-is an error that names the effect). With springs, :func:`ballbal.balanced_state` gives
-the balanced equilibrium (the full set is not available yet); scans of periodic
-solutions take the planar balancer only.
+Floquet, equilibria, scans and the balanced state need an autonomous scene (no ramp,
+gravity or impulse: asking is an error that names the effect).
 
 Files (TOML): the balancer's keys at the top level or in ``[balancer]`` (``balls`` for
-equal balls), and optional tables ``[springs] stiffness``, ``[ramp] to, start,
+equal balls), and optional tables ``[springs] stiffness, layout`` (``"ring"`` when
+omitted), ``[ramp] to, start,
 duration``, ``[gravity] g``, ``[impulse] amplitude, t0, sharpness, angle``, ``[tilt] a,
 b, j_t, j_z, zeta_r``. Unknown keys and tables are errors.
 """
@@ -135,6 +136,7 @@ class Scene:
     gravity: float = 0.0
     impulse: Impulse | None = None
     tilt: Tilt | None = None
+    spring_layout: str = "ring"
 
     def __post_init__(self) -> None:
         if not isinstance(self.balancer, Balancer):
@@ -147,6 +149,9 @@ class Scene:
             raise ValueError("springs: ball springs need at least 2 balls")
         if self.gravity < 0:
             raise ValueError(f"gravity: must be >= 0, got {self.gravity}")
+        if self.spring_layout not in ("ring", "chain"):
+            raise ValueError(f"spring_layout: must be 'ring' or 'chain', "
+                             f"got {self.spring_layout!r}")
         for name, kind in (("ramp", Ramp), ("impulse", Impulse), ("tilt", Tilt)):
             v = getattr(self, name)
             if v is not None and not isinstance(v, kind):
@@ -195,7 +200,7 @@ class Scene:
             self.impulse.amplitude, self.impulse.t0, self.impulse.sharpness, self.impulse.angle)
         tl = None if self.tilt is None else (
             self.tilt.a, self.tilt.b, self.tilt.j_t, self.tilt.j_z, self.tilt.zeta_r)
-        return (self.springs, ramp, self.gravity, imp, tl)
+        return (self.springs, ramp, self.gravity, imp, tl, self.spring_layout == "chain")
 
     @property
     def time_dependence(self) -> str | None:
@@ -214,8 +219,10 @@ class Scene:
         b["eta"] = list(b["eta"])
         if isinstance(b["zeta_b"], tuple):
             b["zeta_b"] = list(b["zeta_b"])
-        if self.springs:
+        if self.springs or self.spring_layout != "ring":
             d["springs"] = {"stiffness": self.springs}
+            if self.spring_layout != "ring":
+                d["springs"]["layout"] = self.spring_layout
         if self.ramp is not None:
             d["ramp"] = asdict(self.ramp)
         if self.gravity:
@@ -241,13 +248,15 @@ class Scene:
 
 
 def _toml_value(v: Any) -> str:
+    if isinstance(v, str):
+        return '"' + v + '"'  # layout names only: no quotes or escapes inside
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
     return repr(float(v))
 
 
-_TABLES = {"springs": {"stiffness"}, "ramp": {"to", "start", "duration"}, "gravity": {"g"},
-           "impulse": {"amplitude", "t0", "sharpness", "angle"},
+_TABLES = {"springs": {"stiffness", "layout"}, "ramp": {"to", "start", "duration"},
+           "gravity": {"g"}, "impulse": {"amplitude", "t0", "sharpness", "angle"},
            "tilt": {"a", "b", "j_t", "j_z", "zeta_r"}}
 _BALANCER_FIELDS = {f.name for f in fields(Balancer)}
 _TILT_FIELDS = {f.name for f in fields(Tilt)}
@@ -297,6 +306,7 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
         return Scene(
             balancer=b,
             springs=d["springs"]["stiffness"] if "springs" in d else 0.0,
+            spring_layout=d["springs"].get("layout", "ring") if "springs" in d else "ring",
             ramp=Ramp(**d["ramp"]) if "ramp" in d else None,
             gravity=d["gravity"]["g"] if "gravity" in d else 0.0,
             impulse=Impulse(**d["impulse"]) if "impulse" in d else None,

@@ -24,4 +24,4 @@ pub mod tilt_terms;
 
 pub use error::{Error, Result};
 pub use model::{Dynamics, Planar};
-pub use scene::Scene;
+pub use scene::{Scene, SpringLayout};

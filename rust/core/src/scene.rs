@@ -13,10 +13,13 @@
 //! * y row: `+ Omega' x + mu Omega' + sum m_i Omega' cos b_i`;
 //! * ball row i (divided by `m_i`): `+ Omega' (delta + x cos b_i + y sin b_i)`.
 //!
-//! Ball springs: neighbouring balls (a ring, ball n to ball 1) joined by circumferential
-//! springs of stiffness `k_d` and rest spacing `2 pi / n`: potential
+//! Ball springs: neighbouring balls joined by circumferential springs of stiffness `k_d`
+//! and rest spacing `2 pi / n`: potential
 //! `V = kappa delta^2 / 2 sum_j (b_{j+1} - b_j - 2 pi / n)^2` with `kappa = k_d / k`, and
-//! ball row i gains `dV/db_i / m_i`.
+//! ball row i gains `dV/db_i / m_i`. In a ring (the default) `j` runs over all `n`
+//! neighbours, ball n to ball 1 closing it with spacing `b_1 + 2 pi - b_n`; seed 004's
+//! chain (its eq. 16) has the `n - 1` springs from ball 1 to ball n only. For two balls
+//! the ring's two springs are the chain's one at twice the stiffness.
 //!
 //! Ground-fixed forces `F = (F_X, F_Y)` act in the rotating frame as
 //! `(cos th F_X + sin th F_Y, -sin th F_X + cos th F_Y)`. Gravity (spin axis
@@ -116,11 +119,23 @@ pub struct Impulse {
     pub angle: f64,
 }
 
+/// How the ball springs join the balls.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SpringLayout {
+    /// `n` springs round the track, the last from ball n to ball 1.
+    #[default]
+    Ring,
+    /// `n - 1` springs, ball 1 to 2, ..., n - 1 to n (seed 004).
+    Chain,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     pub planar: Planar,
     /// `k_d / k`; 0 for no springs.
     pub springs: f64,
+    /// Ring (default) or chain; set with [`Scene::with_spring_layout`].
+    pub spring_layout: SpringLayout,
     pub ramp: Option<Ramp>,
     /// `g / (e w_n^2)`; 0 for a vertical spin axis.
     pub gravity: f64,
@@ -200,12 +215,29 @@ impl Scene {
         Ok(Scene {
             planar,
             springs,
+            spring_layout: SpringLayout::Ring,
             ramp,
             gravity,
             impulse,
             tilt,
             consts,
         })
+    }
+
+    /// The same scene with its springs joined as `layout`.
+    pub fn with_spring_layout(mut self, layout: SpringLayout) -> Self {
+        self.spring_layout = layout;
+        self
+    }
+
+    /// Number of ball springs (when `springs > 0`).
+    #[inline]
+    fn n_springs(&self) -> usize {
+        let n = self.planar.n_balls();
+        match self.spring_layout {
+            SpringLayout::Ring => n,
+            SpringLayout::Chain => n - 1,
+        }
     }
 
     /// Returns a copy with one named parameter changed (scans and continuation): the
@@ -259,6 +291,7 @@ impl Scene {
             self.impulse.clone(),
             tilt,
         )
+        .map(|s| s.with_spring_layout(self.spring_layout))
     }
 
     /// The balanced state and its stability (seed 004's "stable balanced region"): the
@@ -425,7 +458,7 @@ impl Scene {
         let p = &self.planar;
         let (n, o) = (p.n_balls(), self.off());
         let kd = self.springs * p.delta * p.delta;
-        for j in 0..n {
+        for j in 0..self.n_springs() {
             let f = kd * self.spacing(q, j);
             let b = (j + 1) % n;
             // dV/db_j = -k s_j, dV/db_{j+1} = +k s_j
@@ -438,7 +471,7 @@ impl Scene {
         let p = &self.planar;
         let (n, o, d) = (p.n_balls(), self.off(), self.ndof());
         let kd = self.springs * p.delta * p.delta;
-        for jj in 0..n {
+        for jj in 0..self.n_springs() {
             let b = (jj + 1) % n;
             let (ra, rb) = (o + jj, o + b);
             // Hessian of kd/2 (b_b - b_a - rest)^2, rows divided by the ball's m.
@@ -835,6 +868,53 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn spring_chain_is_seed_004s_potential_and_half_a_two_ball_ring() {
+        // Chain of three balls: ball rows gain dV/db_i / m_i with
+        // V = kd/2 [(b2 - b1 - 2pi/3)^2 + (b3 - b2 - 2pi/3)^2], written out here.
+        let p = planar();
+        let (q, v, a) = state();
+        let k = 0.3;
+        let chain = Scene::new(p.clone(), k, None, 0.0, None, None)
+            .unwrap()
+            .with_spring_layout(SpringLayout::Chain);
+        let plain = Scene::new(p.clone(), 0.0, None, 0.0, None, None).unwrap();
+        let (mut rc, mut r0) = ([0.0; 5], [0.0; 5]);
+        chain.residual(0.0, &q, &v, &a, &mut rc);
+        plain.residual(0.0, &q, &v, &a, &mut r0);
+        let kd = k * p.delta * p.delta;
+        let rest = 2.0 * PI / 3.0;
+        let (s1, s2) = (q[3] - q[2] - rest, q[4] - q[3] - rest);
+        let dv = [-kd * s1, kd * s1 - kd * s2, kd * s2];
+        for i in 0..3 {
+            let want = r0[2 + i] + dv[i] / p.m(i);
+            assert!(
+                (rc[2 + i] - want).abs() < 1e-12 * want.abs().max(1.0),
+                "{i}: {} {want}",
+                rc[2 + i]
+            );
+        }
+        assert_eq!(&rc[..2], &r0[..2]);
+        check_jacobians(&chain, &q, &v, &a);
+        // Two balls: the ring's two springs are one spring of twice the stiffness.
+        let p2 = Planar::new(0.2, 0.05, &[0.07], 50.0, 1.3, &[0.9, 1.1]).unwrap();
+        let ring = Scene::new(p2.clone(), k, None, 0.0, None, None).unwrap();
+        let chain2 = Scene::new(p2, 2.0 * k, None, 0.0, None, None)
+            .unwrap()
+            .with_spring_layout(SpringLayout::Chain);
+        let (q, v, a) = (
+            [0.3, -0.2, 0.7, 2.4],
+            [0.1, 0.4, -1.2, 0.3],
+            [0.0, 0.1, 0.2, -0.3],
+        );
+        let (mut x, mut y) = ([0.0; 4], [0.0; 4]);
+        ring.residual(0.0, &q, &v, &a, &mut x);
+        chain2.residual(0.0, &q, &v, &a, &mut y);
+        for i in 0..4 {
+            assert!((x[i] - y[i]).abs() < 1e-12 * (1.0 + x[i].abs()));
         }
     }
 

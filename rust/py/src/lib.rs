@@ -11,7 +11,7 @@ use ballbal_core::periodic::{
     PeriodicOptions,
 };
 use ballbal_core::simulate::simulate as core_simulate;
-use ballbal_core::{Dynamics, Error, Planar, Scene};
+use ballbal_core::{Dynamics, Error, Planar, Scene, SpringLayout};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -58,19 +58,20 @@ fn planar(
 }
 
 /// Effects of a scene: `(springs, ramp (to, start, duration), gravity, impulse
-/// (amplitude, t0, sharpness, angle), tilt (a, b, j_t, j_z, zeta_r))`; `None` for the
-/// plain planar balancer.
+/// (amplitude, t0, sharpness, angle), tilt (a, b, j_t, j_z, zeta_r), spring chain)`;
+/// `None` for the plain planar balancer.
 type Effects = Option<(
     f64,
     Option<(f64, f64, f64)>,
     f64,
     Option<(f64, f64, f64, f64)>,
     Option<(f64, f64, f64, f64, f64)>,
+    bool,
 )>;
 
 fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
     use ballbal_core::scene::{Impulse, Ramp, Tilt};
-    let Some((springs, ramp, gravity, impulse, tilt)) = effects else {
+    let Some((springs, ramp, gravity, impulse, tilt, chain)) = effects else {
         return Ok(None);
     };
     Scene::new(
@@ -96,7 +97,13 @@ fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
             zeta_r,
         }),
     )
-    .map(Some)
+    .map(|s| {
+        Some(s.with_spring_layout(if chain {
+            SpringLayout::Chain
+        } else {
+            SpringLayout::Ring
+        }))
+    })
     .map_err(to_py)
 }
 
