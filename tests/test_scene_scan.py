@@ -1,6 +1,9 @@
 """Scans of autonomous scenes (ball springs, a tilting disk): checked against the plain
 balancer they reduce to, and against time simulation of the attractors they report."""
 
+import subprocess
+import sys
+
 import numpy as np
 import polars as pl
 import pytest
@@ -73,3 +76,28 @@ def test_scene_axes_and_time_dependent_scenes_give_clear_errors(tmp_path):
     ballbal.scan(SPRINGS, Omega=[1.2], out=tmp_path / "s")
     with pytest.raises(ValueError, match="differs in scene"):
         ballbal.scan(SPRINGS.replace(springs=2e-5), Omega=[1.2], out=tmp_path / "s")
+
+
+def test_command_line_takes_scene_files(tmp_path):
+    scene = tmp_path / "tilt.toml"
+    OFF_CENTRE.replace(springs=1e-4, spring_layout="chain").save(scene)
+    exe = [sys.executable, "-m", "ballbal.cli"]
+    r = subprocess.run(exe + ["equilibria", "--scene", str(scene), "--Omega", "1.5"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "q = (x, y, A, B, b1, b2)" in r.stdout and "balanced" in r.stdout
+    want = ballbal.balanced_state(ballbal.load_scene(scene).replace(Omega=1.5))
+    line = next(x for x in r.stdout.splitlines() if x.strip().startswith("balanced"))
+    printed = [float(v) for v in line.split("q=(")[1].split(")")[0].split(",")]
+    assert np.allclose(printed, want.q, atol=1e-4)
+    out = tmp_path / "scan"
+    r = subprocess.run(exe + ["scan", str(scene), "--Omega", "1.15:1.2:0.05", "--grid",
+                              "springs=0:1e-4:1e-4", "-o", str(out), "--no-progress"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    df = ballbal.read_scan(out)
+    assert set(df["springs"]) == {0.0, 1e-4} and (df["status"] == "converged").any()
+    assert ballbal.scan_meta(out)["scene"]["springs"]["layout"] == "chain"
+    r = subprocess.run(exe + ["equilibria", "--scene", str(scene), "--balls", "3"],
+                       capture_output=True, text=True, timeout=60)
+    assert r.returncode == 2 and "balls: the scene file sets the balls" in r.stderr

@@ -1,5 +1,6 @@
 """Command line: ``ballbal run`` solves the thesis' standard case; ``ballbal periodic``
-and ``ballbal equilibria`` take parameters; ``ballbal scan SCENE.toml --Omega 1:2:0.1
+and ``ballbal equilibria`` take parameters, or a scene file (``--scene SCENE.toml``,
+whose balancer the parameter options given change); ``ballbal scan SCENE.toml --Omega 1:2:0.1
 --eta 0.4:1.5:0.1 -o out.parquet`` maps a parameter plane (Ctrl-C keeps the finished
 chunks, running the same command again resumes) and ``ballbal plot out.parquet`` draws
 the map."""
@@ -15,35 +16,62 @@ import numpy as np
 from .analysis import equilibria, periodic
 from .model import Balancer
 from .scan import SCANNABLE, read_scan, scan, scan_meta
-from .scene import load_scene
+from .scene import Scene, load_scene
+
+_DEFAULTS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0, "Omega": 1.2}
 
 
-def _balancer(a: argparse.Namespace) -> Balancer:
-    eta = a.eta if len(a.eta) > 1 else a.eta * a.balls
-    return Balancer(mu=a.mu, zeta=a.zeta, zeta_b=a.zeta_b, delta=a.delta, Omega=a.Omega, eta=eta)
+def _model(a: argparse.Namespace) -> Balancer | Scene:
+    given = {k: getattr(a, k) for k in _DEFAULTS if getattr(a, k) is not None}
+    if a.scene:
+        if a.balls is not None:
+            raise ValueError("balls: the scene file sets the balls; give --eta to change "
+                             "their masses")
+        sc = load_scene(a.scene)
+        if a.eta is not None:
+            given["eta"] = a.eta[0] if len(a.eta) == 1 else tuple(a.eta)
+        return sc.replace(**given)
+    eta = a.eta or [1.0]
+    eta = eta if len(eta) > 1 else eta * (a.balls or 2)
+    return Balancer(**{**_DEFAULTS, **given}, eta=eta)
 
 
 def _params(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--mu", type=float, default=0.2)
-    p.add_argument("--zeta", type=float, default=0.05)
-    p.add_argument("--zeta-b", dest="zeta_b", type=float, default=0.05)
-    p.add_argument("--delta", type=float, default=50.0)
-    p.add_argument("--Omega", type=float, default=1.2)
-    p.add_argument("--eta", type=float, nargs="+", default=[1.0])
-    p.add_argument("--balls", type=int, default=2, help="number of equal balls if one eta")
+    p.add_argument("--scene", default=None, help="scene TOML (springs, tilt, ...)")
+    p.add_argument("--mu", type=float, default=None, help="default 0.2")
+    p.add_argument("--zeta", type=float, default=None, help="default 0.05")
+    p.add_argument("--zeta-b", dest="zeta_b", type=float, default=None, help="default 0.05")
+    p.add_argument("--delta", type=float, default=None, help="default 50")
+    p.add_argument("--Omega", type=float, default=None, help="default 1.2")
+    p.add_argument("--eta", type=float, nargs="+", default=None, help="default 1.0")
+    p.add_argument("--balls", type=int, default=None,
+                   help="number of equal balls if one eta (default 2)")
 
 
-def _print_equilibria(b: Balancer) -> None:
-    print(f"Equilibria at Omega={b.Omega}, eta={list(b.eta)}:")
-    for e in equilibria(b):
+def _print_equilibria(b: Balancer | Scene) -> None:
+    eta = b.balancer.eta if isinstance(b, Scene) else b.eta
+    names = b.coordinates if isinstance(b, Scene) else ["x", "y"] + [
+        f"b{i + 1}" for i in range(b.n_balls)]
+    print(f"Equilibria at Omega={b.Omega}, eta={list(eta)}, q = ({', '.join(names)}):")
+    eqs = equilibria(b)
+    family = [e for e in eqs if e.neutral > 0]
+    for e in eqs:
+        if e.neutral > 0 and e is not family[0]:
+            continue  # points of one family of perfect balances (n >= 3): shown once
         rh = ""
         if e.routh_hurwitz is not None:
             rh = f", Routh-Hurwitz {'stable' if e.routh_hurwitz else 'not stable'}"
         q = ", ".join(f"{v:+.4f}" for v in e.q)
         print(f"  {e.kind:16s} q=({q})  {e.stability} (index {e.stability_index:+.4g}{rh})")
+        if e.neutral > 0 and len(family) > 1:
+            idx = [f.stability_index for f in family]
+            kinds = sorted({f.stability for f in family})
+            print(f"  {'':16s} ... one of {len(family)} points found on the family of "
+                  f"perfect balances ({e.neutral} neutral direction(s)); {', '.join(kinds)}, "
+                  f"index {min(idx):+.4g} to {max(idx):+.4g}")
 
 
-def _print_periodic(b: Balancer, pattern: str, N: int) -> None:
+def _print_periodic(b: Balancer | Scene, pattern: str, N: int) -> None:
     t = time.perf_counter()
     s = periodic(b, pattern, N=N)
     dt = time.perf_counter() - t
@@ -161,9 +189,9 @@ def main(argv: list[str] | None = None) -> int:
         elif a.cmd == "plot":
             return _plot(a)
         elif a.cmd == "periodic":
-            _print_periodic(_balancer(a), a.pattern, a.N)
+            _print_periodic(_model(a), a.pattern, a.N)
         else:
-            _print_equilibria(_balancer(a))
+            _print_equilibria(_model(a))
     except ValueError as e:
         print(f"ballbal: error: {e}", file=sys.stderr)
         return 2
