@@ -141,7 +141,6 @@ pub struct Scene {
     pub gravity: f64,
     pub impulse: Option<Impulse>,
     pub tilt: Option<Tilt>,
-    consts: Option<RotorConsts>,
 }
 
 impl Scene {
@@ -190,28 +189,9 @@ impl Scene {
                 true,
             )?;
         }
-        let consts = match &tilt {
-            None => None,
-            Some(tl) => {
-                tl.validate()?;
-                let p = &planar;
-                let balls: f64 = (0..p.n_balls()).map(|i| p.m(i)).sum::<f64>() / p.delta;
-                let kt = tl.kappa_t();
-                Some(RotorConsts {
-                    mh: (1.0 - p.mu - balls).max(0.0),
-                    mu: p.mu,
-                    dl: p.delta,
-                    idl: 1.0 / p.delta,
-                    jt: tl.j_t,
-                    jz: tl.j_z,
-                    kc: tl.kappa_c(),
-                    kt,
-                    cr: 2.0 * tl.zeta_r * (kt * tl.j_t).sqrt(),
-                    zeta: p.zeta,
-                    g: gravity,
-                })
-            }
-        };
+        if let Some(tl) = &tilt {
+            tl.validate()?;
+        }
         Ok(Scene {
             planar,
             springs,
@@ -220,7 +200,30 @@ impl Scene {
             gravity,
             impulse,
             tilt,
-            consts,
+        })
+    }
+
+    /// The tilting rotor's constants, derived from the public fields on every call (a
+    /// few flops beside the generated terms), so a scene changed in place never carries
+    /// stale ones. `None` for a planar disk.
+    #[inline]
+    fn rotor_consts(&self) -> Option<RotorConsts> {
+        let tl = self.tilt.as_ref()?;
+        let p = &self.planar;
+        let balls: f64 = (0..p.n_balls()).map(|i| p.m(i)).sum::<f64>() / p.delta;
+        let kt = tl.kappa_t();
+        Some(RotorConsts {
+            mh: (1.0 - p.mu - balls).max(0.0),
+            mu: p.mu,
+            dl: p.delta,
+            idl: 1.0 / p.delta,
+            jt: tl.j_t,
+            jz: tl.j_z,
+            kc: tl.kappa_c(),
+            kt,
+            cr: 2.0 * tl.zeta_r * (kt * tl.j_t).sqrt(),
+            zeta: p.zeta,
+            g: self.gravity,
         })
     }
 
@@ -605,7 +608,7 @@ impl Scene {
     /// The tilting model's mass matrix `dF/da` (it depends on `q` only).
     fn tilt_mass(&self, q: &[f64]) -> DMatrix<f64> {
         let d = self.ndof();
-        let cn = self.consts.as_ref().expect("tilting scene");
+        let cn = &self.rotor_consts().expect("tilting scene");
         let mut m = vec![0.0; d * d];
         let mut rm = [0.0; 16];
         rotor_mass(cn, q, &mut rm);
@@ -663,7 +666,7 @@ impl Dynamics for Scene {
     }
 
     fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
-        if let Some(c) = &self.consts {
+        if let Some(c) = &self.rotor_consts() {
             return self.tilt_residual(c, t, q, v, a, out);
         }
         let (om, _, _) = self.spin(t);
@@ -682,7 +685,7 @@ impl Dynamics for Scene {
         c: &mut [f64],
         m: &mut [f64],
     ) {
-        if let Some(cn) = &self.consts {
+        if let Some(cn) = &self.rotor_consts() {
             return self.tilt_jacobians(cn, t, q, v, a, k, c, m);
         }
         let p = &self.planar;
