@@ -63,6 +63,15 @@ def test_stable_orbits_of_a_scene_scan_are_the_simulated_attractors(scene):
     assert (stable["omega"] - plain["omega"]).abs().min() > 2e-3
 
 
+def test_a_scene_without_effects_can_scan_into_them():
+    """A scan may switch an effect on: springs from 0 on a scene that has none."""
+    a = ballbal.scan(ballbal.Scene(balancer=SPRINGS.balancer), Omega=[1.2],
+                     springs=[0.0, 1e-5], threads=1)
+    b = ballbal.scan(SPRINGS, Omega=[1.2], springs=[0.0, 1e-5], threads=1)
+    assert a.drop("seconds").equals(b.drop("seconds"))
+    assert a.filter(pl.col("springs") == 1e-5)["omega"].is_not_null().all()
+
+
 def test_scene_axes_and_time_dependent_scenes_give_clear_errors(tmp_path):
     with pytest.raises(ValueError, match=r"^j_t: is a tilt parameter"):
         ballbal.scan(SPRINGS, Omega=[1.2], j_t=[0.1])

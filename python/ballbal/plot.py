@@ -20,9 +20,11 @@ def _pyplot() -> Any:
 
 
 def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = "R-R",
-             ax: Any = None, title: str | None = None) -> Any:
+             ax: Any = None, title: str | None = None,
+             shade: str = "perfect balance stable") -> Any:
     """The thesis' map (figures 3-6 to 3-16): solutions of ``type`` over the (x, y) plane,
-    stable and unstable markers, and the perfect balance's stable region shaded."""
+    stable and unstable markers, and the perfect balance's stable region shaded (for a
+    scene with springs, its balanced state's: name it with ``shade``)."""
     plt = _pyplot()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))
@@ -36,7 +38,7 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
         stable[np.searchsorted(ys, row[1]), np.searchsorted(xs, row[0])] = float(row[2])
     if xs.size > 1 and ys.size > 1:
         ax.contourf(xs, ys, stable, levels=[0.5, 1.5], colors=["#cfe8cf"])
-    ax.plot([], [], "s", color="#cfe8cf", label="perfect balance stable")
+    ax.plot([], [], "s", color="#cfe8cf", label=shade)
     sols = df.filter((pl.col("type") == type) & (pl.col("status") == "converged"))
     for verdict, (m, c) in _MARK.items():
         s = sols.filter(pl.col("stability") == verdict)

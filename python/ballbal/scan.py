@@ -103,7 +103,7 @@ class _Job:
     def native(self, chunks: list[int], threads: int,
                on_chunk: Callable[[int, dict[str, Any]], None]) -> None:
         o = dict(self.options)
-        effects = self.model.native_effects() if isinstance(self.model, Scene) else None
+        effects = self.model.effects_tuple() if isinstance(self.model, Scene) else None
         _native.scan(
             *self.model.native_args(), list(self.names), [list(v) for v in self.values],
             list(self.patterns), o["N"], o["samples"], o["tol"], o["step_tol"],
@@ -292,9 +292,6 @@ def scan(
     ``f(done_points, total_points)``. Ctrl-C stops the scan and returns the finished
     chunks with a :class:`ScanInterrupted` warning.
     """
-    model: Balancer | Scene = balancer
-    if isinstance(model, Scene) and model.native_effects() is None:
-        model = model.balancer  # the same table, and a scan directory it can resume
     axes_all: dict[str, GridSpec] = dict(grid or {})
     for k, v in axes.items():
         if k in axes_all:
@@ -303,6 +300,10 @@ def scan(
     if not axes_all:
         raise ValueError("grid: give at least one parameter to scan, e.g. Omega=(1, 2, 0.1)")
     names = tuple(axes_all)
+    model: Balancer | Scene = balancer
+    if (isinstance(model, Scene) and model.native_effects() is None
+            and not set(names) & set(SCENE_SCANNABLE)):
+        model = model.balancer  # the same table, and a scan directory it can resume
     values = tuple(tuple(grid_values(n, s).tolist()) for n, s in axes_all.items())
     if isinstance(patterns, str):
         patterns = (patterns,)

@@ -192,9 +192,14 @@ class Scene:
         return replace(self, **changes)
 
     def native_effects(self) -> tuple[Any, ...] | None:
+        """The effects for the core; None when there are none (the planar code runs)."""
         if (self.springs == 0 and self.ramp is None and self.gravity == 0
                 and self.impulse is None and self.tilt is None):
             return None
+        return self.effects_tuple()
+
+    def effects_tuple(self) -> tuple[Any, ...]:
+        """The effects for the core, even when all are off (a scan may switch one on)."""
         ramp = None if self.ramp is None else (self.ramp.to, self.ramp.start, self.ramp.duration)
         imp = None if self.impulse is None else (
             self.impulse.amplitude, self.impulse.t0, self.impulse.sharpness, self.impulse.angle)
