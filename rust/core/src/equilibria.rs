@@ -636,4 +636,27 @@ mod tests {
         assert!(pb.residual < 1e-10);
         assert_eq!(pb.neutral, 1);
     }
+
+    #[test]
+    fn track_order_starts_and_identity() {
+        for n in 1..=6 {
+            let st = ordered_starts(n, 2);
+            assert!(!st.is_empty() && st.len() <= 600, "n {n}: {}", st.len());
+            for q in &st {
+                let b = &q[2..];
+                assert!(b.windows(2).all(|w| w[1] > w[0]) && b[n - 1] < b[0] + 2.0 * PI);
+            }
+        }
+        let a = [0.1, -0.2, 1.0, 4.0, 5.5];
+        // the same state a whole turn on, for any balls
+        let turned = [0.1, -0.2, 1.0 + 2.0 * PI, 4.0 + 2.0 * PI, 5.5 + 2.0 * PI];
+        assert!(same_in_order(false, 2, &a, &turned));
+        // relabelled round the ring: one state only if the balls are identical
+        let relabelled = [0.1, -0.2, 4.0, 5.5, 1.0 + 2.0 * PI];
+        assert!(same_in_order(true, 2, &a, &relabelled));
+        assert!(!same_in_order(false, 2, &a, &relabelled));
+        // one ball a turn on is another winding of the springs, not the same state
+        let wound = [0.1, -0.2, 1.0, 4.0, 5.5 - 2.0 * PI];
+        assert!(!same_in_order(true, 2, &a, &wound));
+    }
 }
