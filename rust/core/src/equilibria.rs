@@ -144,7 +144,8 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
     }
 }
 
-fn equal_balls(p: &Planar) -> bool {
+/// Whether all balls have the same mass (states that differ by relabelling are one).
+pub fn equal_balls(p: &Planar) -> bool {
     p.eta.windows(2).all(|w| w[0] == w[1])
 }
 

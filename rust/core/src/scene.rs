@@ -41,7 +41,7 @@
 //! the coupling vanishes and a disk started flat stays flat: the planar equations.
 
 use crate::equilibria::{
-    analyse_all, analyse_model, equilibria, equilibria_in_track_order, equilibria_of,
+    analyse_all, analyse_model, equal_balls, equilibria, equilibria_in_track_order, equilibria_of,
     newton_static, Equilibrium,
 };
 use crate::error::{check_range, Error, Result};
@@ -304,6 +304,17 @@ impl Scene {
     /// whirl `hypot(x, y)`; it is followed from zero spring stiffness in steps. `None`
     /// when the balls cannot balance the disk or the continuation fails.
     pub fn balanced_state(&self) -> Option<Equilibrium> {
+        let q = self.balanced_q()?;
+        let kind = if self.springs > 0.0 {
+            "balanced"
+        } else {
+            "perfect_balance"
+        };
+        Some(analyse_model(self, &q, kind, self.springs == 0.0))
+    }
+
+    /// The balanced state's coordinates, unanalysed (see [`Self::balanced_state`]).
+    fn balanced_q(&self) -> Option<Vec<f64>> {
         if self.time_dependence().is_some() {
             return None;
         }
@@ -331,17 +342,11 @@ impl Scene {
         }
         let mut start = vec![0.0; self.ndof()];
         start[o..].copy_from_slice(&q[2..]);
-        let kind = if self.springs > 0.0 {
-            "balanced"
+        if self.springs > 0.0 {
+            self.spring_homotopy(start)
         } else {
-            "perfect_balance"
-        };
-        let q = if self.springs > 0.0 {
-            self.spring_homotopy(start)?
-        } else {
-            newton_static(self, &start)?
-        };
-        Some(analyse_model(self, &q, kind, self.springs == 0.0))
+            newton_static(self, &start)
+        }
     }
 
     /// All equilibria found, each analysed, for an autonomous scene (empty otherwise).
@@ -353,20 +358,20 @@ impl Scene {
             return vec![];
         }
         let p = &self.planar;
-        let equal = p.eta.windows(2).all(|w| w[0] == w[1]);
+        let equal = equal_balls(p);
         if self.springs == 0.0 {
             return match self.tilt {
                 None => equilibria(p),
                 Some(_) => equilibria_of(self, equal, true),
             };
         }
-        let balanced = self.balanced_state();
-        let extra: Vec<Vec<f64>> = balanced.iter().map(|e| e.q.clone()).collect();
+        let balanced = self.balanced_q();
+        let extra: Vec<Vec<f64>> = balanced.iter().cloned().collect();
         let mut found = equilibria_in_track_order(self, equal, &extra);
         if let Some(b) = &balanced {
             if let Some(f) = found
                 .iter_mut()
-                .find(|(q, _)| q.iter().zip(&b.q).all(|(u, v)| (u - v).abs() < 1e-6))
+                .find(|(q, _)| q.iter().zip(b).all(|(u, v)| (u - v).abs() < 1e-6))
             {
                 f.1 = "balanced".into();
             }
@@ -722,11 +727,7 @@ impl Dynamics for Scene {
         if self.tilt.is_none() {
             return self.planar.solve_mass(t, q, rhs);
         }
-        let lu = self.tilt_mass(q).lu();
-        let mut b = nalgebra::DVector::from_column_slice(rhs);
-        // M is the kinetic-energy Hessian with rows scaled: never singular.
-        lu.solve_mut(&mut b);
-        rhs.copy_from_slice(b.as_slice());
+        self.solve_mass_columns(t, q, rhs);
     }
 
     fn solve_mass_columns(&self, t: f64, q: &[f64], cols: &mut [f64]) {
@@ -734,6 +735,7 @@ impl Dynamics for Scene {
             return self.planar.solve_mass_columns(t, q, cols);
         }
         let d = self.ndof();
+        // M is the kinetic-energy Hessian with rows scaled: never singular.
         let lu = self.tilt_mass(q).lu();
         let mut b = DMatrix::from_column_slice(d, cols.len() / d, cols);
         lu.solve_mut(&mut b);
