@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from .analysis import equilibria, simulate
+from .analysis import simulate
 from .balance import balanced_state
 from .model import Balancer
 from .scene import Ramp, Scene
@@ -31,14 +31,11 @@ class DisturbanceResponse:
 
 def _balanced_start(model: Balancer | Scene) -> np.ndarray:
     """The stable balanced state at the starting speed, where the disturbance begins."""
-    if isinstance(model, Scene):
-        if model.time_dependence is not None:
-            raise ValueError(
-                f"scene: the disturbance brings its own spin change, so the scene must be "
-                f"autonomous, but it has '{model.time_dependence}'")
-        e = balanced_state(model)
-    else:
-        e = next((e for e in equilibria(model) if e.kind == "perfect_balance"), None)
+    if isinstance(model, Scene) and model.time_dependence is not None:
+        raise ValueError(
+            f"scene: the disturbance brings its own spin change, so the scene must be "
+            f"autonomous, but it has '{model.time_dependence}'")
+    e = balanced_state(model)
     if e is None or e.stability != "stable":
         raise ValueError(
             f"balancer: the balanced state must exist and be stable at the starting speed "
