@@ -1,5 +1,6 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
+from . import exceptions
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -11,7 +12,8 @@ from .analysis import (
 )
 from .balance import balance_map, balanced_state, plot_balance_map
 from .model import Balancer, from_seed003, zeta_from_log_decrement
-from .scan import ScanInterrupted, read_scan, scan, scan_meta
+from .exceptions import ScanInterrupted
+from .scan import read_scan, scan, scan_meta
 from .scene import Impulse, Ramp, Scene, Tilt, load_scene
 from .transient import (
     DisturbanceResponse,
@@ -38,6 +40,7 @@ __all__ = [
     "balanced_state",
     "disturbance_response",
     "equilibria",
+    "exceptions",
     "from_seed003",
     "load_scene",
     "periodic",

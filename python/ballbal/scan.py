@@ -23,6 +23,7 @@ import polars as pl
 
 from . import _native
 from .analysis import harmonics
+from .exceptions import ScanInterrupted
 from .model import Balancer
 from .scene import Scene
 
@@ -43,11 +44,6 @@ _SCHEMA: dict[str, Any] = {
     "origin": pl.Utf8, "pb_exists": pl.Boolean, "pb_stable": pl.Boolean,
     "target_met": pl.Boolean, "hill_stability": pl.Utf8, "verdicts_disagree": pl.Boolean,
 }
-
-
-class ScanInterrupted(UserWarning):
-    """A scan was stopped (Ctrl-C) before every chunk finished; the table holds the
-    finished chunks, and a scan with ``out=`` resumes from them when run again."""
 
 
 def grid_values(name: str, spec: GridSpec) -> np.ndarray:

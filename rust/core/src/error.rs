@@ -5,12 +5,21 @@ use std::fmt;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Error {
-    /// A parameter is outside its allowed range.
-    InvalidParameter { name: String, message: String },
+    /// A parameter is outside its allowed range. `allowed` states the range or values
+    /// as text when there is one (the Python exception carries it as `.allowed`).
+    InvalidParameter {
+        name: String,
+        message: String,
+        allowed: Option<String>,
+    },
     /// The analysis needs an autonomous scene; `effect` is what makes it time dependent.
     NotAutonomous { effect: String },
     /// The integrator could not proceed (step size underflow, too many steps, non-finite state).
     Integration(String),
+    /// The equations are too stiff for the explicit integrator at these parameters.
+    Stiff(String),
+    /// An eigenvalue computation did not converge.
+    Eigen(String),
     /// The caller asked the work to stop (e.g. Ctrl-C); finished parts were handed over.
     Cancelled,
 }
@@ -20,6 +29,20 @@ impl Error {
         Error::InvalidParameter {
             name: name.into(),
             message: message.into(),
+            allowed: None,
+        }
+    }
+
+    /// An invalid parameter with its allowed range or values stated separately.
+    pub fn param_range(
+        name: impl Into<String>,
+        message: impl Into<String>,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Error::InvalidParameter {
+            name: name.into(),
+            message: message.into(),
+            allowed: Some(allowed.into()),
         }
     }
 }
@@ -27,12 +50,14 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::InvalidParameter { name, message } => write!(f, "{name}: {message}"),
+            Error::InvalidParameter { name, message, .. } => write!(f, "{name}: {message}"),
             Error::NotAutonomous { effect } => write!(
                 f,
                 "this analysis needs an autonomous scene, but the effect '{effect}' makes it time dependent"
             ),
             Error::Integration(m) => write!(f, "integration failed: {m}"),
+            Error::Stiff(m) => write!(f, "too stiff for the explicit integrator: {m}"),
+            Error::Eigen(m) => write!(f, "eigenvalue computation failed: {m}"),
             Error::Cancelled => write!(f, "cancelled"),
         }
     }
@@ -61,9 +86,11 @@ pub fn check_range(
         } else {
             format!("{hi}")
         };
-        return Err(Error::param(
+        let allowed = format!("{l}{lo}, {hs}{h}");
+        return Err(Error::param_range(
             name,
-            format!("must be a finite number in {l}{lo}, {hs}{h}, got {v}"),
+            format!("must be a finite number in {allowed}, got {v}"),
+            allowed,
         ));
     }
     Ok(())

@@ -175,7 +175,7 @@ pub fn floquet<D: Dynamics + ?Sized>(
     let (phi, steps, evals) = monodromy(model, sol, opts)?;
     let n2 = 2 * model.ndof();
     let mut ev = eigenvalues(&phi, n2).ok_or_else(|| {
-        crate::Error::Integration("eigenvalues of the monodromy matrix did not converge".into())
+        crate::Error::Eigen("eigenvalues of the monodromy matrix did not converge".into())
     })?;
     ev.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
     let v = judge(&ev, opts.margin);
@@ -250,7 +250,7 @@ pub fn hill_multipliers<D: Dynamics + ?Sized>(
         z
     });
     let eig = hm.eigen().map_err(|_| {
-        crate::Error::Integration("eigen-decomposition of the Hill matrix failed".into())
+        crate::Error::Eigen("eigen-decomposition of the Hill matrix failed".into())
     })?;
     let (sv, u) = (eig.S(), eig.U());
     let blocks = 2 * n_hill + 1;

@@ -272,7 +272,7 @@ impl Scene {
             }
             _ => {
                 planar = self.planar.with_param(name, value).map_err(|e| match e {
-                    Error::InvalidParameter { name: n, message }
+                    Error::InvalidParameter { name: n, message, .. }
                         if message.starts_with("is not a") =>
                     {
                         Error::param(

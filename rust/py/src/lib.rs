@@ -18,14 +18,39 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
+/// The one place where core errors become Python exceptions: the classes of
+/// `ballbal.exceptions`, with their fields (`.parameter`, `.allowed`, `.effect`).
 fn to_py(e: Error) -> PyErr {
-    match e {
-        Error::InvalidParameter { .. } | Error::NotAutonomous { .. } => {
-            PyValueError::new_err(e.to_string())
-        }
-        Error::Integration(_) => PyRuntimeError::new_err(e.to_string()),
-        Error::Cancelled => pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled"),
-    }
+    Python::attach(|py| {
+        let text = e.to_string();
+        let made = (|| -> PyResult<PyErr> {
+            let m = py.import("ballbal.exceptions")?;
+            let obj = match e {
+                Error::InvalidParameter {
+                    name,
+                    message,
+                    allowed,
+                } => {
+                    let kw = PyDict::new(py);
+                    kw.set_item("allowed", allowed)?;
+                    m.getattr("ParameterError")?
+                        .call((name, message), Some(&kw))?
+                }
+                Error::NotAutonomous { effect } => {
+                    m.getattr("NotAutonomousError")?.call1((effect,))?
+                }
+                Error::Integration(_) => m.getattr("IntegrationError")?.call1((text.clone(),))?,
+                Error::Stiff(_) => m.getattr("StiffError")?.call1((text.clone(),))?,
+                Error::Eigen(_) => m.getattr("EigenSolverError")?.call1((text.clone(),))?,
+                Error::Cancelled => {
+                    return Ok(pyo3::exceptions::PyKeyboardInterrupt::new_err("cancelled"))
+                }
+            };
+            Ok(PyErr::from_value(obj))
+        })();
+        // Only if the exceptions module itself cannot be imported (a broken install).
+        made.unwrap_or_else(|_| PyRuntimeError::new_err(text))
+    })
 }
 
 /// Runs `f` without the GIL and with panics contained.
@@ -41,9 +66,14 @@ fn panic_error(p: Box<dyn std::any::Any + Send>) -> PyErr {
         .cloned()
         .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
         .unwrap_or_else(|| "unknown".into());
-    PyRuntimeError::new_err(format!(
-        "internal error in ballbal core (please report): {msg}"
-    ))
+    let text = format!("internal error in ballbal core (please report): {msg}");
+    Python::attach(|py| {
+        py.import("ballbal.exceptions")
+            .and_then(|m| m.getattr("InternalError"))
+            .and_then(|c| c.call1((text.clone(),)))
+            .map(PyErr::from_value)
+            .unwrap_or_else(|_| PyRuntimeError::new_err(text))
+    })
 }
 
 fn planar(
@@ -111,7 +141,17 @@ fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
 fn autonomous_scene(p: &Planar, effects: Effects, what: &str) -> PyResult<Option<Scene>> {
     let s = scene(p, effects)?;
     if let Some(sc) = &s {
-        require_autonomous(sc).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))?;
+        require_autonomous(sc).map_err(|e| match e {
+            Error::NotAutonomous { effect } => Python::attach(|py| {
+                let msg = format!("{what}: {}", Error::NotAutonomous { effect: effect.clone() });
+                py.import("ballbal.exceptions")
+                    .and_then(|m| m.getattr("NotAutonomousError"))
+                    .and_then(|c| c.call1((effect, msg.clone())))
+                    .map(PyErr::from_value)
+                    .unwrap_or_else(|_| PyValueError::new_err(msg))
+            }),
+            e => to_py(e),
+        })?;
     }
     Ok(s)
 }
