@@ -143,12 +143,7 @@ fn autonomous_scene(p: &Planar, effects: Effects, what: &str) -> PyResult<Option
     if let Some(sc) = &s {
         require_autonomous(sc).map_err(|e| match e {
             Error::NotAutonomous { effect } => Python::attach(|py| {
-                let msg = format!(
-                    "{what}: {}",
-                    Error::NotAutonomous {
-                        effect: effect.clone()
-                    }
-                );
+                let msg = format!("{what}: {}", Error::NotAutonomous { effect: effect.clone() });
                 py.import("ballbal.exceptions")
                     .and_then(|m| m.getattr("NotAutonomousError"))
                     .and_then(|c| c.call1((effect, msg.clone())))
