@@ -238,7 +238,7 @@ def periodic(
     settle: float = 1500.0,
     window: float = 2500.0,
     max_closure: float = 10.0,
-    max_trivial: float = 0.05,
+    max_trivial: float = 0.1,
     max_tail: float = 0.25,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter

@@ -636,6 +636,26 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
     out
 }
 
+/// Nanoseconds spent in certificate checks by this process (all threads): what
+/// `benchmarks/bench_certificates.py` sets against a scan's time.
+static CERTIFICATE_NANOS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Runs a certificate check, adding its time to [`certificate_seconds`].
+pub(crate) fn timed_certificate<T>(f: impl FnOnce() -> T) -> T {
+    let t = std::time::Instant::now();
+    let out = f();
+    CERTIFICATE_NANOS.fetch_add(
+        t.elapsed().as_nanos() as u64,
+        std::sync::atomic::Ordering::Relaxed,
+    );
+    out
+}
+
+/// Total time this process has spent in certificate checks, in seconds.
+pub fn certificate_seconds() -> f64 {
+    CERTIFICATE_NANOS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9
+}
+
 /// Orbit-closure certificate of a series without integrating the flow: the ODE defect
 /// `M^-1 F(t, q, q', q'')` of the series (an acceleration error) at `points` phases
 /// placed between the collocation times, integrated over one period,

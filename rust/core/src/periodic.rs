@@ -404,7 +404,7 @@ pub fn certify<D: Dynamics + ?Sized>(
     if sol.status != Status::Converged {
         return None;
     }
-    let closure = defect_closure(p, sol, defect_points(sol));
+    let closure = crate::hb::timed_certificate(|| defect_closure(p, sol, defect_points(sol)));
     if !(sol.tail_ratio() <= opts.max_tail) {
         sol.status = Status::Truncated;
     } else if !(closure <= opts.max_closure) {

@@ -874,6 +874,13 @@ fn scan_columns<'py>(
     Ok(d)
 }
 
+/// Seconds this process has spent in certificate checks (all threads; a benchmark's
+/// measure of what they cost).
+#[pyfunction]
+fn certificate_seconds() -> f64 {
+    ballbal_core::hb::certificate_seconds()
+}
+
 /// Default chunk length (values of the last parameter per chunk) for grid lengths `lens`.
 #[pyfunction]
 fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
@@ -892,6 +899,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(orbit_closure, m)?)?;
     m.add_function(wrap_pyfunction!(scan, m)?)?;
     m.add_function(wrap_pyfunction!(default_chunk, m)?)?;
+    m.add_function(wrap_pyfunction!(certificate_seconds, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
