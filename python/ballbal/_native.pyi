@@ -46,6 +46,6 @@ def scan(
     guess_rtol: float, auto: float | None, n_max: int, hill: bool, seeds: int, starts: int,
     chunk: int, max_tail: float, threads: int,
     chunks: list[int], on_chunk: Callable[[int, dict[str, Any]], None],
-    effects: Effects = None,
+    effects: Effects = None, block: int | None = None,
 ) -> None: ...
 def default_chunk(lens: list[int]) -> int: ...
