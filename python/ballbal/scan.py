@@ -1,9 +1,11 @@
 """Parallel parameter scans returning polars tables.
 
-The grid is cut into chunks along its last parameter. A chunk's rows depend only on the
-grid, the options and the chunk's bounds, so the table is the same whether the chunks
-run here on any number of threads, on an executor's workers (``concurrent.futures`` or
-a Dask ``Client``), or partly now and partly after an interruption (``out=``).
+The grid is cut into blocks along its last parameter (seeding and continuation stay
+inside a block), and blocks are grouped into chunks (files, progress, tasks). A block's
+rows depend only on the grid, the options and the block's bounds, so the table is the
+same for any chunk length, whether the chunks run here on any number of threads, on an
+executor's workers (``concurrent.futures`` or a Dask ``Client``), or partly now and
+partly after an interruption or a crash (``out=``).
 """
 
 from __future__ import annotations
