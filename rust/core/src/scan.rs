@@ -748,7 +748,10 @@ mod tests {
             let rows = scan(&s).unwrap();
             assert_eq!(rows.len(), reference.len(), "chunk {chunk}");
             for (x, y) in rows.iter().zip(&reference) {
-                assert_eq!((&x.index, x.pattern, x.solution), (&y.index, y.pattern, y.solution));
+                assert_eq!(
+                    (&x.index, x.pattern, x.solution),
+                    (&y.index, y.pattern, y.solution)
+                );
                 assert_eq!(
                     x.result.as_ref().map(|r| r.sol.omega.to_bits()),
                     y.result.as_ref().map(|r| r.sol.omega.to_bits())
