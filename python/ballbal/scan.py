@@ -240,19 +240,26 @@ def _chunk_problem(f: Path, meta: Mapping[str, Any], c: int | None) -> str | Non
     return None
 
 
-def _read_meta(mfile: Path) -> dict[str, Any]:
-    """The scan description in ``mfile``; ScanStoreError naming it when it is damaged."""
+def _meta_problem(mfile: Path) -> tuple[dict[str, Any] | None, str | None]:
+    """The scan description in ``mfile``, or why it cannot be read."""
     try:
         meta = json.loads(mfile.read_text())
-        if not isinstance(meta, dict) or not isinstance(meta.get("grid"), dict):
-            raise ValueError("not a scan description")
-        return meta
     except FileNotFoundError:
-        raise ScanStoreError(f"path: {mfile} is missing: not a scan directory") from None
+        return None, "missing: not a scan directory"
     except (OSError, UnicodeDecodeError, ValueError) as e:
-        raise ScanStoreError(
-            f"path: {mfile} is damaged ({e}); run the same scan with out= again to "
-            "rewrite it") from None
+        return None, f"unreadable: {type(e).__name__}: {e}"
+    if not isinstance(meta, dict) or not isinstance(meta.get("grid"), dict):
+        return None, "not a scan description"
+    return meta, None
+
+
+def _read_meta(mfile: Path) -> dict[str, Any]:
+    """The scan description in ``mfile``; ScanStoreError naming it when it is damaged."""
+    meta, why = _meta_problem(mfile)
+    if meta is None:
+        raise ScanStoreError(f"path: {mfile} is damaged ({why}); run the same scan with "
+                             "out= again to rewrite it")
+    return meta
 
 
 class _Store:
@@ -318,11 +325,10 @@ class _Store:
         mfile = self.dir / "meta.json"
         old: dict[str, Any] | None = None
         if mfile.exists():
-            try:
-                old = _read_meta(mfile)
-            except ScanStoreError as e:
-                self._set_aside(mfile, str(e.__cause__ or "not a scan description"),
-                                "rewritten; the chunks are checked one by one")
+            old, why = _meta_problem(mfile)
+            if old is None:
+                self._set_aside(mfile, why or "", "rewritten; the chunks are checked by "
+                                "their fingerprints")
         if old is not None:
             same = {k: v for k, v in old.items() if k != "chunk"} == {
                 k: v for k, v in meta.items() if k != "chunk"}
