@@ -161,7 +161,7 @@ import sys, warnings, ballbal
 b = ballbal.Balancer()
 with warnings.catch_warnings(record=True) as w:
     warnings.simplefilter("always")
-    df = ballbal.scan(b, Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), chunk=1, threads=1,
+    df = ballbal.scan(b, Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), block=1, threads=1,
                       starts=8, out=sys.argv[1])
 print("ROWS", df.height, "WARNED", sum(issubclass(x.category, ballbal.ScanInterrupted) for x in w))
 """
@@ -169,7 +169,7 @@ print("ROWS", df.height, "WARNED", sum(issubclass(x.category, ballbal.ScanInterr
 
 def test_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
     out = tmp_path / "scan.parquet"
-    kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), chunk=1, threads=1, starts=8)
+    kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), block=1, threads=1, starts=8)
     p = subprocess.Popen([sys.executable, "-c", SCRIPT, str(out)], stdout=subprocess.PIPE,
                          text=True)
     deadline = time.time() + 120
@@ -192,7 +192,7 @@ def test_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
 
 def test_resume_refuses_a_different_scan(tmp_path):
     ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s")
-    with pytest.raises(ValueError, match="^out: .* differs in grid"):
+    with pytest.raises(ballbal.exceptions.ScanStoreError, match="^out: .* differs in grid"):
         ballbal.scan(BASE, Omega=[1.3], eta=[1.0], out=tmp_path / "s")
     meta = ballbal.scan_meta(tmp_path / "s")
     assert meta["grid"] == {"Omega": [1.2], "eta": [1.0]}

@@ -10,10 +10,12 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 
 import numpy as np
 
 from .analysis import equilibria, periodic
+from .exceptions import ScanInterrupted
 from .model import Balancer
 from .scan import SCANNABLE, read_scan, scan, scan_meta
 from .scene import Scene, load_scene
@@ -116,12 +118,32 @@ def _scan(a: argparse.Namespace) -> int:
             raise ValueError(f"grid: give NAME=START:STOP:STEP, got {g!r}")
         grid[name.strip()] = spec
     t = time.perf_counter()
-    df = scan(b, grid=grid, patterns=a.types, N=a.N, threads=a.threads, chunk=a.chunk,
-              out=a.out, progress=not a.no_progress)
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ScanInterrupted)
+            df = scan(b, grid=grid, patterns=a.types, N=a.N, threads=a.threads,
+                      chunk=a.chunk, out=a.out, progress=not a.no_progress)
+    except KeyboardInterrupt:
+        # Outside the chunks' work (validation, reading back): nothing new to keep.
+        print(f"\nballbal scan: interrupted; run the same command to resume from {a.out}",
+              file=sys.stderr)
+        return 130
+    interrupted = False
+    for w in caught:
+        if issubclass(w.category, ScanInterrupted):
+            interrupted = True
+        else:  # not ours to swallow
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     found = df.filter(df["status"] == "converged")
     stable = found.filter(found["stability"] == "stable")
-    print(f"ballbal scan: {df.height} rows, {found.height} solutions ({stable.height} stable) "
-          f"in {time.perf_counter() - t:.1f} s -> {a.out}")
+    summary = (f"{df.height} rows, {found.height} solutions ({stable.height} stable) "
+               f"in {time.perf_counter() - t:.1f} s -> {a.out}")
+    if interrupted:
+        # 128 + SIGINT, as a shell reports a process stopped by Ctrl-C.
+        print(f"\nballbal scan: interrupted: {summary} (finished chunks only); run the same "
+              "command again to resume", file=sys.stderr)
+        return 130
+    print(f"ballbal scan: {summary}")
     return 0
 
 

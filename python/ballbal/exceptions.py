@@ -22,6 +22,7 @@ __all__ = [
     "ParameterTypeError",
     "ScanInterrupted",
     "ScanStoreError",
+    "ScanStoreWarning",
     "StiffError",
 ]
 
@@ -101,3 +102,8 @@ class ScanStoreError(BallbalError, RuntimeError):
 class ScanInterrupted(UserWarning):
     """A scan was stopped (Ctrl-C) before every chunk finished; the table holds the
     finished chunks, and a scan with ``out=`` resumes from them when run again."""
+
+
+class ScanStoreWarning(UserWarning):
+    """A file of a scan directory was damaged (unreadable, truncated, not this scan's):
+    it is set aside as ``<name>.damaged`` and recomputed; the message names it."""

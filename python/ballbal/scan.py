@@ -1,31 +1,40 @@
 """Parallel parameter scans returning polars tables.
 
-The grid is cut into chunks along its last parameter. A chunk's rows depend only on the
-grid, the options and the chunk's bounds, so the table is the same whether the chunks
-run here on any number of threads, on an executor's workers (``concurrent.futures`` or
-a Dask ``Client``), or partly now and partly after an interruption (``out=``).
+The grid is cut into blocks along its last parameter (seeding and continuation stay
+inside a block), and blocks are grouped into chunks (files, progress, tasks). A block's
+rows depend only on the grid, the options and the block's bounds, so the table is the
+same for any chunk length, whether the chunks run here on any number of threads, on an
+executor's workers (``concurrent.futures`` or a Dask ``Client``), or partly now and
+partly after an interruption or a crash (``out=``).
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
+import re
 import sys
 import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import IO, Any, Literal, overload
 
 import numpy as np
 import polars as pl
 
 from . import _native
 from .analysis import harmonics
-from .exceptions import ScanInterrupted
+from .exceptions import ParameterError, ScanInterrupted, ScanStoreError, ScanStoreWarning
 from .model import Balancer
 from .scene import Scene
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not on POSIX: scan directories are not locked
+    fcntl = None  # type: ignore[assignment]
 
 SCANNABLE = ("mu", "zeta", "zeta_b", "delta", "Omega", "eta")
 #: Scene parameters a scan can vary besides the balancer's (tilt fields need a tilt).
@@ -95,6 +104,9 @@ class _Job:
     values: tuple[tuple[float, ...], ...]
     patterns: tuple[str, ...]
     options: tuple[tuple[str, Any], ...]
+    #: Values of the last axis per continuation block (the numerical unit) and per
+    #: chunk (whole blocks: the unit of files, progress and interruption).
+    block: int
     chunk: int
 
     def native(self, chunks: list[int], threads: int,
@@ -107,7 +119,7 @@ class _Job:
             o["max_iter"], o["floquet"], o["rtol"], o["atol"], o["margin"], o["max_steps"],
             o["settle"], o["window"], o["guess_rtol"], o["auto"], o["N_max"], o["hill"],
             o["seeds"], o["starts"], self.chunk,
-            o["max_tail"], threads, chunks, on_chunk, effects,
+            o["max_tail"], threads, chunks, on_chunk, effects, self.block,
         )
 
     def n_chunks(self) -> int:
@@ -125,7 +137,7 @@ class _Job:
                else {"balancer": asdict(self.model)}),
             "grid": {n: list(v) for n, v in zip(self.names, self.values, strict=True)},
             "patterns": list(self.patterns), "options": dict(self.options),
-            "chunk": self.chunk,
+            "block": self.block, "chunk": self.chunk,
         }
 
 
@@ -151,39 +163,221 @@ def run_chunk(job: _Job, c: int, threads: int = 1) -> pl.DataFrame:
     return out[0]
 
 
-class _Store:
-    """Finished chunks as Parquet files in a directory, with the scan's description."""
+#: Parquet key-value metadata entry holding the fingerprint of the scan a chunk belongs
+#: to, so that a chunk is trusted only for the scan that wrote it (even when meta.json
+#: itself was damaged and had to be rewritten).
+_FINGERPRINT = "ballbal_scan"
+_CHUNK_FILE = re.compile(r"chunk-(\d{5,})\.parquet")
 
-    def __init__(self, path: str | os.PathLike[str], job: _Job) -> None:
+
+def _fingerprint(meta: Mapping[str, Any]) -> str:
+    return hashlib.sha256(json.dumps(meta).encode()).hexdigest()
+
+
+def _chunk_index(f: Path) -> int | None:
+    m = _CHUNK_FILE.fullmatch(f.name)
+    return int(m.group(1)) if m else None
+
+
+def _sync_dir(d: Path) -> None:
+    # The rename itself must reach the disk, or a crash can bring back the old name.
+    try:
+        fd = os.open(d, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _write_atomic(path: Path, write: Callable[[Any], None]) -> None:
+    """Write through ``write(file)`` to a temporary file, flush it to disk, then rename:
+    ``path`` is always either the old complete file or the new complete one."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    with open(tmp, "wb") as fh:
+        write(fh)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+    _sync_dir(path.parent)
+
+
+def _chunk_problem(f: Path, meta: Mapping[str, Any], c: int | None) -> str | None:
+    """Why chunk file ``f`` (number ``c``) cannot be trusted for the scan ``meta``, or
+    ``None``; reads the whole file."""
+    if c is None:
+        return "not a chunk file name"
+    names = list(meta["grid"])
+    values = [meta["grid"][n] for n in names]
+    patterns = meta["patterns"]
+    chunk = int(meta["chunk"])
+    lo, hi = c * chunk, min(len(values[-1]), (c + 1) * chunk)
+    if lo >= hi:
+        return f"chunk {c} is outside the grid"
+    try:
+        # Directories of ballbal 0.1 (no blocks yet) have no fingerprints to check.
+        if ("block" in meta
+                and pl.read_parquet_metadata(f).get(_FINGERPRINT) != _fingerprint(meta)):
+            return "it was not written by this scan"
+        df = pl.read_parquet(f)
+    except Exception as e:  # noqa: BLE001 - any failure to read means a damaged file
+        return f"unreadable: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
+    if df.schema != _empty(names).schema:
+        return "its columns are not a scan table's"
+    wanted = [set(v) for v in values[:-1]] + [set(values[-1][lo:hi])]
+    for n, w in zip(names, wanted, strict=True):
+        if not set(df[n].to_list()) <= w:
+            return f"it holds {n} values outside chunk {c}"
+    if not set(df["type"].to_list()) <= set(patterns):
+        return "it holds other solution types"
+    # Values within the chunk's, and as many distinct (point, type) pairs as the chunk
+    # has: every point and type is there.
+    expected = math.prod(len(w) for w in wanted) * len(set(patterns))
+    if df.select([*names, "type"]).unique().height != expected:
+        return "it misses points of the chunk"
+    return None
+
+
+def _meta_problem(mfile: Path) -> tuple[dict[str, Any] | None, str | None]:
+    """The scan description in ``mfile``, or why it cannot be read."""
+    try:
+        meta = json.loads(mfile.read_text())
+    except FileNotFoundError:
+        return None, "missing: not a scan directory"
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        return None, f"unreadable: {type(e).__name__}: {e}"
+    if not isinstance(meta, dict) or not isinstance(meta.get("grid"), dict):
+        return None, "not a scan description"
+    return meta, None
+
+
+def _read_meta(mfile: Path) -> dict[str, Any]:
+    """The scan description in ``mfile``; ScanStoreError naming it when it is damaged."""
+    meta, why = _meta_problem(mfile)
+    if meta is None:
+        raise ScanStoreError(f"path: {mfile} is damaged ({why}); run the same scan with "
+                             "out= again to rewrite it")
+    return meta
+
+
+class _Store:
+    """Finished chunks as Parquet files in a directory, with the scan's description.
+
+    The directory is locked (``fcntl.flock`` on ``.lock``) while a scan uses it; the
+    kernel drops the lock when the process ends, even when killed. Every file is
+    written atomically; on opening, a file that cannot be trusted (unreadable, truncated,
+    of another scan, missing points) is set aside as ``<name>.damaged`` with a
+    :class:`ScanStoreWarning` and recomputed.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], job: _Job, chunk_given: bool) -> None:
         self.dir = Path(path)
+        try:
+            self.dir.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise ScanStoreError(f"out: cannot create the directory {self.dir}: {e}") from e
+        self._lock = self._acquire()
+        try:
+            self.job = self._open(job, chunk_given)
+        except BaseException:
+            self.close()
+            raise
+
+    def _acquire(self) -> IO[str]:
+        try:
+            fh = open(self.dir / ".lock", "a+")  # noqa: SIM115 - held until close()
+        except OSError as e:
+            raise ScanStoreError(f"out: cannot use the directory {self.dir}: {e}") from e
+        if fcntl is not None:
+            try:
+                fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError:
+                fh.seek(0)
+                who = fh.read().strip()
+                fh.close()
+                raise ScanStoreError(
+                    f"out: {self.dir} is in use by another scan"
+                    + (f" (process {who})" if who else "")
+                    + "; wait for it to finish or choose another directory") from None
+            fh.seek(0)
+            fh.truncate()
+            fh.write(f"{os.getpid()}\n")
+            fh.flush()
+        return fh
+
+    def close(self) -> None:
+        if self._lock is not None and not self._lock.closed:
+            if fcntl is not None:
+                fcntl.flock(self._lock.fileno(), fcntl.LOCK_UN)
+            self._lock.close()
+
+    def _set_aside(self, f: Path, why: str, then: str) -> None:
+        dest = f.with_name(f.name + ".damaged")
+        os.replace(f, dest)
+        warnings.warn(ScanStoreWarning(f"out: {f} is damaged ({why}); set aside as "
+                                       f"{dest.name} and {then}"), stacklevel=4)
+
+    def _open(self, job: _Job, chunk_given: bool) -> _Job:
         # As it reads back from JSON (tuples become lists), to compare with the file.
         meta = json.loads(json.dumps(job.meta()))
         mfile = self.dir / "meta.json"
+        old: dict[str, Any] | None = None
         if mfile.exists():
-            old = json.loads(mfile.read_text())
+            old, why = _meta_problem(mfile)
+            if old is None:
+                self._set_aside(mfile, why or "", "rewritten; the chunks are checked by "
+                                "their fingerprints")
+        if old is not None:
+            same = {k: v for k, v in old.items() if k != "chunk"} == {
+                k: v for k, v in meta.items() if k != "chunk"}
+            stored = old.get("chunk")
+            if (same and not chunk_given and isinstance(stored, int) and stored > 0
+                    and stored % job.block == 0):
+                # The table does not depend on the chunk length: keep the directory's.
+                job = replace(job, chunk=stored)
+                meta["chunk"] = stored
             if old != meta:
-                diff = sorted(k for k in meta if old.get(k) != meta[k])
-                raise ValueError(
+                diff = sorted(k for k in meta.keys() | old.keys() if old.get(k) != meta.get(k))
+                raise ScanStoreError(
                     f"out: {self.dir} holds a different scan (it differs in "
-                    f"{', '.join(diff)}); choose another directory or delete it"
-                )
+                    f"{', '.join(diff)}); choose another directory or delete it")
+            if list(old["grid"]) != list(meta["grid"]):
+                # Same axes, other order: the chunks would be cut along another axis.
+                raise ScanStoreError(
+                    f"out: {self.dir} holds this scan with its axes in the order "
+                    f"{', '.join(old['grid'])}; give them in that order to resume it")
         else:
-            self.dir.mkdir(parents=True, exist_ok=True)
-            mfile.write_text(json.dumps(meta, indent=1))
+            _write_atomic(mfile, lambda fh: fh.write(json.dumps(meta, indent=1).encode()))
+        self.meta = meta
+        self.fingerprint = _fingerprint(meta)
+        for tmp in self.dir.glob(".*.tmp"):  # left by a crash; the lock says nobody writes
+            tmp.unlink(missing_ok=True)
+        return job
 
     def file(self, c: int) -> Path:
         return self.dir / f"chunk-{c:05d}.parquet"
 
     def done(self) -> set[int]:
-        return {int(p.stem.split("-")[1]) for p in self.dir.glob("chunk-*.parquet")}
+        """The chunks on disk that can be trusted; the others are set aside."""
+        ok = set()
+        for f in sorted(self.dir.glob("chunk-*.parquet")):
+            c = _chunk_index(f)
+            why = _chunk_problem(f, self.meta, c)
+            if why is None and c is not None:
+                ok.add(c)
+            else:
+                self._set_aside(f, why or "", "recomputed")
+        return ok
 
     def write(self, c: int, df: pl.DataFrame) -> None:
-        tmp = self.dir / f".chunk-{c:05d}.tmp"
-        df.write_parquet(tmp)
-        os.replace(tmp, self.file(c))  # a chunk file is complete or absent
+        _write_atomic(self.file(c),
+                      lambda fh: df.write_parquet(fh, metadata={_FINGERPRINT: self.fingerprint}))
 
-    def read(self, c: int) -> pl.DataFrame:
-        return pl.read_parquet(self.file(c))
+    def files(self, chunks: Iterable[int]) -> list[Path]:
+        return [self.file(c) for c in sorted(chunks)]
 
 
 class _Progress:
@@ -223,7 +417,12 @@ def _as_completed(futures: list[Any]) -> Iterable[Any]:
     return cf_as_completed(futures)
 
 
-def scan(
+@overload
+def scan(balancer: Balancer | Scene, *, lazy: Literal[False] = ...,
+         **kwargs: Any) -> pl.DataFrame: ...
+@overload
+def scan(balancer: Balancer | Scene, *, lazy: Literal[True], **kwargs: Any) -> pl.LazyFrame: ...
+def scan(  # noqa: E302 - overloads above
     balancer: Balancer | Scene,
     *,
     patterns: Sequence[str] = ("R-R",),
@@ -246,14 +445,16 @@ def scan(
     seeds: int = 4,
     starts: int = 4,
     max_tail: float = 0.25,
+    block: int | None = None,
     chunk: int | None = None,
     threads: int | None = None,
     progress: bool | Callable[[int, int], Any] = False,
     out: str | os.PathLike[str] | None = None,
+    lazy: bool = False,
     executor: Any = None,
     grid: Mapping[str, GridSpec] | None = None,
     **axes: GridSpec,
-) -> pl.DataFrame:
+) -> pl.DataFrame | pl.LazyFrame:
     """Scan parameters of ``balancer`` over a grid and return one row per solution found.
 
     Axes are keywords (``Omega=(1.0, 2.0, 0.1), eta=np.arange(0.4, 1.51, 0.1)``) or a
@@ -266,14 +467,21 @@ def scan(
     :func:`balanced_state`). A scene with a ramp, gravity or an impulse is time
     dependent and has no periodic solutions to scan: that is an error naming the effect.
 
-    Each chunk of the grid (``chunk`` values of the last axis; default about 1024
-    points) is solved in the Rust core on ``threads`` cores with the GIL released:
-    simulated starts at ``seeds`` points per axis (and, for O-types, along the perfect
-    balance's stability boundary) are classified by rotation pattern, then every
-    solution is continued to its grid neighbours until nothing new appears. Coexisting
-    solutions of one type get separate rows (``solution`` 0, 1, ...); a point and type
-    with none gets one row with ``status="not_found"`` and nulls. ``max_tail`` refuses
-    series whose last harmonic is that large relative to the motion (``N`` too small).
+    The grid is cut along its last axis into blocks of ``block`` values (default: about
+    1024 points, fixed by the grid's shape). Each block is solved in the Rust core on
+    ``threads`` cores with the GIL released: simulated starts at ``seeds`` points per
+    axis (and, for O-types, along the perfect balance's stability boundary) are
+    classified by rotation pattern, then every solution is continued to its grid
+    neighbours until nothing new appears. Continuation does not cross block edges, so
+    ``block`` is a numerical option (smaller blocks find fewer continued solutions);
+    the table depends on it and on nothing else of the layout. Coexisting solutions of
+    one type get separate rows (``solution`` 0, 1, ...); a point and type with none gets
+    one row with ``status="not_found"`` and nulls. ``max_tail`` refuses series whose
+    last harmonic is that large relative to the motion (``N`` too small).
+
+    ``chunk``: values of the last axis per chunk, rounded up to whole blocks (default
+    one block): the unit of progress, interruption, resumption, files and executor
+    tasks. It never changes the table.
 
     ``N="auto"``: continuation runs at N = 3 and each solution found is refined until
     its highest harmonic and trivial multiplier error are below ``target`` (at most
@@ -281,8 +489,15 @@ def scan(
     ``hill=True`` adds Hill's-method verdicts (``hill_stability``) and flags rows where
     they contradict the monodromy's (``verdicts_disagree``).
 
-    ``out``: a directory; each finished chunk is written there as Parquet at once, and a
-    later call with the same arguments and ``out`` skips the chunks on disk (resume).
+    ``out``: a directory; each finished chunk is written there as Parquet at once
+    (atomically), and a later call with the same arguments and ``out`` skips the chunks
+    on disk (resume; the axes must be given in the same order). Only one scan at a time
+    may use a directory (another gets :class:`~ballbal.exceptions.ScanStoreError`). A
+    damaged file found on resuming (truncated, unreadable, not this scan's) is set aside
+    as ``<name>.damaged`` with a :class:`~ballbal.exceptions.ScanStoreWarning` naming it,
+    and recomputed. With ``out``, only one chunk per thread is held in memory while the
+    scan runs; ``lazy=True`` returns a ``polars.LazyFrame`` over the files instead of
+    reading them back, for grids whose table does not fit in memory.
     ``executor``: a ``concurrent.futures`` executor or Dask ``Client``; the chunks run
     as its tasks (``threads`` per task, default 1) and the table is the same as here.
     ``progress``: ``True`` for a progress bar (tqdm if installed), or a callable
@@ -306,10 +521,26 @@ def scan(
         patterns = (patterns,)
     if not patterns:
         raise ValueError("patterns: give at least one solution type, e.g. ['R-R']")
+    if lazy and out is None:
+        raise ParameterError("lazy", "a lazy table needs out= (it reads the chunk files)",
+                             allowed="False without out", value=lazy)
+    if out is not None and str(out) == "":
+        raise ParameterError("out", "give a directory name", value=out)
+    default = _native.default_chunk([len(v) for v in values])
+    if block is None:
+        block = default
+    if int(block) < 1:
+        raise ParameterError("block", f"must be >= 1, got {block}", allowed=">= 1",
+                             value=block)
+    block = int(block)
+    chunk_given = chunk is not None
     if chunk is None:
-        chunk = _native.default_chunk([len(v) for v in values])
+        chunk = block
     if int(chunk) < 1:
-        raise ValueError(f"chunk: must be >= 1, got {chunk}")
+        raise ParameterError("chunk", f"must be >= 1, got {chunk}", allowed=">= 1",
+                             value=chunk)
+    # Whole blocks per chunk: a split block would continue less (see the Rust core).
+    chunk = -(-int(chunk) // block) * block
     local_threads = (os.cpu_count() or 1) if threads is None else int(threads)
     if local_threads < 1:
         raise ValueError(f"threads: must be >= 1, got {threads}")
@@ -323,25 +554,38 @@ def scan(
         ("window", float(window)), ("guess_rtol", float(guess_rtol)), ("seeds", int(seeds)),
         ("starts", int(starts)), ("max_tail", float(max_tail)),
     )
-    job = _Job(model, names, values, tuple(str(p) for p in patterns), options, int(chunk))
+    job = _Job(model, names, values, tuple(str(p) for p in patterns), options, block, chunk)
     # Validates everything (grid values, combinations, options) before any work.
     job.native([], 1, lambda _c, _d: None)
 
-    store = _Store(out, job) if out is not None else None
-    n = job.n_chunks()
-    frames: dict[int, pl.DataFrame] = {}
+    store = _Store(out, job, chunk_given) if out is not None else None
+    try:
+        return _run(job, store, executor, threads, local_threads, progress, lazy)
+    finally:
+        if store is not None:
+            store.close()
+
+
+def _run(job: _Job, store: _Store | None, executor: Any, threads: int | None,
+         local_threads: int, progress: bool | Callable[[int, int], Any],
+         lazy: bool) -> pl.DataFrame | pl.LazyFrame:
     if store is not None:
-        for c in sorted(store.done()):
-            if c < n:
-                frames[c] = store.read(c)
-    todo = [c for c in range(n) if c not in frames]
+        job = store.job
+    n = job.n_chunks()
+    # In memory without out=; with out= only the chunk numbers, the rows are on disk.
+    frames: dict[int, pl.DataFrame] = {}
+    finished: set[int] = store.done() if store is not None else set()
+    finished &= set(range(n))
+    todo = [c for c in range(n) if c not in finished]
     total = sum(job.points(c) for c in range(n))
-    bar = _Progress(progress, total, sum(job.points(c) for c in frames))
+    bar = _Progress(progress, total, sum(job.points(c) for c in finished))
 
     def keep(c: int, df: pl.DataFrame) -> None:
-        frames[c] = df
         if store is not None:
             store.write(c, df)
+        else:
+            frames[c] = df
+        finished.add(c)
         bar.update(job.points(c))
 
     try:
@@ -357,32 +601,74 @@ def scan(
                     f.cancel()
                 raise
         elif todo:
-            job.native(todo, local_threads, lambda c, d: keep(c, _frame(names, d)))
+            job.native(todo, local_threads, lambda c, d: keep(c, _frame(job.names, d)))
     except KeyboardInterrupt:
         warnings.warn(
             ScanInterrupted(
-                f"scan interrupted: {len(frames)} of {n} chunks finished"
+                f"scan interrupted: {len(finished)} of {n} chunks finished"
                 + (f" and kept in {store.dir}; run the same scan again to resume"
                    if store is not None else "; pass out= to keep chunks on disk")
             ),
-            stacklevel=2,
+            stacklevel=3,
         )
     finally:
         bar.close()
+    if store is not None:
+        files = store.files(finished)
+        if lazy:
+            return (pl.scan_parquet(files) if files else _empty(job.names).lazy())
+        frames = {c: pl.read_parquet(f) for c, f in zip(sorted(finished), files, strict=True)}
     if not frames:
-        return _empty(names)
+        return _empty(job.names)
     return pl.concat([frames[c] for c in sorted(frames)], how="vertical")
 
 
-def read_scan(path: str | os.PathLike[str]) -> pl.DataFrame:
-    """The table of a scan written with ``out=path`` (the finished chunks, in order)."""
+@overload
+def read_scan(path: str | os.PathLike[str], *, lazy: Literal[False] = ...) -> pl.DataFrame: ...
+@overload
+def read_scan(path: str | os.PathLike[str], *, lazy: Literal[True]) -> pl.LazyFrame: ...
+def read_scan(  # noqa: E302 - overloads above
+    path: str | os.PathLike[str], *, lazy: bool = False,
+) -> pl.DataFrame | pl.LazyFrame:
+    """The table of a scan written with ``out=path`` (the finished chunks, in order).
+
+    Every chunk file is checked against the scan's ``meta.json`` before its rows are
+    used; a damaged one (truncated, unreadable, another scan's, missing points) raises
+    :class:`~ballbal.exceptions.ScanStoreError` naming it; running the same scan with
+    ``out=path`` again sets it aside and recomputes it. ``lazy=True`` returns a
+    ``polars.LazyFrame`` over the files (checked by their footers only: row data is read
+    when the frame is collected).
+    """
     d = Path(path)
     files = sorted(d.glob("chunk-*.parquet"))
     if not files:
-        raise ValueError(f"path: no scan chunks (chunk-*.parquet) in {d}")
+        raise ParameterError("path", f"no scan chunks (chunk-*.parquet) in {d}", value=path)
+    meta = _read_meta(d / "meta.json")
+    damaged = []
+    for f in files:
+        c = _chunk_index(f)
+        if lazy:
+            try:
+                ok = ("block" not in meta
+                      or pl.read_parquet_metadata(f).get(_FINGERPRINT) == _fingerprint(meta))
+                ok = ok and pl.read_parquet_schema(f) == dict(_empty(list(meta["grid"])).schema)
+            except Exception:  # noqa: BLE001 - any failure to read means a damaged file
+                ok = False
+            why = None if ok and c is not None else "unreadable or not this scan's"
+        else:
+            why = _chunk_problem(f, meta, c)
+        if why is not None:
+            damaged.append(f"{f} ({why})")
+    if damaged:
+        raise ScanStoreError(
+            f"path: damaged chunk file(s): {'; '.join(damaged)}; run the same scan with "
+            f"out={str(d)!r} again to recompute them")
+    if lazy:
+        return pl.scan_parquet(files)
     return pl.concat([pl.read_parquet(f) for f in files], how="vertical")
 
 
 def scan_meta(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """The description (balancer, grid, options) stored with a scan written with ``out=``."""
-    return dict(json.loads((Path(path) / "meta.json").read_text()))
+    """The description (balancer, grid, options) stored with a scan written with ``out=``;
+    :class:`~ballbal.exceptions.ScanStoreError` naming ``meta.json`` if it is damaged."""
+    return _read_meta(Path(path) / "meta.json")

@@ -1,9 +1,12 @@
 //! Parallel scans of a parameter grid (one or more dimensions).
 //!
-//! The grid is cut into chunks along its last parameter; a chunk is the unit of
-//! progress reports, interruption, resumption and distribution (a chunk's rows depend
-//! only on the grid, the options and the chunk's bounds, never on which other chunks
-//! run, where, or on how many threads). Inside a chunk:
+//! The grid is cut into *blocks* along its last parameter (`block` values each, fixed by
+//! the grid's shape unless chosen): a block is the unit of the science, since seeding
+//! and continuation stay inside it, so its rows depend only on the grid, the options
+//! and its bounds. Blocks are grouped into *chunks* of whole blocks, the unit of
+//! progress reports, interruption, resumption and distribution: a chunk's rows never
+//! depend on the chunk length, on which other chunks run, where, or on how many
+//! threads. Inside a block:
 //!
 //! 1. *Seeds*: a sparse lattice of points, plus the points where the perfect balance
 //!    changes stability (O-type motions are born there), is simulated from a few
@@ -96,7 +99,11 @@ pub struct ScanSpec<'a, D: Family> {
     pub seeds: usize,
     /// Simulated initial states per seed point.
     pub starts: usize,
-    /// Values of the last parameter per chunk.
+    /// Values of the last parameter per continuation block (seeding and continuation
+    /// stay inside a block, so this is a numerical option; see [`default_chunk`]).
+    pub block: usize,
+    /// Values of the last parameter per chunk, rounded up to whole blocks: the unit of
+    /// progress and resumption only; the rows do not depend on it.
     pub chunk: usize,
     pub threads: usize,
     /// Largest accepted [`HbSolution::tail_ratio`]; a solution above it is not resolved
@@ -146,6 +153,7 @@ impl<D: Family> ScanSpec<'_, D> {
             ("seeds", self.seeds, 1),
             ("starts", self.starts, 1),
             ("chunk", self.chunk, 1),
+            ("block", self.block, 1),
         ] {
             if v < lo {
                 return Err(Error::param(name, format!("must be >= {lo}, got {v}")));
@@ -167,19 +175,34 @@ impl<D: Family> ScanSpec<'_, D> {
         Ok(())
     }
 
+    /// Chunk length actually used: `chunk` rounded up to whole blocks, so that no block
+    /// is ever split between chunks (a split block would continue less).
+    pub fn chunk_len(&self) -> usize {
+        let b = self.block.max(1);
+        self.chunk.max(1).div_ceil(b) * b
+    }
+
     /// Chunk bounds along the last parameter.
     pub fn chunks(&self) -> Vec<Range<usize>> {
         let n = self.values.last().map_or(0, |v| v.len());
-        (0..n)
-            .step_by(self.chunk.max(1))
-            .map(|a| a..(a + self.chunk).min(n))
+        let len = self.chunk_len();
+        (0..n).step_by(len).map(|a| a..(a + len).min(n)).collect()
+    }
+
+    /// Block bounds inside a chunk (chunks start on block edges).
+    fn blocks(&self, chunk: &Range<usize>) -> Vec<Range<usize>> {
+        let b = self.block.max(1);
+        chunk
+            .clone()
+            .step_by(b)
+            .map(|a| a..(a + b).min(chunk.end))
             .collect()
     }
 }
 
-/// Default chunk length: about 1024 grid points a chunk, so that a chunk is long enough
-/// for continuation and seeds to pay off and short enough to report progress and lose
-/// little on interruption.
+/// Default block (and chunk) length: about 1024 grid points, so that a block is long
+/// enough for continuation and seeds to pay off and short enough to report progress and
+/// lose little on interruption. It depends on the grid's shape only.
 pub fn default_chunk(lens: &[usize]) -> usize {
     let inner: usize = lens[..lens.len().saturating_sub(1)].iter().product();
     let outer = lens.last().copied().unwrap_or(1);
@@ -209,8 +232,12 @@ pub fn scan_chunks<D: Family>(
         .map_err(|e| Error::param("threads", e.to_string()))?;
     pool.install(|| {
         which.par_iter().try_for_each(|&c| {
-            let rows = scan_chunk(spec, chunks[c].clone(), cancel)?;
-            on_chunk(c, rows);
+            let parts = spec
+                .blocks(&chunks[c])
+                .into_par_iter()
+                .map(|b| scan_chunk(spec, b, cancel))
+                .collect::<Result<Vec<_>>>()?;
+            on_chunk(c, parts.into_iter().flatten().collect());
             Ok(())
         })
     })
@@ -681,6 +708,7 @@ mod tests {
             },
             seeds: 2,
             starts: 2,
+            block: 2,
             chunk: 2,
             threads,
             max_tail: 0.25,
@@ -727,6 +755,36 @@ mod tests {
                 x.result.as_ref().map(|r| r.sol.omega.to_bits()),
                 y.result.as_ref().map(|r| r.sol.omega.to_bits())
             );
+        }
+    }
+
+    #[test]
+    fn chunk_length_does_not_change_the_table() {
+        // Chunks of 1, 2 (one block), 3 and 5 values: every chunk is made of whole
+        // blocks, so the rows are those of the one-block-per-chunk scan, bit for bit.
+        let base = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let om = [1.15, 1.2, 1.25];
+        let eta = [0.8, 0.9, 1.0, 1.1, 1.2];
+        let reference = scan(&spec(&base, &om, &eta, 2)).unwrap();
+        assert!(reference.iter().filter(|r| r.result.is_some()).count() >= 10);
+        for chunk in [1, 3, 5] {
+            let s = ScanSpec {
+                chunk,
+                ..spec(&base, &om, &eta, 1)
+            };
+            assert!(s.chunks().iter().all(|c| c.start % 2 == 0));
+            let rows = scan(&s).unwrap();
+            assert_eq!(rows.len(), reference.len(), "chunk {chunk}");
+            for (x, y) in rows.iter().zip(&reference) {
+                assert_eq!(
+                    (&x.index, x.pattern, x.solution),
+                    (&y.index, y.pattern, y.solution)
+                );
+                assert_eq!(
+                    x.result.as_ref().map(|r| r.sol.omega.to_bits()),
+                    y.result.as_ref().map(|r| r.sol.omega.to_bits())
+                );
+            }
         }
     }
 

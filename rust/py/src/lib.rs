@@ -580,7 +580,7 @@ fn orbit_closure(
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, names, values, patterns,
                     n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin,
                     max_steps, settle, window, guess_rtol, auto, n_max, hill, seeds, starts,
-                    chunk, max_tail, threads, chunks, on_chunk, effects=None))]
+                    chunk, max_tail, threads, chunks, on_chunk, effects=None, block=None))]
 #[allow(clippy::too_many_arguments)]
 fn scan(
     py: Python<'_>,
@@ -617,8 +617,11 @@ fn scan(
     chunks: Vec<usize>,
     on_chunk: Bound<'_, PyAny>,
     effects: Effects,
+    block: Option<usize>,
 ) -> PyResult<()> {
     use ballbal_core::scan::ScanSpec;
+    let lens: Vec<usize> = values.iter().map(Vec::len).collect();
+    let block = block.unwrap_or_else(|| ballbal_core::scan::default_chunk(&lens));
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let sc = autonomous_scene(&p, effects, "scan")?;
     let rots = patterns
@@ -666,6 +669,7 @@ fn scan(
                 opts,
                 seeds,
                 starts,
+                block,
                 chunk,
                 threads,
                 max_tail,

@@ -1,0 +1,80 @@
+"""Peak memory of scans streamed to Parquet against grid size (issue 13).
+
+Each size runs in its own process (peak RSS from ``resource.getrusage`` is a process's
+high-water mark): an Omega x eta square grid of 10^4, 10^5 and 10^6 points scanned with
+``out=`` and ``lazy=True`` (one chunk per thread in memory; the table stays on disk),
+and, for contrast, the same grid held in memory without ``out=`` (up to 10^5 points).
+
+Grid Omega 1.0-2.0 x eta 0.4-1.5 (mu 0.2, delta 50, zeta_b 0.1), R-R only,
+``floquet=False`` (multipliers are null: rows a little smaller than with Floquet), two
+settings:
+
+* ``solved`` (``seeds=2, starts=2``): most points get a solution (about 0.6 ms a point
+  on 2 threads), up to 10^5 points;
+* ``cheap`` (``seeds=1, starts=1``): the one start per block finds no R-R, so every
+  point is a ``not_found`` row after its perfect-balance check (about 0.15 ms a point):
+  the setting that lets 10^6 points run in minutes. A row's size on disk and in memory
+  hardly depends on the setting; the time does.
+
+The target is under 1 GiB at 10^6 points.
+
+    python benchmarks/bench_scan_memory.py            # 10^4, 10^5, 10^6
+    python benchmarks/bench_scan_memory.py --quick    # 10^4, 10^5
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+
+CHILD = r"""
+import json, resource, sys, time
+import numpy as np, polars as pl, ballbal
+side, mode, setting, out = int(sys.argv[1]), sys.argv[2], sys.argv[3], sys.argv[4]
+grid = dict(Omega=np.linspace(1.0, 2.0, side), eta=np.linspace(0.4, 1.5, side))
+seeds = 2 if setting == "solved" else 1
+kw = dict(patterns=["R-R"], floquet=False, seeds=seeds, starts=seeds, threads=2, **grid)
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+t = time.perf_counter()
+if mode == "streamed":
+    lf = ballbal.scan(ballbal.Balancer(zeta_b=0.1), out=out, lazy=True, **kw)
+    n = lf.select(pl.len()).collect().item()
+    found = lf.filter(pl.col("status") == "converged").select(pl.len()).collect().item()
+else:
+    df = ballbal.scan(ballbal.Balancer(zeta_b=0.1), **kw)
+    n, found = df.height, df.filter(pl.col("status") == "converged").height
+dt = time.perf_counter() - t
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps(dict(points=side * side, rows=n, found=found, seconds=dt,
+                      peak_mib=peak / 1024, import_mib=base / 1024)))
+"""
+
+
+def run(side: int, mode: str, setting: str) -> dict:
+    with tempfile.TemporaryDirectory() as d:
+        r = subprocess.run([sys.executable, "-c", CHILD, str(side), mode, setting,
+                            f"{d}/scan"],
+                           capture_output=True, text=True, check=True)
+    return json.loads(r.stdout)
+
+
+def main() -> None:
+    quick = "--quick" in sys.argv
+    print(f"{'setting':<8} {'mode':<10} {'points':>9} {'rows':>9} {'found':>9} "
+          f"{'seconds':>8} {'peak MiB':>9} {'after import':>12}")
+    runs = [("solved", 100, "streamed"), ("solved", 100, "memory"),
+            ("solved", 316, "streamed"), ("solved", 316, "memory"),
+            ("cheap", 100, "streamed"), ("cheap", 316, "streamed")]
+    if not quick:
+        runs.append(("cheap", 1000, "streamed"))
+    for setting, side, mode in runs:
+        r = run(side, mode, setting)
+        print(f"{setting:<8} {mode:<10} {r['points']:>9} {r['rows']:>9} {r['found']:>9} "
+              f"{r['seconds']:>8.1f} {r['peak_mib']:>9.0f} {r['import_mib']:>12.0f}",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()
