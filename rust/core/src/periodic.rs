@@ -733,6 +733,7 @@ mod tests {
             seeds: 4,
             starts: 4,
             chunk: 12,
+            block: 12,
             threads: 2,
             max_tail: 0.25,
         };
