@@ -213,3 +213,22 @@ def test_accuracy_study_gives_no_verdict_without_an_accurate_trivial_multiplier(
     assert abs(n3["trivial_error"] - 0.18) < 0.02 and n3["stability"] == "undetermined"
     n12 = df.filter((df["knob"] == "N") & (df["N"] == 12)).row(0, named=True)
     assert n12["stability"] == "stable" and n12["verdict_ok"]
+
+
+def test_auto_harmonics_from_a_non_orbit_certifies_after_refinement():
+    b = ballbal.Balancer(**REPRO, Omega=1.0, eta=(1.0, 1.0))
+    prev = ballbal.periodic(b, "R-R", N=8)
+    for W in (0.98, 0.96, 0.94, 0.92):
+        prev = ballbal.periodic(b.replace(Omega=W), "R-R", N=8, guess=prev,
+                                max_closure=1e300)
+    assert prev.converged and simulated_closure(prev, rtol=1e-9) > 1.0  # certificate off
+    outcomes = set()
+    for W in (0.92, 0.915, 0.9):
+        s = ballbal.periodic(b.replace(Omega=W), "R-R", N="auto", guess=prev, hill=False)
+        check_verdict(s)
+        outcomes.add(s.converged)
+        if s.converged:
+            assert simulated_closure(s, rtol=1e-9) < 0.05, (W, s.N, s.omega)
+        else:
+            assert s.stability == "undetermined" and s.target_met is not True
+    assert outcomes == {True, False}
