@@ -64,7 +64,7 @@ def test_continuation_into_the_branch_end_gives_orbits_or_says_not_converged(N):
             if s.status in ("not_closed", "truncated"):
                 # kept for inspection, and indeed no orbit
                 assert s.omega is not None and s.closure is not None
-                assert s.status == "truncated" or s.closure > 10.0
+                assert s.status == "truncated" or s.closure > 6.0
         prev = s
     assert closed >= 2 and refused >= 15
 
@@ -138,20 +138,25 @@ def test_merged_balls_separation_product_is_exp_minus_two_zeta_b_t():
 
 
 def test_scan_rows_are_certified():
-    b = ballbal.Balancer(**REPRO, Omega=1.2, eta=(1.0, 1.0))
-    df = ballbal.scan(b, Omega=(0.9, 1.3, 0.05), eta=(0.6, 1.0, 0.2), patterns=["R-R"])
+    # Light rotor damping: at Omega 1.0 the N = 3 rows have trivial errors of 0.06 to
+    # 0.56; before, they came with definite verdicts (all multipliers judged against a
+    # margin of that size), and the slowest (eta 0.6) "converged" with a simulated
+    # closure of 0.94.
+    b = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
+    df = ballbal.scan(b, Omega=(1.0, 1.2, 0.1), eta=(0.6, 1.1, 0.1), patterns=["R-R"])
     assert {"closure", "separation_error"} <= set(df.columns)
     ok = df.filter(df["status"] == "converged")
     assert ok.height >= 10
-    assert (ok["closure"] <= 10.0).all() and (ok["tail"] <= 0.25).all()
+    assert (ok["closure"] <= 6.0).all() and (ok["tail"] <= 0.25).all()
     definite = ok.filter(ok["stability"] != "undetermined")
     assert (definite["trivial_error"] <= MAX_TRIVIAL).all()
-    # independent: the rows reported as orbits close under scipy simulation
+    assert ok.filter(ok["trivial_error"] > MAX_TRIVIAL).height >= 3
+    # independent: the slowest rows reported as orbits close under scipy simulation
     for row in ok.sort("omega").head(3).iter_rows(named=True):
         s = ballbal.periodic(b.replace(Omega=row["Omega"], eta=(row["eta"],) * 2), "R-R",
-                             N=3)
-        if s.converged and abs(s.omega - row["omega"]) < 1e-6:
-            assert simulated_closure(s) < 0.3
+                             N=3, rtol=1e-6, atol=1e-9)
+        assert s.converged and abs(s.omega - row["omega"]) < 1e-6
+        assert simulated_closure(s, rtol=1e-9) < 0.75
 
 
 params = st.fixed_dictionaries({
@@ -185,10 +190,10 @@ def test_random_continuation_paths_are_certified(p):
             assert s.stability == "undetermined"
         if not s.converged:
             continue
-        assert s.closure is not None and s.closure <= 10.0 and s.tail <= 0.25
+        assert s.closure is not None and s.closure <= 6.0 and s.tail <= 0.25
         # an orbit: scipy closes it (where the flow does not amplify the error much)
         if s.max_modulus is not None and s.max_modulus < 2 and s.period < 250:
-            assert simulated_closure(s, rtol=1e-9) < 0.5, (W, s.omega, s.closure)
+            assert simulated_closure(s, rtol=1e-9) < 0.75, (W, s.omega, s.closure)
         # the verdict does not flip under much tighter tolerances
         t = ballbal.periodic(b.replace(Omega=W), "R-R", N=p["N"], guess=s, rtol=1e-10,
                              atol=1e-12, tol=1e-12, step_tol=1e-10)
