@@ -29,7 +29,8 @@ def main(repeats: int = 3, threads: int = 2) -> None:
         t0 = time.perf_counter()
         df = ballbal.scan(b, patterns=["R-R", "O-O", "R-O"], threads=threads, **grid)
         wall = time.perf_counter() - t0
-        cert = _native.certificate_seconds() - c0
+        c1 = _native.certificate_seconds()
+        cert = c1 - c0
         points = df.select("Omega", "eta").unique().height
         found = df.filter(df["status"] == "converged").height
         frac = cert / (wall * threads)
@@ -46,5 +47,23 @@ def main(repeats: int = 3, threads: int = 2) -> None:
           f"{d['separation_error'].max()}")
 
 
+def separation() -> None:
+    """The closure certificate against the simulated closure (verify()) on the issue's
+    reproduction, certificates off, so that both sides of the threshold show."""
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, Omega=1.0, eta=(1.0, 1.0))
+    for n in (8, 3):
+        prev = ballbal.periodic(b, "R-R", N=n, max_closure=1e300, max_tail=1e300)
+        for k in range(1, 20):
+            w = round(1.0 - 0.02 * k, 3)
+            s = ballbal.periodic(b.replace(Omega=w), "R-R", N=n, guess=prev,
+                                 max_closure=1e300, max_tail=1e300, hill=False)
+            if s.omega is None:
+                break
+            print(f"N={n} Omega={w:.2f}: omega {s.omega:.2e}, closure certificate "
+                  f"{s.closure:.2e}, simulated closure {s.verify():.2e}, tail {s.tail:.2f}")
+            prev = s
+
+
 if __name__ == "__main__":
     main(int(sys.argv[1]) if len(sys.argv) > 1 else 3)
+    separation()

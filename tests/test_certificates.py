@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
@@ -64,7 +64,7 @@ def test_continuation_into_the_branch_end_gives_orbits_or_says_not_converged(N):
             if s.status in ("not_closed", "truncated"):
                 # kept for inspection, and indeed no orbit
                 assert s.omega is not None and s.closure is not None
-                assert s.status == "truncated" or s.closure > 10.0
+                assert s.status == "truncated" or s.closure > 6.0
         prev = s
     assert closed >= 2 and refused >= 15
 
@@ -138,32 +138,38 @@ def test_merged_balls_separation_product_is_exp_minus_two_zeta_b_t():
 
 
 def test_scan_rows_are_certified():
-    b = ballbal.Balancer(**REPRO, Omega=1.2, eta=(1.0, 1.0))
-    df = ballbal.scan(b, Omega=(0.9, 1.3, 0.05), eta=(0.6, 1.0, 0.2), patterns=["R-R"])
+    # Light rotor damping: at Omega 1.0 the N = 3 rows have trivial errors of 0.06 to
+    # 0.56; before, they came with definite verdicts (all multipliers judged against a
+    # margin of that size), and the slowest (eta 0.6) "converged" with a simulated
+    # closure of 0.94.
+    b = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
+    df = ballbal.scan(b, Omega=(1.0, 1.2, 0.1), eta=(0.6, 1.1, 0.1), patterns=["R-R"])
     assert {"closure", "separation_error"} <= set(df.columns)
     ok = df.filter(df["status"] == "converged")
     assert ok.height >= 10
-    assert (ok["closure"] <= 10.0).all() and (ok["tail"] <= 0.25).all()
+    assert (ok["closure"] <= 6.0).all() and (ok["tail"] <= 0.25).all()
     definite = ok.filter(ok["stability"] != "undetermined")
     assert (definite["trivial_error"] <= MAX_TRIVIAL).all()
-    # independent: the rows reported as orbits close under scipy simulation
+    assert ok.filter(ok["trivial_error"] > MAX_TRIVIAL).height >= 3
+    # independent: the slowest rows reported as orbits close under scipy simulation
     for row in ok.sort("omega").head(3).iter_rows(named=True):
         s = ballbal.periodic(b.replace(Omega=row["Omega"], eta=(row["eta"],) * 2), "R-R",
-                             N=3)
-        if s.converged and abs(s.omega - row["omega"]) < 1e-6:
-            assert simulated_closure(s) < 0.3
+                             N=3, rtol=1e-6, atol=1e-9)
+        assert s.converged and abs(s.omega - row["omega"]) < 1e-6
+        assert simulated_closure(s, rtol=1e-9) < 0.75
 
 
 params = st.fixed_dictionaries({
     "mu": st.floats(0.1, 0.3), "zeta": st.floats(0.02, 0.1), "zeta_b": st.floats(0.03, 0.2),
     "delta": st.floats(20.0, 100.0), "eta": st.floats(0.7, 1.3),
     "equal": st.booleans(), "N": st.sampled_from([3, 8]),
-    "start": st.floats(1.05, 1.4),
-    "steps": st.lists(st.floats(-0.12, 0.04), min_size=1, max_size=4),
+    "start": st.floats(1.0, 1.3),
+    # mostly downwards: a rotating branch ends (period to infinity) below Omega ~ 1
+    "steps": st.lists(st.floats(-0.1, 0.02), min_size=2, max_size=5),
 })
 
 
-@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.too_slow],
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow],
           derandomize=True)
 @given(params)
 def test_random_continuation_paths_are_certified(p):
@@ -171,6 +177,7 @@ def test_random_continuation_paths_are_certified(p):
     b = ballbal.Balancer(mu=p["mu"], zeta=p["zeta"], zeta_b=p["zeta_b"], delta=p["delta"],
                          Omega=p["start"], eta=eta)
     s = ballbal.periodic(b, "R-R", N=p["N"], settle=800, window=1500)
+    assume(s.omega is not None)
     W = p["start"]
     for dw in [0.0, *p["steps"]]:
         W = max(0.5, W + dw)
@@ -183,12 +190,50 @@ def test_random_continuation_paths_are_certified(p):
             assert s.stability == "undetermined"
         if not s.converged:
             continue
-        assert s.closure is not None and s.closure <= 10.0 and s.tail <= 0.25
+        assert s.closure is not None and s.closure <= 6.0 and s.tail <= 0.25
         # an orbit: scipy closes it (where the flow does not amplify the error much)
-        if s.max_modulus is not None and s.max_modulus < 2 and s.period < 400:
-            assert simulated_closure(s, rtol=1e-9) < 0.5, (W, s.omega, s.closure)
+        if s.max_modulus is not None and s.max_modulus < 2 and s.period < 250:
+            assert simulated_closure(s, rtol=1e-9) < 0.75, (W, s.omega, s.closure)
         # the verdict does not flip under much tighter tolerances
         t = ballbal.periodic(b.replace(Omega=W), "R-R", N=p["N"], guess=s, rtol=1e-10,
                              atol=1e-12, tol=1e-12, step_tol=1e-10)
         if t.converged and abs(t.omega - s.omega) < 1e-6:
             assert {t.stability, s.stability} != {"stable", "unstable"}
+
+
+def test_accuracy_study_gives_no_verdict_without_an_accurate_trivial_multiplier():
+    # The thesis' hard case: at N = 3 the trivial multiplier is off by 0.18 (the
+    # published 1.1808), which used to pass as a "stable" verdict matching the reference.
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, Omega=1.0,
+                         eta=(0.7, 0.7))
+    df = ballbal.accuracy_cost(b, N=(3, 12), samples=(), tol=(), rtol=(1e-9,), repeats=1,
+                               reference_N=24)
+    assert {"closure", "separation_error", "stability"} <= set(df.columns)
+    for row in df.iter_rows(named=True):
+        if row["stability"] != "undetermined":
+            assert row["trivial_error"] <= MAX_TRIVIAL and row["verdict_ok"] is not None
+        else:
+            assert row["verdict_ok"] is None
+    n3 = df.filter((df["knob"] == "N") & (df["N"] == 3)).row(0, named=True)
+    assert abs(n3["trivial_error"] - 0.18) < 0.02 and n3["stability"] == "undetermined"
+    n12 = df.filter((df["knob"] == "N") & (df["N"] == 12)).row(0, named=True)
+    assert n12["stability"] == "stable" and n12["verdict_ok"]
+
+
+def test_auto_harmonics_from_a_non_orbit_certifies_after_refinement():
+    b = ballbal.Balancer(**REPRO, Omega=1.0, eta=(1.0, 1.0))
+    prev = ballbal.periodic(b, "R-R", N=8)
+    for W in (0.98, 0.96, 0.94, 0.92):
+        prev = ballbal.periodic(b.replace(Omega=W), "R-R", N=8, guess=prev,
+                                max_closure=1e300)
+    assert prev.converged and simulated_closure(prev, rtol=1e-9) > 1.0  # certificate off
+    outcomes = set()
+    for W in (0.92, 0.915, 0.9):
+        s = ballbal.periodic(b.replace(Omega=W), "R-R", N="auto", guess=prev, hill=False)
+        check_verdict(s)
+        outcomes.add(s.converged)
+        if s.converged:
+            assert simulated_closure(s, rtol=1e-9) < 0.05, (W, s.N, s.omega)
+        else:
+            assert s.stability == "undetermined" and s.target_met is not True
+    assert outcomes == {True, False}

@@ -94,8 +94,8 @@ def accuracy_cost(
     for n in N:
         settings.append(("N", n, {**base, "N": int(n)}))
     for m in samples:
-        s = max(int(m * base_N), 2 * base_N + 2)
-        settings.append(("samples", s, {**base, "samples": s}))
+        count = max(int(m * base_N), 2 * base_N + 2)
+        settings.append(("samples", count, {**base, "samples": count}))
     for t in tol:
         settings.append(("tol", t, {**base, "tol": t, "step_tol": max(t * 100, 1e-8)}))
     for r in rtol:
@@ -109,14 +109,21 @@ def accuracy_cost(
             s = periodic(balancer, pattern, guess=warm, hill=False, **kw)
             times.append(time.perf_counter() - t0)
         ok = s.converged and s.multipliers is not None
+        errors: dict[str, float | None] = dict.fromkeys(
+            ("omega_error", "coeff_error", "multiplier_error"))
+        if (s.converged and s.omega is not None and s.multipliers is not None
+                and ref.omega is not None and ref.multipliers is not None):
+            errors = {
+                "omega_error": abs(s.omega - ref.omega) / ref.omega,
+                "coeff_error": _coeff_error(s.coeffs, ref.coeffs),
+                "multiplier_error": _match_error(s.multipliers, ref.multipliers),
+            }
         rows.append({
             "knob": knob, "value": float(value), "N": int(kw["N"]),
             "samples": s.samples, "tol": float(kw["tol"]), "rtol": float(kw["rtol"]),
             "status": s.status, "iterations": s.iterations,
             "floquet_steps": s.floquet_steps, "seconds": statistics.median(times),
-            "omega_error": abs(s.omega - ref.omega) / ref.omega if ok else None,
-            "coeff_error": _coeff_error(s.coeffs, ref.coeffs) if ok else None,
-            "multiplier_error": _match_error(s.multipliers, ref.multipliers) if ok else None,
+            **errors,
             "trivial_error": s.trivial_error, "tail": s.tail if ok else None,
             "closure": s.closure, "separation_error": s.separation_error,
             "stability": s.stability,

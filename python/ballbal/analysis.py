@@ -237,7 +237,7 @@ def periodic(
     max_steps: int = 200_000,
     settle: float = 1500.0,
     window: float = 2500.0,
-    max_closure: float = 10.0,
+    max_closure: float = 6.0,
     max_trivial: float = 0.1,
     max_tail: float = 0.25,
 ) -> PeriodicSolution:
@@ -266,8 +266,8 @@ def periodic(
       velocity error one simulated period from the series' state would show before the
       linearised flow amplifies or damps it, so unlike a simulated closure (``verify()``)
       it does not grow with the multipliers of a strongly unstable orbit. Above
-      ``max_closure`` (default 10; genuine orbits of the thesis grid at N = 3 give at
-      most 4.5, the series near a rotating branch's infinite-period end that are no
+      ``max_closure`` (default 6; genuine orbits of the thesis grid at N = 3 give at
+      most 4.9, the series near a rotating branch's infinite-period end that are no
       orbits 23 and more) the status is ``not_closed``.
     * ``tail`` above ``max_tail``: status ``truncated`` (N does not resolve the orbit).
     * ``trivial_error``: no stability verdict (``undetermined``) unless the trivial
