@@ -178,6 +178,16 @@ def _chunk_index(f: Path) -> int | None:
     return int(m.group(1)) if m else None
 
 
+def _caller() -> int:
+    """The ``stacklevel`` of the first frame outside ballbal, seen from the function
+    that calls this one: warnings then point at the user's line."""
+    here = str(Path(__file__).parent)
+    f, level = sys._getframe(1), 1
+    while f is not None and f.f_code.co_filename.startswith(here):
+        f, level = f.f_back, level + 1
+    return level
+
+
 def _sync_dir(d: Path) -> None:
     # The rename itself must reach the disk, or a crash can bring back the old name.
     try:
@@ -317,7 +327,7 @@ class _Store:
         dest = f.with_name(f.name + ".damaged")
         os.replace(f, dest)
         warnings.warn(ScanStoreWarning(f"out: {f} is damaged ({why}); set aside as "
-                                       f"{dest.name} and {then}"), stacklevel=4)
+                                       f"{dest.name} and {then}"), stacklevel=_caller())
 
     def _open(self, job: _Job, chunk_given: bool) -> _Job:
         # As it reads back from JSON (tuples become lists), to compare with the file.
