@@ -20,6 +20,7 @@ import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+from types import FrameType
 from typing import IO, Any, Literal, overload
 
 import numpy as np
@@ -182,7 +183,8 @@ def _caller() -> int:
     """The ``stacklevel`` of the first frame outside ballbal, seen from the function
     that calls this one: warnings then point at the user's line."""
     here = str(Path(__file__).parent)
-    f, level = sys._getframe(1), 1
+    f: FrameType | None = sys._getframe(1)
+    level = 1
     while f is not None and f.f_code.co_filename.startswith(here):
         f, level = f.f_back, level + 1
     return level
@@ -649,7 +651,12 @@ def read_scan(  # noqa: E302 - overloads above
     when the frame is collected).
     """
     d = Path(path)
-    files = sorted(d.glob("chunk-*.parquet"))
+    # In chunk order, also past chunk 99999 (where names stop sorting as numbers).
+    def order(f: Path) -> tuple[int, str]:
+        c = _chunk_index(f)
+        return (-1 if c is None else c, f.name)
+
+    files = sorted(d.glob("chunk-*.parquet"), key=order)
     if not files:
         raise ParameterError("path", f"no scan chunks (chunk-*.parquet) in {d}", value=path)
     meta = _read_meta(d / "meta.json")
