@@ -317,3 +317,16 @@ def test_lazy_table_over_the_files(tmp_path, reference):
     lf2 = ballbal.read_scan(out, lazy=True)
     assert isinstance(lf2, pl.LazyFrame) and same(lf2.collect(), reference)
     assert os.path.exists(out / ".lock")
+
+
+def test_command_line_scan_into_another_scans_directory_is_a_clear_error(tmp_path):
+    out = tmp_path / "cli"
+    exe = [sys.executable, "-m", "ballbal.cli", "scan", "--eta", "1:1:1", "-o", str(out),
+           "--no-progress"]
+    r = subprocess.run(exe + ["--Omega", "1.2:1.2:0.1"], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run(exe + ["--Omega", "1.3:1.3:0.1"], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert r.stderr.startswith("ballbal: error: out:") and "differs in grid" in r.stderr
