@@ -31,7 +31,8 @@ def periodic(
     pattern: str, n_harm: int, samples: int | None, tol: float, step_tol: float, max_iter: int,
     guess_omega: float | None, guess_coeffs: npt.NDArray[np.float64] | None, floquet: bool,
     f_rtol: float, f_atol: float, margin: float, max_steps: int, settle: float, window: float,
-    guess_rtol: float, auto: float | None, n_max: int, hill: bool, effects: Effects = None,
+    guess_rtol: float, auto: float | None, n_max: int, hill: bool, max_closure: float = 10.0,
+    max_trivial: float = 0.1, max_tail: float = 0.25, effects: Effects = None,
 ) -> dict[str, Any]: ...
 def orbit_closure(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
@@ -49,3 +50,4 @@ def scan(
     effects: Effects = None, block: int | None = None,
 ) -> None: ...
 def default_chunk(lens: list[int]) -> int: ...
+def certificate_seconds() -> float: ...

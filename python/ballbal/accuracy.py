@@ -66,7 +66,10 @@ def accuracy_cost(
     coefficient difference relative to the largest coefficient), ``multiplier_error``
     (largest distance between paired multipliers), ``trivial_error`` (the computed
     trivial multiplier's distance from 1) and whether the verdict matches the
-    reference's.
+    reference's. The same certificates as :func:`~ballbal.periodic` apply: a setting whose
+    series fails one (``status`` ``not_closed`` or ``truncated``) has no errors, and
+    ``verdict_ok`` is null where either verdict is ``undetermined`` (no verdict is not a
+    wrong verdict); ``closure``, ``separation_error`` and ``stability`` are columns.
     """
     if repeats < 1:
         raise ValueError(f"repeats: must be >= 1, got {repeats}")
@@ -115,7 +118,10 @@ def accuracy_cost(
             "coeff_error": _coeff_error(s.coeffs, ref.coeffs) if ok else None,
             "multiplier_error": _match_error(s.multipliers, ref.multipliers) if ok else None,
             "trivial_error": s.trivial_error, "tail": s.tail if ok else None,
-            "verdict_ok": (s.stability == ref.stability) if ok else None,
+            "closure": s.closure, "separation_error": s.separation_error,
+            "stability": s.stability,
+            "verdict_ok": (s.stability == ref.stability)
+            if ok and "undetermined" not in (s.stability, ref.stability) else None,
             "reference_closure": closure,
         })
     return pl.DataFrame(rows)

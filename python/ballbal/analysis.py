@@ -119,6 +119,10 @@ class PeriodicSolution:
     ``coeffs[j] = [a_0, a_1, b_1, ..., a_N, b_N]`` for coordinate ``j`` of
     ``(x, y, b_1..b_n)``; ``q_j(tau) = a_0 + sum a_m cos(m tau) + b_m sin(m tau) + w_j tau``,
     ``tau = omega t``, with ``winding[j] = -1`` for a rotating ball.
+
+    Certificates (see :func:`periodic`): ``closure`` (the series' ODE defect integrated
+    over one period), ``tail`` (highest harmonic relative to the motion),
+    ``trivial_error`` and, for merged balls, ``separation_error``.
     """
 
     balancer: Balancer | Scene
@@ -142,10 +146,13 @@ class PeriodicSolution:
     hill_multipliers: np.ndarray | None = None
     hill_stability: Stability | None = None
     verdicts_disagree: bool | None = None
+    closure: float | None = None
+    separation_error: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
     @property
     def converged(self) -> bool:
+        """Newton converged *and* every certificate passed."""
         return self.status == "converged"
 
     @property
@@ -230,6 +237,9 @@ def periodic(
     max_steps: int = 200_000,
     settle: float = 1500.0,
     window: float = 2500.0,
+    max_closure: float = 10.0,
+    max_trivial: float = 0.1,
+    max_tail: float = 0.25,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
     per ball) by Newton–IHB with ``N`` harmonics, and its Floquet multipliers.
@@ -249,8 +259,31 @@ def periodic(
     the Hill matrix, no time integration): ``hill_multipliers``, ``hill_stability``, and
     ``verdicts_disagree`` when one says stable and the other unstable.
 
-    A solve that fails is returned with its ``status`` (``diverged``, ``singular``,
-    ``max_iterations``, ``no_guess``) and ``omega = None``; it never raises for that.
+    Every converged series is certified before it is called ``converged``:
+
+    * ``closure``: the series' ODE defect (acceleration error, ``M^-1 F``) at twice the
+      collocation samples, between them, integrated over one period. It estimates the
+      velocity error one simulated period from the series' state would show before the
+      linearised flow amplifies or damps it, so unlike a simulated closure (``verify()``)
+      it does not grow with the multipliers of a strongly unstable orbit. Above
+      ``max_closure`` (default 10; genuine orbits of the thesis grid at N = 3 give at
+      most 4.5, the series near a rotating branch's infinite-period end that are no
+      orbits 23 and more) the status is ``not_closed``.
+    * ``tail`` above ``max_tail``: status ``truncated`` (N does not resolve the orbit).
+    * ``trivial_error``: no stability verdict (``undetermined``) unless the trivial
+      multiplier is within ``max_trivial`` of 1; the same for ``hill_stability``.
+    * ``separation_error`` (merged balls, i.e. identical balls on the same motion, only):
+      the product of the two ball-separation multipliers against its exact value
+      ``exp(-2 zeta_b T)`` (Liouville's formula on the separation mode); above
+      ``max_trivial`` the verdict is ``undetermined`` too.
+
+    A ``not_closed`` or ``truncated`` result keeps ``omega`` and ``coeffs`` for
+    inspection but has no multipliers and no verdict. A solve that fails is returned with
+    its ``status`` (``diverged``, ``singular``, ``max_iterations``, ``no_guess``) and
+    ``omega = None``; it never raises for that. Tolerances and margins outside their
+    ranges (``rtol`` and ``atol`` in (0, 1), ``margin`` in [0, 1), ``settle`` and
+    ``window`` up to 1e5, ...) raise :class:`~ballbal.exceptions.ParameterError` naming
+    them.
     """
     go: float | None = None
     gc: np.ndarray | None = None
@@ -267,7 +300,7 @@ def periodic(
         *balancer.native_args(), pattern, n0, samples, float(tol), float(step_tol),
         int(max_iter), go, gc, bool(floquet), float(rtol), float(atol), float(margin),
         int(max_steps), float(settle), float(window), 1e-9, auto, int(N_max), bool(hill),
-        balancer.native_effects(),
+        float(max_closure), float(max_trivial), float(max_tail), balancer.native_effects(),
     )
     mult = d["mult_re"] + 1j * d["mult_im"] if "mult_re" in d else None
     hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None
@@ -279,6 +312,7 @@ def periodic(
         residual=d["residual"], iterations=d["iterations"], multipliers=mult,
         stability=d["stability"], max_modulus=d.get("max_modulus"),
         trivial_error=d.get("trivial_error"), floquet_steps=d.get("floquet_steps"),
-        condition=d["pivot_ratio"],
+        condition=d["pivot_ratio"], closure=d["closure"],
+        separation_error=d["separation_error"],
         info={"floquet_error": d["floquet_error"], "last_omega": d["last_omega"]},
     )

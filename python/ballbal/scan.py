@@ -49,6 +49,7 @@ _SCHEMA: dict[str, Any] = {
     "type": pl.Utf8, "solution": pl.Int64, "status": pl.Utf8, "omega": pl.Float64,
     "stability": pl.Utf8, "max_modulus": pl.Float64, "trivial_error": pl.Float64,
     "multipliers": MULTIPLIER, "residual": pl.Float64, "tail": pl.Float64,
+    "closure": pl.Float64, "separation_error": pl.Float64,
     "pivot_ratio": pl.Float64, "iterations": pl.Int64, "floquet_steps": pl.Int64,
     "floquet_error": pl.Utf8, "N": pl.Int64, "attempts": pl.Int64, "seconds": pl.Float64,
     "origin": pl.Utf8, "pb_exists": pl.Boolean, "pb_stable": pl.Boolean,

@@ -16,7 +16,9 @@ use crate::ode::{Dopri5, Options};
 pub enum Stability {
     Stable,
     Unstable,
-    /// The largest non-trivial modulus is within the accuracy margin of 1.
+    /// The largest non-trivial modulus is within the accuracy margin of 1, or the
+    /// multipliers are not accurate enough to judge (trivial multiplier, or the product of
+    /// merged balls' separation multipliers, off by more than `max_trivial`).
     Undetermined,
 }
 
@@ -41,7 +43,24 @@ pub struct FloquetOptions {
     /// a rotating branch ends) would otherwise run for minutes; past it the analysis
     /// fails with a message and the verdict is undetermined.
     pub max_steps: usize,
+    /// Largest error of the trivial multiplier (and of the merged balls' separation
+    /// product, see [`Floquet::separation_error`]) for which a verdict is given at all:
+    /// beyond it the multipliers are not known well enough to say anything, and the
+    /// verdict is undetermined whatever the moduli.
+    pub max_trivial: f64,
 }
+
+/// Default of [`FloquetOptions::max_trivial`]. A genuine orbit's trivial multiplier is
+/// off by the harmonic balance's truncation error plus the RK45 error. Measured on the
+/// thesis maps at N = 3 with the scan's tolerances: below 3e-2 except at the slowest R-R
+/// orbits (Omega 1.0): 0.057 and 0.13 at zeta_b 0.1, eta 0.7 and 0.6; 0.07 and 0.18 at
+/// zeta_b 0.05, eta 0.8 and 0.7; up to 0.56 at zeta 0.02. N = 27 confirms the verdicts
+/// (stable) and the largest moduli to 1e-5 at the first ones, but below 0.1 those are
+/// still verdicts worth giving (the margin already demands the largest modulus further
+/// from 1 than the trivial error). The series of the reproduction that are no
+/// orbits give 0.11 to 1 with every other multiplier near 0, which judged against a
+/// margin of that size read "stable".
+pub const MAX_TRIVIAL: f64 = 0.1;
 
 impl Default for FloquetOptions {
     fn default() -> Self {
@@ -50,7 +69,28 @@ impl Default for FloquetOptions {
             atol: 1e-10,
             margin: 1e-6,
             max_steps: 200_000,
+            max_trivial: MAX_TRIVIAL,
         }
+    }
+}
+
+impl FloquetOptions {
+    /// Refuses tolerances and margins outside their meaningful ranges (an `rtol` of 1 or
+    /// more is no accuracy at all; a margin of 1 or more can never give a verdict).
+    pub fn validate(&self) -> Result<()> {
+        use crate::error::check_range;
+        check_range("rtol", self.rtol, 0.0, true, 1.0, true)?;
+        check_range("atol", self.atol, 0.0, false, 1.0, true)?;
+        check_range("margin", self.margin, 0.0, false, 1.0, true)?;
+        check_range("max_trivial", self.max_trivial, 0.0, true, 1.0, false)?;
+        if self.max_steps == 0 || self.max_steps > 100_000_000 {
+            return Err(crate::Error::param_range(
+                "max_steps",
+                format!("must be in [1, 100000000], got {}", self.max_steps),
+                "[1, 100000000]",
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -62,6 +102,11 @@ pub struct Floquet {
     pub trivial: usize,
     /// `|lambda_trivial - 1|`.
     pub trivial_error: f64,
+    /// Merged balls only (two identical balls on the same motion): the error of the
+    /// product of the two ball-separation multipliers against its exact value
+    /// `exp(-integral of the separation mode's damping)` (`exp(-2 zeta_b T)` for the planar
+    /// balancer), relative to the larger of 1 and the pair's largest modulus.
+    pub separation_error: Option<f64>,
     /// Largest modulus among the non-trivial multipliers.
     pub max_modulus: f64,
     pub stability: Stability,
@@ -80,8 +125,10 @@ pub struct Judgement {
 
 /// Finds the trivial multiplier (closest to 1) and judges the others: stable if all lie
 /// inside the unit circle by more than `max(margin, trivial error)`, unstable if one lies
-/// outside by more than that, undetermined otherwise.
-pub fn judge(ev: &[(f64, f64)], margin: f64) -> Judgement {
+/// outside by more than that, undetermined otherwise, and undetermined whenever the
+/// trivial multiplier is further than `max_trivial` from 1 (the multipliers are then not
+/// accurate enough for any verdict; e.g. all of them near 0 for a series that is no orbit).
+pub fn judge(ev: &[(f64, f64)], margin: f64, max_trivial: f64) -> Judgement {
     let (trivial, trivial_error) = ev
         .iter()
         .enumerate()
@@ -95,7 +142,9 @@ pub fn judge(ev: &[(f64, f64)], margin: f64) -> Judgement {
         .map(|(_, z)| z.0.hypot(z.1))
         .fold(0.0, f64::max);
     let margin = margin.max(trivial_error);
-    let stability = if max_modulus < 1.0 - margin {
+    let stability = if !(trivial_error <= max_trivial) || !max_modulus.is_finite() {
+        Stability::Undetermined
+    } else if max_modulus < 1.0 - margin {
         Stability::Stable
     } else if max_modulus > 1.0 + margin {
         Stability::Unstable
@@ -178,16 +227,121 @@ pub fn floquet<D: Dynamics + ?Sized>(
         crate::Error::Eigen("eigenvalues of the monodromy matrix did not converge".into())
     })?;
     ev.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
-    let v = judge(&ev, opts.margin);
+    let v = judge(&ev, opts.margin, opts.max_trivial);
+    let separation_error = crate::hb::timed_certificate(|| separation_error(model, sol, &phi));
+    let stability = match separation_error {
+        Some(e) if !(e <= opts.max_trivial) => Stability::Undetermined,
+        _ => v.stability,
+    };
     Ok(Floquet {
         multipliers: ev,
         trivial: v.trivial,
         trivial_error: v.trivial_error,
+        separation_error,
         max_modulus: v.max_modulus,
-        stability: v.stability,
+        stability,
         steps,
         rhs_evals: evals,
     })
+}
+
+/// The first pair of balls `(i, j)` whose series are the same motion (coefficients equal
+/// to 1e-9 relative, same winding): merged balls.
+pub fn merged_pair(sol: &HbSolution, first_ball: usize) -> Option<(usize, usize)> {
+    let d = sol.ndof();
+    let scale = sol.coeffs.iter().fold(1.0f64, |m, c| m.max(c.abs()));
+    (first_ball..d)
+        .flat_map(|i| (i + 1..d).map(move |j| (i, j)))
+        .find(|&(i, j)| {
+            sol.winding[i] == sol.winding[j]
+                && sol
+                    .coord(i)
+                    .iter()
+                    .zip(sol.coord(j))
+                    .all(|(a, b)| (a - b).abs() <= 1e-9 * scale)
+        })
+}
+
+/// Merged balls' separation check on a monodromy matrix `phi` (row-major `2d x 2d`).
+///
+/// Separating merged identical balls (`db_i = -db_j = e`) leaves the rotor's equations
+/// unchanged to first order (the two balls' terms cancel), so the separation mode
+/// `(e, e')` is an invariant subspace of the linearisation, with a 2 x 2 block `B(t)`;
+/// by Liouville's formula the product of its two multipliers is `exp(int_0^T tr B)`,
+/// `tr B = -(M^-1 C)` in that direction (`-2 zeta_b` for the planar balancer, whose ball
+/// rows read `delta b'' + 2 zeta_b delta b' + ...`). The pair is identified as the
+/// restriction of `phi` to that subspace, which RK45 keeps invariant to rounding when the
+/// balls' equations are the same; if it does not (balls that only look merged, or
+/// different ball parameters) there is no check (`None`).
+pub fn separation_error<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    phi: &[f64],
+) -> Option<f64> {
+    let d = model.ndof();
+    let n2 = 2 * d;
+    let (i, j) = merged_pair(sol, model.first_ball())?;
+    let r = std::f64::consts::FRAC_1_SQRT_2;
+    // Basis of the separation subspace: position and velocity parts.
+    let mut basis = [vec![0.0; n2], vec![0.0; n2]];
+    basis[0][i] = r;
+    basis[0][j] = -r;
+    basis[1][d + i] = r;
+    basis[1][d + j] = -r;
+    let norm = phi.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut b = [[0.0; 2]; 2];
+    for (c, e) in basis.iter().enumerate() {
+        // phi e, its projection on the subspace, and what leaks out of it.
+        let pe: Vec<f64> = (0..n2)
+            .map(|row| (0..n2).map(|k| phi[row * n2 + k] * e[k]).sum())
+            .collect();
+        for (rr, f) in basis.iter().enumerate() {
+            b[rr][c] = pe.iter().zip(f).map(|(x, y)| x * y).sum();
+        }
+        let leak = (0..n2)
+            .map(|row| (pe[row] - b[0][c] * basis[0][row] - b[1][c] * basis[1][row]).abs())
+            .fold(0.0f64, f64::max);
+        if !(leak <= 1e-9 * norm.max(1.0)) {
+            return None;
+        }
+    }
+    let det = b[0][0] * b[1][1] - b[0][1] * b[1][0];
+    // Exact value: exp(-int (M^-1 C)_ee dt), by the trapezoidal rule (spectrally accurate
+    // for a periodic integrand) at the harmonic-balance sample count.
+    let s = crate::hb::default_samples(sol.n_harm).max(64);
+    let om = sol.omega;
+    let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
+    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    let mut integral = 0.0;
+    for p in 0..s {
+        let tau = 2.0 * std::f64::consts::PI * p as f64 / s as f64;
+        sol.eval(tau, &mut q, &mut qt, &mut qtt);
+        for jj in 0..d {
+            v[jj] = om * qt[jj];
+            a[jj] = om * om * qtt[jj];
+        }
+        let t = tau / om;
+        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        // C e, then M^-1 (C e), then its component along e.
+        let mut ce: Vec<f64> = (0..d)
+            .map(|row| r * (c[row * d + i] - c[row * d + j]))
+            .collect();
+        model.solve_mass(t, &q, &mut ce);
+        integral += r * (ce[i] - ce[j]);
+    }
+    let exact = (-integral * sol.period() / s as f64).exp();
+    // Eigenvalues of B: the two separation multipliers, for the scale of the error.
+    let (tr, disc) = (
+        b[0][0] + b[1][1],
+        (b[0][0] - b[1][1]).powi(2) + 4.0 * b[0][1] * b[1][0],
+    );
+    let big = if disc >= 0.0 {
+        (tr.abs() + disc.sqrt()) / 2.0
+    } else {
+        det.abs().sqrt()
+    };
+    Some((det - exact).abs() / big.max(1.0))
 }
 
 /// Floquet multipliers by Hill's method: an estimate independent of the RK45 monodromy.
@@ -249,9 +403,9 @@ pub fn hill_multipliers<D: Dynamics + ?Sized>(
         }
         z
     });
-    let eig = hm.eigen().map_err(|_| {
-        crate::Error::Eigen("eigen-decomposition of the Hill matrix failed".into())
-    })?;
+    let eig = hm
+        .eigen()
+        .map_err(|_| crate::Error::Eigen("eigen-decomposition of the Hill matrix failed".into()))?;
     let (sv, u) = (eig.S(), eig.U());
     let blocks = 2 * n_hill + 1;
     // Each eigenvalue with the centroid of its eigenvector over the harmonic index: the

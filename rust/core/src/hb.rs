@@ -115,6 +115,13 @@ pub enum Status {
     MaxIterations,
     /// No starting guess could be built (e.g. the simulation found no motion of this type).
     NoGuess,
+    /// Newton converged, but the series is not an orbit: its ODE defect between the
+    /// collocation times integrates to more than the allowed closure error
+    /// ([`defect_closure`]).
+    NotClosed,
+    /// Newton converged, but the highest harmonic is too large relative to the motion
+    /// ([`HbSolution::tail_ratio`]): `N` does not resolve the orbit.
+    Truncated,
 }
 
 impl Status {
@@ -125,6 +132,8 @@ impl Status {
             Status::Singular => "singular",
             Status::MaxIterations => "max_iterations",
             Status::NoGuess => "no_guess",
+            Status::NotClosed => "not_closed",
+            Status::Truncated => "truncated",
         }
     }
 }
@@ -625,6 +634,70 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         }
     }
     out
+}
+
+/// Nanoseconds spent in certificate checks by this process (all threads): what
+/// `benchmarks/bench_certificates.py` sets against a scan's time.
+static CERTIFICATE_NANOS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Runs a certificate check, adding its time to [`certificate_seconds`].
+pub(crate) fn timed_certificate<T>(f: impl FnOnce() -> T) -> T {
+    let t = std::time::Instant::now();
+    let out = f();
+    CERTIFICATE_NANOS.fetch_add(
+        t.elapsed().as_nanos() as u64,
+        std::sync::atomic::Ordering::Relaxed,
+    );
+    out
+}
+
+/// Total time this process has spent in certificate checks, in seconds.
+pub fn certificate_seconds() -> f64 {
+    CERTIFICATE_NANOS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9
+}
+
+/// Orbit-closure certificate of a series without integrating the flow: the ODE defect
+/// `M^-1 F(t, q, q', q'')` of the series (an acceleration error) at `points` phases
+/// placed between the collocation times, integrated over one period,
+/// `T / points * sum_k max_j |defect_j(t_k)|`.
+///
+/// Harmonic balance zeroes only the first `N` harmonics of the residual at the sampled
+/// times; what the series leaves in the higher harmonics and between the samples is the
+/// defect. Integrated, it bounds the velocity error a simulation from the series'
+/// state accumulates over a period *before* the linearised flow amplifies it, so the
+/// certificate does not grow with the multipliers of an unstable orbit the way a
+/// simulated closure does (which would refuse genuine unstable orbits at small `N`),
+/// while a series that is no orbit at all (aliased solutions near a branch's
+/// infinite-period end) has an O(1) defect over a long period.
+pub fn defect_closure<D: Dynamics + ?Sized>(model: &D, sol: &HbSolution, points: usize) -> f64 {
+    let d = sol.ndof();
+    let om = sol.omega;
+    if !(om > 0.0 && om.is_finite()) || points == 0 {
+        return f64::INFINITY;
+    }
+    let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    let (mut v, mut a, mut f) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    let mut sum = 0.0;
+    for k in 0..points {
+        // Half a step off a uniform grid of `points`: with `points` a multiple of the
+        // collocation samples, none of these phases is a collocation time.
+        let tau = 2.0 * PI * (k as f64 + 0.5) / points as f64;
+        sol.eval(tau, &mut q, &mut qt, &mut qtt);
+        for j in 0..d {
+            v[j] = om * qt[j];
+            a[j] = om * om * qtt[j];
+        }
+        let t = tau / om;
+        model.residual(t, &q, &v, &a, &mut f);
+        model.solve_mass(t, &q, &mut f);
+        sum += max_abs(&f);
+    }
+    let c = sum * sol.period() / points as f64;
+    if c.is_nan() {
+        f64::INFINITY
+    } else {
+        c
+    }
 }
 
 /// Fourier coefficients of `d` sampled coordinates over one period: `samples[i*d + j]`

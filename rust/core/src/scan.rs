@@ -449,11 +449,14 @@ fn scan_chunk<D: Family>(
                 .collect();
             let k = spec.patterns.iter().position(|r| *r == rot)?;
             let sol = solve(model, &g, &spec.opts.hb);
-            if !accept(&sol, &g, spec.max_tail) {
+            if !accept(model, &sol, &g, spec) {
                 return None;
             }
             let key = orbit_key(&sol);
             let res = finish(model, sol, &spec.opts);
+            if res.sol.status != Status::Converged {
+                return None;
+            }
             Some((
                 p,
                 Found {
@@ -520,7 +523,7 @@ fn scan_chunk<D: Family>(
                         for g in secant.iter().chain(std::iter::once(&src.res.sol)) {
                             tries[k] += 1;
                             let r = solve(&params[q], g, &spec.opts.hb);
-                            if accept(&r, &src.res.sol, spec.max_tail) {
+                            if accept(&params[q], &r, &src.res.sol, spec) {
                                 sol = Some(r);
                                 break;
                             }
@@ -536,6 +539,12 @@ fn scan_chunk<D: Family>(
                             continue;
                         }
                         let res = finish(&params[q], sol, &spec.opts);
+                        // Refined with N = "auto" and certified: a series that fails
+                        // is neither reported nor continued, like a failed solve.
+                        if res.sol.status != Status::Converged {
+                            secs[k] += t.elapsed().as_secs_f64();
+                            continue;
+                        }
                         new.push(Found {
                             pattern: k,
                             res,
@@ -603,9 +612,27 @@ fn scan_chunk<D: Family>(
     Ok(rows)
 }
 
-/// A converged, resolved solution of the same rotation pattern as its guess.
-fn accept(s: &HbSolution, guess: &HbSolution, max_tail: f64) -> bool {
-    s.status == Status::Converged && s.winding == guess.winding && s.tail_ratio() <= max_tail
+/// A converged, resolved solution of the same rotation pattern as its guess, whose
+/// series passes the orbit-closure certificate (checked here already, before the
+/// duplicate test and the Floquet analysis, so that a refused series can fall back to
+/// the next guess; with N = "auto" only after refinement, in `finish`).
+fn accept<D: Family>(
+    model: &D,
+    s: &HbSolution,
+    guess: &HbSolution,
+    spec: &ScanSpec<'_, D>,
+) -> bool {
+    if !(s.status == Status::Converged
+        && s.winding == guess.winding
+        && s.tail_ratio() <= spec.max_tail)
+    {
+        return false;
+    }
+    spec.opts.auto.is_some() || {
+        let mut c = s.clone();
+        crate::periodic::certify(model, &mut c, &spec.opts);
+        c.status == Status::Converged
+    }
 }
 
 /// Whether an orbit of type `pattern` with `key` is new among `have`, and its type
@@ -648,6 +675,7 @@ pub fn scan_floquet_default() -> FloquetOptions {
         atol: 1e-9,
         margin: 1e-6,
         max_steps: 20_000,
+        ..FloquetOptions::default()
     }
 }
 

@@ -3,12 +3,12 @@
 //! raised as `RuntimeError` so that it never unwinds into Python.
 
 use ballbal_core::equilibria::{equilibria as core_equilibria, Equilibrium};
-use ballbal_core::floquet::FloquetOptions;
+use ballbal_core::floquet::{FloquetOptions, MAX_TRIVIAL};
 use ballbal_core::hb::{HbOptions, HbSolution, Status};
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{
     closure_error, parse_pattern, pattern_string, periodic as core_periodic, require_autonomous,
-    PeriodicOptions,
+    PeriodicOptions, MAX_CLOSURE, MAX_TAIL,
 };
 use ballbal_core::simulate::simulate as core_simulate;
 use ballbal_core::{Dynamics, Error, Planar, Scene, SpringLayout};
@@ -322,9 +322,19 @@ fn solution_dict<'py>(
         )?;
         d.set_item("hill_stability", st.as_str())?;
     }
+    d.set_item("closure", r.closure)?;
+    d.set_item(
+        "separation_error",
+        r.floquet.as_ref().and_then(|f| f.separation_error),
+    )?;
     let s = r.sol;
     d.set_item("tail", s.tail_ratio())?;
-    let ok = s.status == Status::Converged;
+    // A series that converged but failed a certificate keeps its omega for inspection;
+    // its status says why it is not a result.
+    let ok = matches!(
+        s.status,
+        Status::Converged | Status::NotClosed | Status::Truncated
+    );
     d.set_item("status", s.status.as_str())?;
     d.set_item("type", pattern_string(&s.winding, n_balls))?;
     d.set_item("omega", if ok { Some(s.omega) } else { None })?;
@@ -362,7 +372,8 @@ fn solution_dict<'py>(
     Ok(d)
 }
 
-/// Solver options shared by `periodic` and `scan`, validated before any work starts.
+/// Solver options shared by `periodic` and `scan`, validated (in the core) before any
+/// work starts; errors name the option.
 #[allow(clippy::too_many_arguments)]
 fn periodic_options(
     n_harm: usize,
@@ -382,71 +393,49 @@ fn periodic_options(
     auto: Option<f64>,
     n_max: usize,
     hill: bool,
+    max_closure: f64,
+    max_trivial: f64,
+    max_tail: f64,
 ) -> PyResult<PeriodicOptions> {
-    let hb = HbOptions {
-        n_harm,
-        samples,
-        tol,
-        step_tol,
-        max_iter,
+    let fo = FloquetOptions {
+        rtol: f_rtol,
+        atol: f_atol,
+        margin,
+        max_steps,
+        max_trivial,
     };
-    hb.validate().map_err(to_py)?;
-    Options::new(f_rtol, f_atol).validate(1).map_err(to_py)?;
-    if max_steps == 0 {
-        return Err(PyValueError::new_err("max_steps: must be >= 1"));
-    }
-    Options::new(guess_rtol, guess_atol)
-        .validate(1)
-        .map_err(|_| {
-            PyValueError::new_err(format!(
-                "guess_rtol: must be a finite number > 0, got {guess_rtol}"
-            ))
-        })?;
-    if !(settle > 0.0 && window > 0.0 && settle.is_finite() && window.is_finite()) {
-        return Err(PyValueError::new_err(
-            "settle, window: must be finite and > 0",
-        ));
-    }
-    let auto = match auto {
-        None => None,
-        Some(t) if t > 0.0 && t < 1.0 => {
-            if n_max < n_harm || n_max > 256 {
-                return Err(PyValueError::new_err(format!(
-                    "N_max: must be in [N, 256] = [{n_harm}, 256], got {n_max}"
-                )));
-            }
-            Some(ballbal_core::periodic::AutoHarmonics { target: t, n_max })
-        }
-        Some(t) => {
-            return Err(PyValueError::new_err(format!(
-                "target: must be a number in (0, 1), got {t}"
-            )))
-        }
-    };
-    Ok(PeriodicOptions {
-        auto,
+    // Checked even with the Floquet analysis off: a bad value is a mistake either way.
+    fo.validate().map_err(to_py)?;
+    let opts = PeriodicOptions {
+        auto: auto.map(|target| ballbal_core::periodic::AutoHarmonics { target, n_max }),
         hill,
-        hb,
-        floquet: floquet.then_some(FloquetOptions {
-            rtol: f_rtol,
-            atol: f_atol,
-            margin,
-            max_steps,
-        }),
+        hb: HbOptions {
+            n_harm,
+            samples,
+            tol,
+            step_tol,
+            max_iter,
+        },
+        floquet: floquet.then_some(fo),
         guess: ballbal_core::periodic::GuessOptions {
             settle,
             window,
             rtol: guess_rtol,
             atol: guess_atol,
         },
-    })
+        max_closure,
+        max_tail,
+    };
+    opts.validate().map_err(to_py)?;
+    Ok(opts)
 }
 
 /// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers.
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, pattern, n_harm, samples, tol, step_tol, max_iter,
                     guess_omega, guess_coeffs, floquet, f_rtol, f_atol, margin, max_steps, settle,
-                    window, guess_rtol, auto, n_max, hill, effects=None))]
+                    window, guess_rtol, auto, n_max, hill, max_closure=MAX_CLOSURE,
+                    max_trivial=MAX_TRIVIAL, max_tail=MAX_TAIL, effects=None))]
 #[allow(clippy::too_many_arguments)]
 fn periodic<'py>(
     py: Python<'py>,
@@ -475,6 +464,9 @@ fn periodic<'py>(
     auto: Option<f64>,
     n_max: usize,
     hill: bool,
+    max_closure: f64,
+    max_trivial: f64,
+    max_tail: f64,
     effects: Effects,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
@@ -498,6 +490,9 @@ fn periodic<'py>(
         auto,
         n_max,
         hill,
+        max_closure,
+        max_trivial,
+        max_tail,
     )?;
     let (d, o) = match &sc {
         Some(s) => (s.ndof(), s.first_ball()),
@@ -653,6 +648,10 @@ fn scan(
         auto,
         n_max,
         hill,
+        // Scans certify with the core's defaults; `max_tail` is the scan's own.
+        MAX_CLOSURE,
+        MAX_TRIVIAL,
+        max_tail,
     )?;
     let cols = Columns {
         names: &names,
@@ -800,13 +799,7 @@ fn scan_columns<'py>(
     d.set_item(
         "status",
         sols.iter()
-            .map(|s| {
-                if s.is_some() {
-                    "converged"
-                } else {
-                    "not_found"
-                }
-            })
+            .map(|s| s.map_or("not_found", |x| x.sol.status.as_str()))
             .collect::<Vec<_>>(),
     )?;
     d.set_item("omega", col(&sols, |x| Some(x.sol.omega)))?;
@@ -839,6 +832,13 @@ fn scan_columns<'py>(
     d.set_item("mult_im", part(|z| z.1))?;
     d.set_item("residual", col(&sols, |x| Some(x.sol.residual)))?;
     d.set_item("tail", col(&sols, |x| Some(x.sol.tail_ratio())))?;
+    d.set_item("closure", col(&sols, |x| x.closure))?;
+    d.set_item(
+        "separation_error",
+        col(&sols, |x| {
+            x.floquet.as_ref().and_then(|fl| fl.separation_error)
+        }),
+    )?;
     d.set_item("pivot_ratio", col(&sols, |x| Some(x.sol.pivot_ratio)))?;
     d.set_item("iterations", col(&sols, |x| Some(x.sol.iterations)))?;
     d.set_item(
@@ -878,6 +878,13 @@ fn scan_columns<'py>(
     Ok(d)
 }
 
+/// Seconds this process has spent in certificate checks (all threads; a benchmark's
+/// measure of what they cost).
+#[pyfunction]
+fn certificate_seconds() -> f64 {
+    ballbal_core::hb::certificate_seconds()
+}
+
 /// Default block (and chunk) length, in values of the last parameter, for grid lengths
 /// `lens`: about 1024 points.
 #[pyfunction]
@@ -897,6 +904,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(orbit_closure, m)?)?;
     m.add_function(wrap_pyfunction!(scan, m)?)?;
     m.add_function(wrap_pyfunction!(default_chunk, m)?)?;
+    m.add_function(wrap_pyfunction!(certificate_seconds, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
