@@ -80,8 +80,8 @@ def test_default_chunk_does_not_cut_continuation():
     b = ballbal.Balancer(zeta_b=0.1)
     grid = dict(Omega=(1.0, 2.0, 0.05), eta=(0.4, 1.5, 0.1))
     default = ballbal.scan(b, threads=2, **grid)
-    one = ballbal.scan(b, chunk=1, threads=2, **grid)
-    assert same(one, default.drop("seconds"))
+    for chunk in (1, 3):
+        assert same(ballbal.scan(b, chunk=chunk, threads=1, **grid), default.drop("seconds"))
     lines = ballbal.scan(b, block=1, threads=2, **grid)  # the old chunk=1
     found = default.filter(pl.col("status") == "converged").height
     assert lines.filter(pl.col("status") == "converged").height < found
@@ -317,3 +317,16 @@ def test_lazy_table_over_the_files(tmp_path, reference):
     lf2 = ballbal.read_scan(out, lazy=True)
     assert isinstance(lf2, pl.LazyFrame) and same(lf2.collect(), reference)
     assert os.path.exists(out / ".lock")
+
+
+def test_command_line_scan_into_another_scans_directory_is_a_clear_error(tmp_path):
+    out = tmp_path / "cli"
+    exe = [sys.executable, "-m", "ballbal.cli", "scan", "--eta", "1:1:1", "-o", str(out),
+           "--no-progress"]
+    r = subprocess.run(exe + ["--Omega", "1.2:1.2:0.1"], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0, r.stderr
+    r = subprocess.run(exe + ["--Omega", "1.3:1.3:0.1"], capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert r.stderr.startswith("ballbal: error: out:") and "differs in grid" in r.stderr

@@ -83,7 +83,7 @@ def test_scene_axes_and_time_dependent_scenes_give_clear_errors(tmp_path):
         ballbal.scan(SPRINGS.replace(ramp=ballbal.Ramp(to=2.0)), Omega=[1.2])
     # A stored scan remembers its scene: another stiffness does not resume it.
     ballbal.scan(SPRINGS, Omega=[1.2], out=tmp_path / "s")
-    with pytest.raises(ValueError, match="differs in scene"):
+    with pytest.raises(ballbal.exceptions.ScanStoreError, match="differs in scene"):
         ballbal.scan(SPRINGS.replace(springs=2e-5), Omega=[1.2], out=tmp_path / "s")
 
 

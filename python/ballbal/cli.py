@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 
 from .analysis import equilibria, periodic
-from .exceptions import ScanInterrupted
+from .exceptions import ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .scan import SCANNABLE, read_scan, scan, scan_meta
 from .scene import Scene, load_scene
@@ -123,6 +123,9 @@ def _scan(a: argparse.Namespace) -> int:
             warnings.simplefilter("always", ScanInterrupted)
             df = scan(b, grid=grid, patterns=a.types, N=a.N, threads=a.threads,
                       chunk=a.chunk, out=a.out, progress=not a.no_progress)
+    except ScanStoreError as e:  # another scan's directory, or one in use
+        print(f"ballbal: error: {e}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         # Outside the chunks' work (validation, reading back): nothing new to keep.
         print(f"\nballbal scan: interrupted; run the same command to resume from {a.out}",

@@ -20,6 +20,7 @@ import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+from types import FrameType
 from typing import IO, Any, Literal, overload
 
 import numpy as np
@@ -179,6 +180,17 @@ def _chunk_index(f: Path) -> int | None:
     return int(m.group(1)) if m else None
 
 
+def _caller() -> int:
+    """The ``stacklevel`` of the first frame outside ballbal, seen from the function
+    that calls this one: warnings then point at the user's line."""
+    here = str(Path(__file__).parent)
+    f: FrameType | None = sys._getframe(1)
+    level = 1
+    while f is not None and f.f_code.co_filename.startswith(here):
+        f, level = f.f_back, level + 1
+    return level
+
+
 def _sync_dir(d: Path) -> None:
     # The rename itself must reach the disk, or a crash can bring back the old name.
     try:
@@ -318,7 +330,7 @@ class _Store:
         dest = f.with_name(f.name + ".damaged")
         os.replace(f, dest)
         warnings.warn(ScanStoreWarning(f"out: {f} is damaged ({why}); set aside as "
-                                       f"{dest.name} and {then}"), stacklevel=4)
+                                       f"{dest.name} and {then}"), stacklevel=_caller())
 
     def _open(self, job: _Job, chunk_given: bool) -> _Job:
         # As it reads back from JSON (tuples become lists), to compare with the file.
@@ -640,7 +652,12 @@ def read_scan(  # noqa: E302 - overloads above
     when the frame is collected).
     """
     d = Path(path)
-    files = sorted(d.glob("chunk-*.parquet"))
+    # In chunk order, also past chunk 99999 (where names stop sorting as numbers).
+    def order(f: Path) -> tuple[int, str]:
+        c = _chunk_index(f)
+        return (-1 if c is None else c, f.name)
+
+    files = sorted(d.glob("chunk-*.parquet"), key=order)
     if not files:
         raise ParameterError("path", f"no scan chunks (chunk-*.parquet) in {d}", value=path)
     meta = _read_meta(d / "meta.json")

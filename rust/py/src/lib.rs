@@ -885,7 +885,8 @@ fn certificate_seconds() -> f64 {
     ballbal_core::hb::certificate_seconds()
 }
 
-/// Default chunk length (values of the last parameter per chunk) for grid lengths `lens`.
+/// Default block (and chunk) length, in values of the last parameter, for grid lengths
+/// `lens`: about 1024 points.
 #[pyfunction]
 fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
     if lens.is_empty() || lens.contains(&0) {
