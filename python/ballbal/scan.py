@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from . import _native
+from . import _check, _native
 from .analysis import harmonics
 from .exceptions import ScanInterrupted
 from .model import Balancer
@@ -71,7 +71,7 @@ def grid_values(name: str, spec: GridSpec) -> np.ndarray:
             raise ValueError(
                 f"{name}: (start, stop, step) needs step > 0 and stop >= start, got {spec}"
             )
-        count = int(math.floor((stop - start) / step + 1e-9)) + 1
+        count = _check.axis_count(name, (stop - start) / step)
         vals = np.round(start + step * np.arange(count), 12)
     else:
         try:
@@ -287,7 +287,16 @@ def scan(
     ``progress``: ``True`` for a progress bar (tqdm if installed), or a callable
     ``f(done_points, total_points)``. Ctrl-C stops the scan and returns the finished
     chunks with a :class:`ScanInterrupted` warning.
+
+    Limits (checked before any work): at most 1e6 values per axis, 5e6 grid points for a
+    table held in memory and 1e9 for one streamed to ``out=``.
     """
+    patterns = _check.scan_arguments(
+        balancer, patterns=patterns, N_max=N_max, samples=samples, max_iter=max_iter,
+        max_steps=max_steps, seeds=seeds, starts=starts, chunk=chunk, threads=threads, out=out,
+        hill=hill, floquet=floquet, reals=dict(
+            target=target, tol=tol, step_tol=step_tol, rtol=rtol, atol=atol, margin=margin,
+            settle=settle, window=window, guess_rtol=guess_rtol, max_tail=max_tail))
     axes_all: dict[str, GridSpec] = dict(grid or {})
     for k, v in axes.items():
         if k in axes_all:
@@ -301,6 +310,7 @@ def scan(
             and not set(names) & set(SCENE_SCANNABLE)):
         model = model.balancer  # the same table, and a scan directory it can resume
     values = tuple(tuple(grid_values(n, s).tolist()) for n, s in axes_all.items())
+    _check.grid_points([len(v) for v in values], names, streamed=out is not None)
     if isinstance(patterns, str):
         patterns = (patterns,)
     if not patterns:
