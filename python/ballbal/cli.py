@@ -31,11 +31,18 @@ class _Parser(argparse.ArgumentParser):
         m = re.match(r"argument (?:-\w/)?-*([\w-]+)(?:/\S+)?: (.*)", message, re.S)
         if m:
             message = f"{m.group(1).replace('-', '_')}: {m.group(2)}"
+        elif m := re.match(r"the following arguments are required: (.*)", message):
+            first = m.group(1).split(",")[0].split("/")[-1].lstrip("-")
+            message = f"{first}: required (see '{self.prog} --help')"
+        elif m := re.match(r"(unrecognized arguments|ambiguous option): (\S*)(.*)", message,
+                           re.S):
+            flag = m.group(2).split("=")[0]
+            # An option is named as typed; a stray value belongs to the command line.
+            name = flag.lstrip("-").replace("-", "_") if flag.startswith("-") else ""
+            name = name or "cmd"
+            message = f"{name}: {m.group(1)}: {m.group(2)}{m.group(3)}"
         else:
-            m = re.match(r"the following arguments are required: (.*)", message)
-            if m:
-                first = m.group(1).split(",")[0].split("/")[-1].lstrip("-")
-                message = f"{first}: required (see '{self.prog} --help')"
+            message = f"cmd: {message}"
         _fail(message)
 
 

@@ -23,7 +23,7 @@ import polars as pl
 
 from . import _check, _native
 from .analysis import harmonics
-from .exceptions import ScanInterrupted
+from .exceptions import ParameterError, ParameterTypeError, ScanInterrupted
 from .model import Balancer
 from .scene import Scene
 
@@ -51,37 +51,39 @@ def grid_values(name: str, spec: GridSpec) -> np.ndarray:
     ``"start:stop:step"`` (both ends included)."""
     if not (name in SCANNABLE or name in SCENE_SCANNABLE
             or (name.startswith(_INDEXED) and name.endswith("]"))):
-        raise ValueError(
-            f"{name}: not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
+        raise ParameterError(
+            name, f"not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
             f"eta[i], zeta_b[i]; for scenes also {', '.join(SCENE_SCANNABLE)})"
         )
     if isinstance(spec, str):
         try:
             parts = [float(p) for p in spec.split(":")]
         except ValueError as e:
-            raise ValueError(f"{name}: give start:stop:step, got {spec!r}") from e
+            raise ParameterError(name, f"give start:stop:step, got {spec!r}") from e
         if len(parts) != 3:
-            raise ValueError(f"{name}: give start:stop:step, got {spec!r}")
+            raise ParameterError(name, f"give start:stop:step, got {spec!r}")
         spec = (parts[0], parts[1], parts[2])
     if isinstance(spec, tuple) and len(spec) == 3 and not isinstance(spec, np.ndarray):
-        start, stop, step = (float(v) for v in spec)
+        start, stop, step = (_check.real(name, v) for v in spec)
         if not all(math.isfinite(v) for v in (start, stop, step)):
-            raise ValueError(f"{name}: (start, stop, step) must be finite, got {spec}")
+            raise ParameterError(name, f"(start, stop, step) must be finite, got {spec}")
         if step <= 0 or stop < start:
-            raise ValueError(
-                f"{name}: (start, stop, step) needs step > 0 and stop >= start, got {spec}"
+            raise ParameterError(
+                name, f"(start, stop, step) needs step > 0 and stop >= start, got {spec}"
             )
         count = _check.axis_count(name, (stop - start) / step)
         vals = np.round(start + step * np.arange(count), 12)
     else:
+        if spec is None or isinstance(spec, (bool, np.bool_)):
+            raise ParameterTypeError(name, f"grid values must be numbers, got {spec!r}")
         try:
             vals = np.asarray(spec, dtype=float).ravel()
         except (TypeError, ValueError) as e:
-            raise ValueError(f"{name}: grid values must be numbers, got {spec!r}") from e
+            raise ParameterError(name, f"grid values must be numbers, got {spec!r}") from e
     if vals.size == 0:
-        raise ValueError(f"{name}: the grid is empty")
+        raise ParameterError(name, "the grid is empty")
     if not np.all(np.isfinite(vals)):
-        raise ValueError(f"{name}: grid values must be finite (no NaN or inf)")
+        raise ParameterError(name, "grid values must be finite (no NaN or inf)")
     return vals
 
 
@@ -300,10 +302,11 @@ def scan(
     axes_all: dict[str, GridSpec] = dict(grid or {})
     for k, v in axes.items():
         if k in axes_all:
-            raise ValueError(f"{k}: given twice (keyword and grid)")
+            raise ParameterError(k, "given twice (keyword and grid)")
         axes_all[k] = v
     if not axes_all:
-        raise ValueError("grid: give at least one parameter to scan, e.g. Omega=(1, 2, 0.1)")
+        raise ParameterError("grid", "give at least one parameter to scan, e.g. "
+                             "Omega=(1, 2, 0.1)")
     names = tuple(axes_all)
     model: Balancer | Scene = balancer
     if (isinstance(model, Scene) and model.native_effects() is None
@@ -314,14 +317,14 @@ def scan(
     if isinstance(patterns, str):
         patterns = (patterns,)
     if not patterns:
-        raise ValueError("patterns: give at least one solution type, e.g. ['R-R']")
+        raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
     if chunk is None:
         chunk = _native.default_chunk([len(v) for v in values])
     if int(chunk) < 1:
-        raise ValueError(f"chunk: must be >= 1, got {chunk}")
+        raise ParameterError("chunk", f"must be >= 1, got {chunk}")
     local_threads = (os.cpu_count() or 1) if threads is None else int(threads)
     if local_threads < 1:
-        raise ValueError(f"threads: must be >= 1, got {threads}")
+        raise ParameterError("threads", f"must be >= 1, got {threads}")
     n0, auto = harmonics(N, target)
     options = (
         ("N", n0), ("auto", auto), ("N_max", int(N_max)), ("hill", bool(hill)),
@@ -385,10 +388,10 @@ def scan(
 
 def read_scan(path: str | os.PathLike[str]) -> pl.DataFrame:
     """The table of a scan written with ``out=path`` (the finished chunks, in order)."""
-    d = Path(path)
+    d = Path(_check.path("path", path))
     files = sorted(d.glob("chunk-*.parquet"))
     if not files:
-        raise ValueError(f"path: no scan chunks (chunk-*.parquet) in {d}")
+        raise ParameterError("path", f"no scan chunks (chunk-*.parquet) in {d}")
     return pl.concat([pl.read_parquet(f) for f in files], how="vertical")
 
 

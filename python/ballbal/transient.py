@@ -165,7 +165,7 @@ def run_up(
     n = scene.n_balls
     if balls is None:
         balls = list(np.linspace(-1.0, 1.0, n)) if n > 1 else [1.0]
-    balls = _check.reals("balls", balls)
+    balls = [_check.real("balls", x, finite=True) for x in _check.reals("balls", balls)]
     if len(balls) != n:
         raise ParameterError("balls", f"needs {n} angles, got {len(balls)}")
     sc = replace(scene, ramp=Ramp(to=to, start=0.0, duration=duration))
