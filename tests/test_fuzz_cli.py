@@ -12,7 +12,6 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
 from test_fuzz_api import NAMES
 
 FUZZ = settings(max_examples=30, derandomize=True, deadline=None, database=None,

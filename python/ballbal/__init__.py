@@ -11,8 +11,8 @@ from .analysis import (
     simulate,
 )
 from .balance import balance_map, balanced_state, plot_balance_map
-from .model import Balancer, from_seed003, zeta_from_log_decrement
 from .exceptions import ScanInterrupted
+from .model import Balancer, from_seed003, zeta_from_log_decrement
 from .scan import read_scan, scan, scan_meta
 from .scene import Impulse, Ramp, Scene, Tilt, load_scene
 from .transient import (

@@ -73,8 +73,8 @@ def accuracy_cost(
     _check.model("balancer", balancer)
     _check.string("pattern", pattern)
     N = [_check.integer("N", n, 1, 256) for n in _check.sequence("N", N)]
-    samples = [_check.real("samples", m, 0.0, 1 << 16, lo_open=True)
-               for m in _check.sequence("samples", samples)]
+    multiples = [_check.real("samples", m, 0.0, 1 << 16, lo_open=True)
+                 for m in _check.sequence("samples", samples)]
     tol = [_check.real("tol", t) for t in _check.sequence("tol", tol)]
     rtol = [_check.real("rtol", r) for r in _check.sequence("rtol", rtol)]
     base_N = _check.integer("base_N", base_N, 1, 256)
@@ -104,9 +104,9 @@ def accuracy_cost(
     base: dict[str, Any] = dict(N=base_N, samples=None, tol=1e-10, rtol=1e-9, atol=1e-11)
     for n in N:
         settings.append(("N", n, {**base, "N": int(n)}))
-    for m in samples:
-        s = max(int(m * base_N), 2 * base_N + 2)
-        settings.append(("samples", s, {**base, "samples": s}))
+    for m in multiples:
+        per = max(int(m * base_N), 2 * base_N + 2)
+        settings.append(("samples", per, {**base, "samples": per}))
     for t in tol:
         settings.append(("tol", t, {**base, "tol": t, "step_tol": max(t * 100, 1e-8)}))
     for r in rtol:
