@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 import ballbal
+from ballbal.exceptions import ParameterError
 
 
 def _wrap(a):
@@ -139,6 +140,7 @@ def test_lab_conversion_round_trip_and_published_example():
     z = ballbal.zeta_from_log_decrement(d)
     # free decay of a damped oscillator: ln(x_k / x_{k+1}) = 2 pi z / sqrt(1 - z^2)
     assert np.isclose(2 * np.pi * z / np.sqrt(1 - z**2), d)
-    with pytest.raises(ValueError, match="stiffness"):
+    with pytest.raises(ParameterError) as err:
         ballbal.Balancer.from_lab(disk_mass=1, eccentricity=1, ball_masses=[1], track_radius=1,
                                   stiffness=-1, damping=0, track_damping=0, spin=1)
+    assert err.value.parameter == "stiffness"

@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 
 import ballbal
+from ballbal.exceptions import ParameterError
 
 from shooting import monodromy_multipliers, shoot
 
@@ -109,16 +110,22 @@ def test_failure_is_data_not_exception():
 
 def test_bad_periodic_input():
     b = ballbal.Balancer()
-    with pytest.raises(ValueError, match="pattern"):
+    with pytest.raises(ParameterError) as err:
         ballbal.periodic(b, "R-X")
-    with pytest.raises(ValueError, match="pattern"):
+    assert err.value.parameter == "pattern"
+    with pytest.raises(ParameterError) as err:
         ballbal.periodic(b, "R-R-R")
-    with pytest.raises(ValueError, match="^N"):
+    assert err.value.parameter == "pattern"
+    with pytest.raises(ParameterError) as err:
         ballbal.periodic(b, N=0)
-    with pytest.raises(ValueError, match="samples"):
+    assert err.value.parameter == "N"
+    with pytest.raises(ParameterError) as err:
         ballbal.periodic(b, N=5, samples=4)
-    with pytest.raises(ValueError, match="tol"):
+    assert err.value.parameter == "samples"
+    with pytest.raises(ParameterError) as err:
         ballbal.periodic(b, tol=float("nan"))
+    assert err.value.parameter == "tol"
+    # The binding's guess-shape check (not yet a ParameterError) names the guess.
     with pytest.raises(ValueError, match="guess"):
         ballbal.periodic(b, guess=(0.2, np.zeros(5)))
 

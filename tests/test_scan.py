@@ -11,6 +11,7 @@ import polars as pl
 import pytest
 
 import ballbal
+from ballbal.exceptions import ParameterError
 
 BASE = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
 THESIS = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
@@ -208,13 +209,14 @@ def test_resume_refuses_a_different_scan(tmp_path):
         ({"Omega": [-1.0], "eta": [1.0]}, "Omega"),
         ({"Omega": (2.0, 1.0, 0.1)}, "Omega"),
         ({"Omega": "1:2"}, "Omega"),
-        ({"eta[5]": [1.0]}, "eta\\[5\\]"),
-        ({"eta": [0.0]}, "eta"),
+        ({"eta[5]": [1.0]}, "eta[5]"),
+        ({"eta": [0.0]}, "eta[0]"),
     ],
 )
 def test_bad_grids_raise_before_work(grid, name):
-    with pytest.raises(ValueError, match=f"^{name}"):
+    with pytest.raises(ParameterError) as err:
         ballbal.scan(BASE, grid=grid)
+    assert err.value.parameter == name
 
 
 @pytest.mark.parametrize(
@@ -224,8 +226,9 @@ def test_bad_grids_raise_before_work(grid, name):
      ({"N": 0}, "N"), ({"rtol": -1.0}, "rtol"), ({"max_tail": 0.0}, "max_tail")],
 )
 def test_bad_options_raise_before_work(kw, name):
-    with pytest.raises(ValueError, match=f"^{name}"):
+    with pytest.raises(ParameterError) as err:
         ballbal.scan(BASE, Omega=[1.2], eta=[1.0], **kw)
+    assert err.value.parameter == name
 
 
 def test_command_line_scan_and_plot(tmp_path):

@@ -233,31 +233,31 @@ def test_scene_files_round_trip(tmp_path):
     assert sc.balancer.eta == (0.9, 0.9, 0.9) and sc.native_effects() is None
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("mu = 0.2\nzetta = 0.1\n", "unknown key"),
-    ("[balancer]\nmu = 0.2\n[spring]\nstiffness = 1.0\n", "unknown table"),
-    ("[balancer]\nmu = 0.2\n[springs]\nk = 1.0\n", "springs: unknown key"),
-    ("[balancer]\nmu = 0.2\n[springs]\nstiffness = 1.0\nlayout = 'star'\n",
-     "spring_layout: must be 'ring' or 'chain'"),
-    ("[balancer]\nmu = 0.2\n[ramp]\nstart = 1.0\n", "incomplete"),
+@pytest.mark.parametrize(("text", "parameter"), [
+    ("mu = 0.2\nzetta = 0.1\n", "zetta"),
+    ("[balancer]\nmu = 0.2\n[spring]\nstiffness = 1.0\n", "spring"),
+    ("[balancer]\nmu = 0.2\n[springs]\nk = 1.0\n", "springs.k"),
+    ("[balancer]\nmu = 0.2\n[springs]\nstiffness = 1.0\nlayout = 'star'\n", "spring_layout"),
+    ("[balancer]\nmu = 0.2\n[ramp]\nstart = 1.0\n", "ramp.to"),
     ("[balancer]\nmu = 0.2\n[ramp]\nto = 2.0\nduration = 0.0\n", "ramp.duration"),
     ("[balancer]\nmu = 2.0\n", "mu"),
     ("mu = 'x'\n", "mu"),
     ("[balancer]\nmu = 0.2\n[gravity]\ng = -1.0\n", "gravity"),
     ("[balancer]\neta = [1.0]\n[springs]\nstiffness = 0.1\n", "springs"),
-    ("mu = 0.2\n[balancer]\nzeta = 0.1\n", "outside a table"),
-    ("mu = = 1\n", "not valid TOML"),
+    ("mu = 0.2\n[balancer]\nzeta = 0.1\n", "mu"),
+    ("mu = = 1\n", "path"),
     ("[balancer]\nmu = 0.2\n[tilt]\na = 1.0\nb = 2.0\nj_t = 0.3\nj_z = 0.7\n", "tilt.j_z"),
     ("[balancer]\nmu = 0.2\n[tilt]\na = 0.0\nb = 2.0\nj_t = 0.3\nj_z = 0.1\n", "tilt.a"),
-    ("[balancer]\nmu = 0.2\n[tilt]\na = 1.0\nb = 2.0\nj_t = 0.3\n", "incomplete"),
+    ("[balancer]\nmu = 0.2\n[tilt]\na = 1.0\nb = 2.0\nj_t = 0.3\n", "tilt.j_z"),
     ("[balancer]\nmu = 0.2\n[tilt]\na = 1.0\nb = 2.0\nj_t = 0.3\nj_z = 0.1\nJ = 1\n",
-     "tilt: unknown key"),
+     "tilt.J"),
 ])
-def test_malformed_scene_files_say_what_is_wrong(tmp_path, text, message):
+def test_malformed_scene_files_say_what_is_wrong(tmp_path, text, parameter):
     p = tmp_path / "bad.toml"
     p.write_text(text)
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(ballbal.exceptions.ParameterError) as info:
         ballbal.load_scene(p)
+    assert info.value.parameter == parameter, str(info.value)
 
 
 values = st.one_of(st.floats(allow_nan=True), st.integers(-3, 3), st.text(max_size=3),
@@ -311,10 +311,12 @@ def test_track_damping_trade_off_of_seed_001():
 
 
 def test_disturbance_needs_a_stable_balanced_state_and_an_autonomous_scene():
-    with pytest.raises(ValueError, match="^balancer: the balanced state must exist"):
+    with pytest.raises(ballbal.exceptions.ParameterError) as info:
         ballbal.disturbance_response(ballbal.Balancer(Omega=1.2), to=1.5)
-    with pytest.raises(ValueError, match="^scene: .*'gravity'"):
+    assert info.value.parameter == "balancer"
+    with pytest.raises(ballbal.exceptions.NotAutonomousError) as e:
         ballbal.disturbance_response(ballbal.Scene(gravity=0.1), to=1.5)
+    assert e.value.effect == "gravity"
 
 
 @pytest.mark.parametrize("tilt", [None, ballbal.Tilt(a=1.8, b=2.2, j_t=0.15, j_z=0.25,

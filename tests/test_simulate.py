@@ -1,10 +1,10 @@
-import re
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 import ballbal
+from ballbal.exceptions import ParameterError
 
 from reference import jacobi_integral, rhs
 
@@ -86,24 +86,31 @@ def test_fixed_frame_position():
 )
 def test_bad_parameters_raise_value_error_naming_them(kwargs, name):
     b = ballbal.Balancer(**kwargs)
-    with pytest.raises(ValueError, match="^" + re.escape(name) + ":"):
+    with pytest.raises(ParameterError) as err:
         ballbal.simulate(b, t_span=(0, 1))
-    with pytest.raises(ValueError, match="^" + re.escape(name) + ":"):
+    assert err.value.parameter == name
+    with pytest.raises(ParameterError) as err:
         ballbal.equilibria(b)
+    assert err.value.parameter == name
 
 
 def test_bad_times_and_state():
     b = ballbal.Balancer()
-    with pytest.raises(ValueError, match="t_eval"):
+    with pytest.raises(ParameterError) as err:
         ballbal.simulate(b, t_eval=[0.0, 2.0, 1.0])
-    with pytest.raises(ValueError, match="t_eval"):
+    assert err.value.parameter == "t_eval"
+    with pytest.raises(ParameterError) as err:
         ballbal.simulate(b, t_eval=[0.0, float("nan")])
-    with pytest.raises(ValueError, match="y0"):
+    assert err.value.parameter == "t_eval"
+    with pytest.raises(ParameterError) as err:
         ballbal.simulate(b, y0=[0.0] * 5, t_eval=[0.0, 1.0])
-    with pytest.raises(ValueError, match="y0"):
+    assert err.value.parameter == "y0"
+    with pytest.raises(ParameterError) as err:
         ballbal.simulate(b, y0=[float("nan")] * 8, t_eval=[0.0, 1.0])
-    with pytest.raises(ValueError, match="rtol"):
+    assert err.value.parameter == "y0"
+    with pytest.raises(ParameterError) as err:
         ballbal.simulate(b, t_span=(0, 1), rtol=-1.0)
+    assert err.value.parameter == "rtol"
 
 
 def test_divergent_integration_is_an_error_not_a_panic():

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import ballbal
+from ballbal.exceptions import ParameterError
 
 TILT = ballbal.Tilt(a=1.3, b=2.8, j_t=0.35, j_z=0.55, zeta_r=0.04)
 
@@ -245,12 +246,15 @@ def test_tilt_scene_files_round_trip_and_bad_input(tmp_path):
     sc.save(p)
     assert ballbal.load_scene(p) == sc
     assert ballbal.load_scene(p).coordinates == ["x", "y", "A", "B", "b1", "b2"]
-    with pytest.raises(ValueError, match="^tilt.j_z"):
+    with pytest.raises(ParameterError) as err:
         ballbal.Tilt(a=1.0, b=1.0, j_t=0.2, j_z=0.5)
-    with pytest.raises(ValueError, match="^tilt.zeta_r"):
+    assert err.value.parameter == "tilt.j_z"
+    with pytest.raises(ParameterError) as err:
         ballbal.Tilt(a=1.0, b=1.0, j_t=0.2, j_z=0.1, zeta_r=-1)
-    with pytest.raises(ValueError, match="^y0: needs 2 x 6"):
+    assert err.value.parameter == "tilt.zeta_r"
+    with pytest.raises(ParameterError) as err:
         ballbal.simulate(sc, np.zeros(8), [0.0, 1.0])
+    assert err.value.parameter == "y0"
     with pytest.raises(ValueError, match="^equilibria: .*'ramp'"):
         ballbal.equilibria(sc.replace(ramp=ballbal.Ramp(to=2.0)))
 

@@ -17,7 +17,7 @@ __version__: str
 def simulate(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     y0: npt.NDArray[np.float64], t0: float, t_eval: npt.NDArray[np.float64], rtol: float,
-    atol: list[float], effects: Effects = None,
+    atol: list[float], effects: Effects = None, max_steps: int = 10_000_000,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
 def equilibria(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],

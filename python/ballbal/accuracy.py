@@ -11,7 +11,9 @@ from typing import Any
 import numpy as np
 import polars as pl
 
+from . import _check
 from .analysis import PeriodicSolution, periodic
+from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
 from .scene import Scene
 
@@ -71,18 +73,30 @@ def accuracy_cost(
     ``verdict_ok`` is null where either verdict is ``undetermined`` (no verdict is not a
     wrong verdict); ``closure``, ``separation_error`` and ``stability`` are columns.
     """
-    if repeats < 1:
-        raise ValueError(f"repeats: must be >= 1, got {repeats}")
+    _check.model("balancer", balancer)
+    _check.string("pattern", pattern)
+    N = [_check.integer("N", n, 1, 256) for n in _check.sequence("N", N)]
+    multiples = [_check.real("samples", m, 0.0, 1 << 16, lo_open=True)
+                 for m in _check.sequence("samples", samples)]
+    tol = [_check.real("tol", t) for t in _check.sequence("tol", tol)]
+    rtol = [_check.real("rtol", r) for r in _check.sequence("rtol", rtol)]
+    base_N = _check.integer("base_N", base_N, 1, 256)
+    reference_N = _check.integer("reference_N", reference_N, 1, 256)
+    neighbour = _check.real("neighbour", neighbour, finite=True)
+    repeats = _check.integer("repeats", repeats, 1, 1000)
+    if guess is not None and not isinstance(guess, PeriodicSolution):
+        raise ParameterTypeError("guess", "must be a PeriodicSolution or None, got "
+                                 f"{type(guess).__name__}", value=guess)
     tight: dict[str, Any] = dict(tol=1e-12, step_tol=1e-10, rtol=1e-11, atol=1e-13, hill=False)
     if guess is None:
         start = periodic(balancer, pattern, N=8, hill=False)
         if not start.converged:
-            raise ValueError(f"pattern: no {pattern} solution found at this point by "
+            raise ParameterError("pattern", f"no {pattern} solution found at this point by "
                              f"simulation (status {start.status}); pass guess=")
         guess = start
     ref = periodic(balancer, pattern, N=reference_N, guess=guess, **tight)
     if not ref.converged or ref.multipliers is None:
-        raise ValueError(f"reference: the N = {reference_N} solve did not converge "
+        raise ParameterError("reference_N", f"the N = {reference_N} solve did not converge "
                          f"(status {ref.status})")
     closure = ref.verify(rtol=1e-11, atol=1e-13)
     near_b = balancer.replace(Omega=balancer.Omega - neighbour)
@@ -93,9 +107,9 @@ def accuracy_cost(
     base: dict[str, Any] = dict(N=base_N, samples=None, tol=1e-10, rtol=1e-9, atol=1e-11)
     for n in N:
         settings.append(("N", n, {**base, "N": int(n)}))
-    for m in samples:
-        count = max(int(m * base_N), 2 * base_N + 2)
-        settings.append(("samples", count, {**base, "samples": count}))
+    for m in multiples:
+        per = max(int(m * base_N), 2 * base_N + 2)
+        settings.append(("samples", per, {**base, "samples": per}))
     for t in tol:
         settings.append(("tol", t, {**base, "tol": t, "step_tol": max(t * 100, 1e-8)}))
     for r in rtol:

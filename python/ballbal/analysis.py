@@ -9,7 +9,8 @@ from typing import Any, Literal
 import numpy as np
 import polars as pl
 
-from . import _native
+from . import _check, _native
+from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
 from .scene import Scene
 
@@ -17,7 +18,7 @@ Stability = Literal["stable", "unstable", "undetermined"]
 
 
 def _atol(atol: float | Sequence[float]) -> list[float]:
-    return [float(atol)] if np.isscalar(atol) else [float(a) for a in atol]  # type: ignore[arg-type]
+    return _check.reals("atol", atol)
 
 
 def _state_names(model: Balancer | Scene) -> list[str]:
@@ -34,6 +35,7 @@ def simulate(
     t0: float | None = None,
     rtol: float = 1e-8,
     atol: float | Sequence[float] = 1e-10,
+    max_steps: int = 10_000_000,
 ) -> pl.DataFrame:
     """Integrate the equations of motion with the core's Dormand–Prince 5(4).
 
@@ -44,28 +46,40 @@ def simulate(
     (strictly monotone, not before ``t0``) or ``t_span`` for 1001 evenly spaced outputs.
     Returns columns ``t``, the state, ``theta`` (the disk's angle, 0 at t = 0) and ``X,
     Y``: the disk centre in the fixed frame.
+
+    ``max_steps`` bounds the integrator's steps (accepted and rejected); a simulation
+    that needs more stops with an :class:`~ballbal.exceptions.IntegrationError` saying
+    how far it got. At most ``1e7`` output times.
     """
+    _check.model("balancer", balancer)
     n = balancer.n_balls
     d = len(balancer.coordinates)
     if y0 is None:
         y0 = np.zeros(2 * d)
         y0[d - n : d] = np.linspace(0.0, np.pi, n, endpoint=False) + 0.3
         y0[2 * d - n :] = -balancer.Omega
-    y0 = np.ascontiguousarray(y0, dtype=np.float64).ravel()
+    y0 = _check.array("y0", y0)
     if y0.size != 2 * d:
-        raise ValueError(f"y0: needs 2 x {d} values ({', '.join(balancer.coordinates)} and "
-                         f"their rates), got {y0.size}")
+        raise ParameterError("y0", f"needs 2 x {d} values ({', '.join(balancer.coordinates)} "
+                             f"and their rates), got {y0.size}")
+    span = None if t_span is None else _span(t_span)
     if t_eval is None:
-        if t_span is None:
-            raise ValueError("t_eval: give output times, or t_span=(t0, t1)")
-        t_eval = np.linspace(float(t_span[0]), float(t_span[1]), 1001)
-    t = np.ascontiguousarray(t_eval, dtype=np.float64).ravel()
+        if span is None:
+            raise ParameterError("t_eval", "give output times, or t_span=(t0, t1)")
+        t_eval = np.linspace(span[0], span[1], 1001)
+    t = _check.array("t_eval", t_eval)
     if t.size == 0:
-        raise ValueError("t_eval: must hold at least one time")
+        raise ParameterError("t_eval", "must hold at least one time")
+    if t.size > _check.MAX_SAMPLES:
+        raise ParameterError("t_eval", f"at most {_check.MAX_SAMPLES:.0e} output times, got "
+                             f"{t.size}", allowed=f"at most {_check.MAX_SAMPLES:.0e} times")
     if t0 is None:
-        t0 = float(t_span[0]) if t_span is not None else 0.0
-    y, theta, *_ = _native.simulate(*balancer.native_args(), y0, float(t0), t, float(rtol),
-                                    _atol(atol), balancer.native_effects())
+        t0 = span[0] if span is not None else 0.0
+    t0 = _check.real("t0", t0, finite=True)
+    steps = _check.integer("max_steps", max_steps, 1)
+    y, theta, *_ = _native.simulate(*balancer.native_args(), y0, t0, t,
+                                    _check.real("rtol", rtol), _atol(atol),
+                                    balancer.native_effects(), steps)
     cols: dict[str, Any] = {"t": t}
     for name, col in zip(_state_names(balancer), np.asarray(y).T, strict=True):
         cols[name] = col
@@ -73,6 +87,21 @@ def simulate(
     cols["X"] = cols["x"] * np.cos(theta) - cols["y"] * np.sin(theta)
     cols["Y"] = cols["x"] * np.sin(theta) + cols["y"] * np.cos(theta)
     return pl.DataFrame(cols)
+
+
+def _span(t_span: Any) -> tuple[float, float]:
+    """``(t0, t1)``: two finite, different times."""
+    if isinstance(t_span, (str, bytes)) or not isinstance(t_span, (Sequence, np.ndarray)):
+        raise ParameterTypeError("t_span", f"must be a pair (t0, t1), got {t_span!r:.60}",
+                                 value=t_span)
+    if len(t_span) != 2:
+        raise ParameterError("t_span", f"must be a pair (t0, t1), got {len(t_span)} values",
+                             value=t_span)
+    a = _check.real("t_span", t_span[0], finite=True)
+    b = _check.real("t_span", t_span[1], finite=True)
+    if a == b:
+        raise ParameterError("t_span", f"t1 must differ from t0, got ({a}, {b})", value=t_span)
+    return a, b
 
 
 @dataclass(frozen=True)
@@ -99,6 +128,7 @@ def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
     ``b_1`` in ``(-pi, pi]``, and identical balls relabelled round the ring count once;
     the one that continues the perfect balance (:func:`balanced_state`) is ``"balanced"``.
     Scenes with a ramp, gravity or an impulse have none (an error naming the effect)."""
+    _check.model("balancer", balancer)
     return [_equilibrium(d)
             for d in _native.equilibria(*balancer.native_args(), balancer.native_effects())]
 
@@ -210,11 +240,13 @@ def harmonics(N: int | str, target: float) -> tuple[int, float | None]:
     """``(starting N, target or None)`` from ``N`` = an integer or ``"auto"``."""
     if isinstance(N, str):
         if N != "auto":
-            raise ValueError(f"N: must be an integer in [1, 256] or 'auto', got {N!r}")
-        return 3, float(target)
-    if isinstance(N, bool) or not isinstance(N, (int, np.integer)):
-        raise ValueError(f"N: must be an integer in [1, 256] or 'auto', got {N!r}")
-    return int(N), None
+            raise ParameterError("N", f"must be an integer in [1, 256] or 'auto', got {N!r:.60}",
+                                 allowed="[1, 256] or 'auto'", value=N)
+        return 3, _check.real("target", target)
+    if isinstance(N, (bool, np.bool_)) or not isinstance(N, (int, np.integer)):
+        raise ParameterTypeError("N", f"must be an integer in [1, 256] or 'auto', got "
+                                 f"{N!r:.60}", allowed="[1, 256] or 'auto'", value=N)
+    return _check.integer("N", N, 1, 256), None
 
 
 def periodic(
@@ -285,22 +317,35 @@ def periodic(
     ``window`` up to 1e5, ...) raise :class:`~ballbal.exceptions.ParameterError` naming
     them.
     """
+    _check.model("balancer", balancer)
+    _check.string("pattern", pattern)
     go: float | None = None
     gc: np.ndarray | None = None
     if guess is not None:
         if isinstance(guess, PeriodicSolution):
             if guess.omega is None:
-                raise ValueError("guess: a solution that did not converge cannot seed a solve")
+                raise ParameterError("guess", "a solution that did not converge cannot seed "
+                                     "a solve")
             go, gc = guess.omega, guess.coeffs
+        elif isinstance(guess, (tuple, list)) and len(guess) == 2:
+            go, gc = _check.real("guess", guess[0]), _check.array("guess", guess[1])
         else:
-            go, gc = float(guess[0]), np.asarray(guess[1], dtype=float)
+            raise ParameterTypeError("guess", "must be a PeriodicSolution or (omega, coeffs), "
+                                     f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
     n0, auto = harmonics(N, target)
     d = _native.periodic(
-        *balancer.native_args(), pattern, n0, samples, float(tol), float(step_tol),
-        int(max_iter), go, gc, bool(floquet), float(rtol), float(atol), float(margin),
-        int(max_steps), float(settle), float(window), 1e-9, auto, int(N_max), bool(hill),
-        float(max_closure), float(max_trivial), float(max_tail), balancer.native_effects(),
+        *balancer.native_args(), pattern, n0,
+        _check.optional_integer("samples", samples, 1, 1 << 16),
+        _check.real("tol", tol), _check.real("step_tol", step_tol),
+        _check.integer("max_iter", max_iter, 1, 10_000), go, gc,
+        _check.boolean("floquet", floquet), _check.real("rtol", rtol),
+        _check.real("atol", atol), _check.real("margin", margin),
+        _check.integer("max_steps", max_steps, 1), _check.real("settle", settle),
+        _check.real("window", window), 1e-9, auto, _check.integer("N_max", N_max, 1, 256),
+        _check.boolean("hill", hill), _check.real("max_closure", max_closure),
+        _check.real("max_trivial", max_trivial), _check.real("max_tail", max_tail),
+        balancer.native_effects(),
     )
     mult = d["mult_re"] + 1j * d["mult_im"] if "mult_re" in d else None
     hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None

@@ -9,8 +9,9 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from . import _native
+from . import _check, _native
 from .analysis import Equilibrium, _equilibrium
+from .exceptions import ParameterError
 from .model import Balancer
 from .scene import Scene
 
@@ -23,6 +24,7 @@ def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
     rest spacing is not the balancing spacing leave a nearly balanced state whose
     residual whirl is ``hypot(x, y)`` (in units of ``e``); it is followed from zero
     spring stiffness. Needs an autonomous scene."""
+    _check.model("model", model)
     d = _native.balanced_states([(model.native_args(), model.native_effects())])[0]
     return None if d is None else _equilibrium(d)
 
@@ -40,23 +42,27 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     ``index`` (largest real part of the eigenvalues, seed 001's relative-stability
     index), ``whirl`` (residual ``hypot(x, y)``), ``tilt`` (residual ``hypot(A, B)``,
     0 for a planar disk), ``residual`` (of the equilibrium equations)."""
+    _check.model("model", model)
     if not axes:
-        raise ValueError("axes: give at least one parameter to vary, e.g. Omega=[...]")
+        raise ParameterError("axes", "give at least one parameter to vary, e.g. Omega=[...]")
     scene = model if isinstance(model, Scene) else Scene(balancer=model)
     names = list(axes)
+    allowed = _MAP_AXES | (_TILT_AXES if scene.tilt is not None else set())
     values: list[list[float]] = []
     for name in names:
-        v = np.atleast_1d(np.asarray(axes[name], dtype=float))
-        if v.ndim != 1 or v.size == 0 or not np.all(np.isfinite(v)):
-            raise ValueError(f"{name}: needs a non-empty list of finite numbers")
+        if name not in allowed:
+            raise ParameterError(name, "not a parameter balance_map can vary (allowed: "
+                                 f"{', '.join(sorted(allowed))})",
+                                 allowed=", ".join(sorted(allowed)))
+        v = _check.array(name, axes[name])
+        if v.size == 0 or not np.all(np.isfinite(v)):
+            raise ParameterError(name, "needs a non-empty list of finite numbers")
         values.append([float(x) for x in v])
+    _check.grid_points([len(v) for v in values], names, streamed=False)
     points: list[Any] = []
     grid = list(itertools.product(*values))
     for combo in grid:
-        try:
-            sc = scene.replace(**dict(zip(names, combo, strict=True)))
-        except TypeError as e:
-            raise ValueError(f"axes: {e}; allowed: balancer fields, springs, tilt fields") from e
+        sc = scene.replace(**dict(zip(names, combo, strict=True)))
         points.append((sc.native_args(), sc.native_effects()))
     results = _native.balanced_states(points)
     # Tell "the balls cannot balance the disk" from "the continuation to this scene failed".
@@ -85,6 +91,10 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
         "status": pl.String, "stability": pl.String, "index": pl.Float64,
         "whirl": pl.Float64, "tilt": pl.Float64, "residual": pl.Float64}
     return pl.DataFrame(cols, schema=schema)
+
+
+_MAP_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta", "springs"}
+_TILT_AXES = {"a", "b", "j_t", "j_z", "zeta_r"}
 
 
 def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: str = "",

@@ -8,33 +8,79 @@ the map."""
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import time
 import warnings
+from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 
 from .analysis import equilibria, periodic
-from .exceptions import ScanInterrupted, ScanStoreError
+from .exceptions import BallbalError, ParameterError, ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .scan import SCANNABLE, read_scan, scan, scan_meta
-from .scene import Scene, load_scene
+from .scene import MAX_BALLS, Scene, load_scene
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one ``ballbal: error: <parameter>: ...`` line, exit status 2,
+    like every other error of the command."""
+
+    def error(self, message: str) -> NoReturn:
+        m = re.match(r"argument (?:-\w/)?-*([\w-]+)(?:/\S+)?: (.*)", message, re.S)
+        if m:
+            message = f"{m.group(1).replace('-', '_')}: {m.group(2)}"
+        elif m := re.match(r"the following arguments are required: (.*)", message):
+            first = m.group(1).split(",")[0].split("/")[-1].lstrip("-")
+            message = f"{first}: required (see '{self.prog} --help')"
+        elif m := re.match(r"(unrecognized arguments|ambiguous option): (\S*)(.*)", message,
+                           re.S):
+            flag = m.group(2).split("=")[0]
+            # An option is named as typed; a stray value belongs to the command line.
+            name = flag.lstrip("-").replace("-", "_") if flag.startswith("-") else ""
+            name = name or "cmd"
+            message = f"{name}: {m.group(1)}: {m.group(2)}{m.group(3)}"
+        else:
+            message = f"cmd: {message}"
+        _fail(message)
+
+
+def _fail(message: str, status: int = 2) -> NoReturn:
+    print(f"ballbal: error: {' '.join(message.split())}", file=sys.stderr)
+    sys.exit(status)
+
+
+def _load(path: str, parameter: str) -> Scene:
+    """A scene file, with errors about the file itself named by the CLI's parameter."""
+    try:
+        return load_scene(path)
+    except ParameterError as e:
+        if e.parameter == "path":
+            raise ParameterError(parameter, e.message, value=path) from e
+        raise
 
 _DEFAULTS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0, "Omega": 1.2}
 
 
 def _model(a: argparse.Namespace) -> Balancer | Scene:
     given = {k: getattr(a, k) for k in _DEFAULTS if getattr(a, k) is not None}
-    if a.scene:
+    if a.scene is not None:
         if a.balls is not None:
             raise ValueError("balls: the scene file sets the balls; give --eta to change "
                              "their masses")
-        sc = load_scene(a.scene)
+        sc = _load(a.scene, "scene")
         if a.eta is not None:
             given["eta"] = a.eta[0] if len(a.eta) == 1 else tuple(a.eta)
         return sc.replace(**given)
+    if a.balls is not None and not 1 <= a.balls <= MAX_BALLS:
+        raise ParameterError("balls", f"must be an integer in [1, {MAX_BALLS}], got {a.balls}",
+                             allowed=f"[1, {MAX_BALLS}]")
+    if a.balls is not None and a.eta is not None and len(a.eta) > 1 and len(a.eta) != a.balls:
+        raise ParameterError("balls", f"{a.balls} balls but {len(a.eta)} values of --eta")
     eta = a.eta or [1.0]
-    eta = eta if len(eta) > 1 else eta * (a.balls or 2)
+    eta = eta if len(eta) > 1 else eta * (2 if a.balls is None else a.balls)
     return Balancer(**{**_DEFAULTS, **given}, eta=eta)
 
 
@@ -110,12 +156,12 @@ def _print_map(b: Balancer) -> None:
 
 
 def _scan(a: argparse.Namespace) -> int:
-    b = load_scene(a.scene) if a.scene else Balancer()
+    b = _load(a.scene, "scene") if a.scene is not None else Balancer()
     grid: dict[str, str] = {n: getattr(a, n) for n in SCANNABLE if getattr(a, n) is not None}
     for g in a.grid:
         name, sep, spec = g.partition("=")
         if not sep:
-            raise ValueError(f"grid: give NAME=START:STOP:STEP, got {g!r}")
+            raise ParameterError("grid", f"give NAME=START:STOP:STEP, got {g!r}")
         grid[name.strip()] = spec
     t = time.perf_counter()
     try:
@@ -158,24 +204,46 @@ def _plot(a: argparse.Namespace) -> int:
 
     from .plot import scan_map
 
-    df = read_scan(a.scan_dir)
-    names = list(scan_meta(a.scan_dir)["grid"])
+    d = Path(a.scan_dir)
+    if not d.is_dir():
+        raise ParameterError("scan_dir", f"{d} is not a directory (a scan written by "
+                             "'ballbal scan -o DIR')")
+    if not (d / "meta.json").is_file():
+        raise ParameterError("scan_dir", f"{d} holds no scan (no meta.json)")
+    try:
+        df = read_scan(d)
+        names = list(scan_meta(d)["grid"])
+    except ParameterError as e:
+        raise ParameterError("scan_dir", e.message) from e
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise ParameterError("scan_dir", f"{d} cannot be read as a scan: {e}") from e
     if len(names) < 2:
-        raise ValueError("scan_dir: a map needs a scan over two parameters")
-    types = [a.type] if a.type else sorted(df["type"].unique().to_list())
+        raise ParameterError("scan_dir", "a map needs a scan over two parameters")
+    found = sorted(t for t in df["type"].unique().to_list() if t is not None)
+    if a.type is not None and a.type not in found:
+        raise ParameterError("type", f"no {a.type!r} rows in this scan (types: "
+                             f"{', '.join(found) or 'none'})", allowed=", ".join(found))
+    types = [a.type] if a.type else found
+    if not types:
+        raise ParameterError("scan_dir", "the scan has no rows to plot")
     fig, axes = plt.subplots(1, len(types), figsize=(5.5 * len(types), 4.5), squeeze=False)
     for ax, ty in zip(axes[0], types, strict=True):
         scan_map(df, x=names[0], y=names[1], type=ty, ax=ax)
     fig.tight_layout()
     out = a.out or str(a.scan_dir).rstrip("/") + ".png"
-    fig.savefig(out, dpi=120)
+    if not out.strip():
+        raise ParameterError("out", "must be a non-empty file name")
+    try:
+        fig.savefig(out, dpi=120)
+    except (OSError, ValueError) as e:
+        raise ParameterError("out", f"cannot write the image {out}: {e}") from e
     print(f"ballbal plot: {out}")
     return 0
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="ballbal", description=__doc__)
-    sub = ap.add_subparsers(dest="cmd", required=True)
+    ap = _Parser(prog="ballbal", description=__doc__)
+    sub = ap.add_subparsers(dest="cmd", required=True, parser_class=_Parser)
     sub.add_parser("run", help="the thesis' standard case: equilibria and R-R solution")
     pp = sub.add_parser("periodic", help="a periodic solution with Floquet stability")
     _params(pp)
@@ -217,10 +285,21 @@ def main(argv: list[str] | None = None) -> int:
             _print_periodic(_model(a), a.pattern, a.N)
         else:
             _print_equilibria(_model(a))
-    except ValueError as e:
-        print(f"ballbal: error: {e}", file=sys.stderr)
-        return 2
+    except (ValueError, TypeError) as e:
+        # Bad input: ParameterError, ParameterTypeError, NotAutonomousError.
+        return _report(e, 2)
+    except OSError as e:
+        name = "out" if a.cmd in ("scan", "plot") else "scene"
+        return _report(ParameterError(name, f"{e.strerror or e}: {e.filename or ''}"), 2)
+    except BallbalError as e:
+        # The numerics failed (IntegrationError, ...): not a usage error.
+        return _report(e, 1)
     return 0
+
+
+def _report(e: BaseException, status: int) -> int:
+    print(f"ballbal: error: {' '.join(str(e).split())}", file=sys.stderr)
+    return status
 
 
 if __name__ == "__main__":

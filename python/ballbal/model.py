@@ -3,30 +3,37 @@
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
-
-def _is_number(v: Any) -> bool:
-    # numbers.Real takes numpy scalars too; a bool is not a parameter value.
-    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+from . import _check
+from ._check import is_real as _is_number
+from .exceptions import ParameterError, ParameterTypeError
 
 
 def _tuple(name: str, v: float | Sequence[float]) -> tuple[float, ...]:
-    bad = ValueError(f"{name}: must be a number or a sequence of numbers, got {v!r}")
     if _is_number(v):
-        return (float(v),)
+        return (_check.real(name, v),)
+    bad = ParameterTypeError(name, f"must be a number or a sequence of numbers, got {v!r:.60}",
+                             value=v)
     if isinstance(v, (str, bytes)):
         raise bad
     try:
-        items = list(v)
+        items = list(v)  # type: ignore[arg-type]
     except TypeError as e:
         raise bad from e
     if not all(_is_number(x) for x in items):
         raise bad
-    return tuple(float(x) for x in items)
+    return tuple(_check.real(f"{name}[{i}]", x) for i, x in enumerate(items))
+
+
+def _unknown_fields(cls: type, changes: dict[str, Any]) -> None:
+    known = {f.name for f in fields(cls)}
+    for k in changes:
+        if k not in known:
+            raise ParameterError(k, f"not a field of {cls.__name__} (fields: "
+                                 f"{', '.join(sorted(known))})", allowed=", ".join(sorted(known)))
 
 
 @dataclass(frozen=True)
@@ -47,10 +54,7 @@ class Balancer:
 
     def __post_init__(self) -> None:
         for name in ("mu", "zeta", "delta", "Omega"):
-            v = getattr(self, name)
-            if not _is_number(v):
-                raise ValueError(f"{name}: must be a number, got {v!r}")
-            object.__setattr__(self, name, float(v))
+            object.__setattr__(self, name, _check.real(name, getattr(self, name)))
         object.__setattr__(self, "eta", _tuple("eta", self.eta))
         zb = _tuple("zeta_b", self.zeta_b)
         object.__setattr__(self, "zeta_b", zb[0] if len(zb) == 1 else zb)
@@ -74,6 +78,7 @@ class Balancer:
         return None
 
     def replace(self, **changes: Any) -> Balancer:
+        _unknown_fields(Balancer, changes)
         return replace(self, **changes)
 
     def validate(self) -> Balancer:
@@ -101,18 +106,18 @@ class Balancer:
         ``track_damping`` is the viscous coefficient ``c_b`` on a ball's speed relative to
         the track; ``other_mass`` is the rotor and motor base mass ``M_r``.
         """
-        vals = {"disk_mass": disk_mass, "eccentricity": eccentricity, "track_radius": track_radius,
-                "stiffness": stiffness}
-        for k, v in vals.items():
-            if not (math.isfinite(v) and v > 0):
-                raise ValueError(f"{k}: must be a finite number > 0, got {v}")
-        for k, v in {"damping": damping, "track_damping": track_damping, "spin": spin,
-                     "other_mass": other_mass}.items():
-            if not (math.isfinite(v) and v >= 0):
-                raise ValueError(f"{k}: must be a finite number >= 0, got {v}")
-        mb = [float(m) for m in ball_masses]
+        disk_mass, eccentricity, track_radius, stiffness = (
+            _check.real(k, v, 0.0, lo_open=True) for k, v in (
+                ("disk_mass", disk_mass), ("eccentricity", eccentricity),
+                ("track_radius", track_radius), ("stiffness", stiffness)))
+        damping, track_damping, spin, other_mass = (
+            _check.real(k, v, 0.0) for k, v in (
+                ("damping", damping), ("track_damping", track_damping), ("spin", spin),
+                ("other_mass", other_mass)))
+        mb = _check.reals("ball_masses", ball_masses)
         if not mb or any(not (math.isfinite(m) and m > 0) for m in mb):
-            raise ValueError("ball_masses: need at least one ball, every mass finite and > 0")
+            raise ParameterError("ball_masses", "need at least one ball, every mass finite "
+                                 "and > 0", allowed="(0, inf)", value=ball_masses)
         total = other_mass + disk_mass + sum(mb)
         wn = math.sqrt(stiffness / total)
         zb = tuple(track_damping / (2 * m * wn) for m in mb)
@@ -127,6 +132,10 @@ class Balancer:
 
     def to_lab(self, *, disk_mass: float, eccentricity: float, stiffness: float) -> dict[str, Any]:
         """Lab quantities for a given disk mass, eccentricity and support stiffness."""
+        disk_mass, eccentricity, stiffness = (
+            _check.real(k, v, 0.0, lo_open=True) for k, v in (
+                ("disk_mass", disk_mass), ("eccentricity", eccentricity),
+                ("stiffness", stiffness)))
         total = disk_mass / self.mu
         wn = math.sqrt(stiffness / total)
         r_t = self.delta * eccentricity
@@ -146,8 +155,7 @@ class Balancer:
 
 def zeta_from_log_decrement(d: float) -> float:
     """Damping ratio from a measured logarithmic decrement ``d``."""
-    if not (math.isfinite(d) and d >= 0):
-        raise ValueError(f"d: must be a finite number >= 0, got {d}")
+    d = _check.real("d", d, 0.0)
     return d / math.sqrt(4 * math.pi**2 + d**2)
 
 
@@ -164,13 +172,11 @@ def from_seed003(
     ``zeta_b = D0 sqrt(1 + n m0) / 2``. Its pitchfork point ``(0.5773, 1)`` with ``e = 2``
     is ``(Omega, eta) = (1, 0.5)``.
     """
-    for k, v in {"omega0": omega0, "m0": m0, "e": e, "C0": C0, "D0": D0}.items():
-        if not (math.isfinite(v) and v >= 0):
-            raise ValueError(f"{k}: must be a finite number >= 0, got {v}")
-    if m0 <= 0 or e <= 0:
-        raise ValueError(f"m0, e: must be > 0, got m0={m0}, e={e}")
-    if n < 1:
-        raise ValueError(f"n: must be >= 1, got {n}")
+    omega0, C0, D0 = (_check.real(k, v, 0.0) for k, v in
+                      (("omega0", omega0), ("C0", C0), ("D0", D0)))
+    m0 = _check.real("m0", m0, 0.0, lo_open=True)
+    e = _check.real("e", e, 0.0, lo_open=True)
+    n = _check.integer("n", n, 1, 1024)
     s = math.sqrt(1.0 + n * m0)
     return Balancer(
         mu=1.0 / (1.0 + n * m0),

@@ -26,9 +26,15 @@ from typing import IO, Any, Literal, overload
 import numpy as np
 import polars as pl
 
-from . import _native
+from . import _check, _native
 from .analysis import harmonics
-from .exceptions import ParameterError, ScanInterrupted, ScanStoreError, ScanStoreWarning
+from .exceptions import (
+    ParameterError,
+    ParameterTypeError,
+    ScanInterrupted,
+    ScanStoreError,
+    ScanStoreWarning,
+)
 from .model import Balancer
 from .scene import Scene
 
@@ -62,37 +68,39 @@ def grid_values(name: str, spec: GridSpec) -> np.ndarray:
     ``"start:stop:step"`` (both ends included)."""
     if not (name in SCANNABLE or name in SCENE_SCANNABLE
             or (name.startswith(_INDEXED) and name.endswith("]"))):
-        raise ValueError(
-            f"{name}: not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
+        raise ParameterError(
+            name, f"not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
             f"eta[i], zeta_b[i]; for scenes also {', '.join(SCENE_SCANNABLE)})"
         )
     if isinstance(spec, str):
         try:
             parts = [float(p) for p in spec.split(":")]
         except ValueError as e:
-            raise ValueError(f"{name}: give start:stop:step, got {spec!r}") from e
+            raise ParameterError(name, f"give start:stop:step, got {spec!r}") from e
         if len(parts) != 3:
-            raise ValueError(f"{name}: give start:stop:step, got {spec!r}")
+            raise ParameterError(name, f"give start:stop:step, got {spec!r}")
         spec = (parts[0], parts[1], parts[2])
     if isinstance(spec, tuple) and len(spec) == 3 and not isinstance(spec, np.ndarray):
-        start, stop, step = (float(v) for v in spec)
+        start, stop, step = (_check.real(name, v) for v in spec)
         if not all(math.isfinite(v) for v in (start, stop, step)):
-            raise ValueError(f"{name}: (start, stop, step) must be finite, got {spec}")
+            raise ParameterError(name, f"(start, stop, step) must be finite, got {spec}")
         if step <= 0 or stop < start:
-            raise ValueError(
-                f"{name}: (start, stop, step) needs step > 0 and stop >= start, got {spec}"
+            raise ParameterError(
+                name, f"(start, stop, step) needs step > 0 and stop >= start, got {spec}"
             )
-        count = int(math.floor((stop - start) / step + 1e-9)) + 1
+        count = _check.axis_count(name, (stop - start) / step)
         vals = np.round(start + step * np.arange(count), 12)
     else:
+        if spec is None or isinstance(spec, (bool, np.bool_)):
+            raise ParameterTypeError(name, f"grid values must be numbers, got {spec!r}")
         try:
             vals = np.asarray(spec, dtype=float).ravel()
         except (TypeError, ValueError) as e:
-            raise ValueError(f"{name}: grid values must be numbers, got {spec!r}") from e
+            raise ParameterError(name, f"grid values must be numbers, got {spec!r}") from e
     if vals.size == 0:
-        raise ValueError(f"{name}: the grid is empty")
+        raise ParameterError(name, "the grid is empty")
     if not np.all(np.isfinite(vals)):
-        raise ValueError(f"{name}: grid values must be finite (no NaN or inf)")
+        raise ParameterError(name, "grid values must be finite (no NaN or inf)")
     return vals
 
 
@@ -515,24 +523,35 @@ def scan(  # noqa: E302 - overloads above
     ``progress``: ``True`` for a progress bar (tqdm if installed), or a callable
     ``f(done_points, total_points)``. Ctrl-C stops the scan and returns the finished
     chunks with a :class:`ScanInterrupted` warning.
+
+    Limits (checked before any work): at most 1e6 values per axis, 5e6 grid points for a
+    table held in memory and 1e9 for one streamed to ``out=``.
     """
+    patterns = _check.scan_arguments(
+        balancer, patterns=patterns, N_max=N_max, samples=samples, max_iter=max_iter,
+        max_steps=max_steps, seeds=seeds, starts=starts, chunk=chunk, threads=threads, out=out,
+        hill=hill, floquet=floquet, reals=dict(
+            target=target, tol=tol, step_tol=step_tol, rtol=rtol, atol=atol, margin=margin,
+            settle=settle, window=window, guess_rtol=guess_rtol, max_tail=max_tail))
     axes_all: dict[str, GridSpec] = dict(grid or {})
     for k, v in axes.items():
         if k in axes_all:
-            raise ValueError(f"{k}: given twice (keyword and grid)")
+            raise ParameterError(k, "given twice (keyword and grid)")
         axes_all[k] = v
     if not axes_all:
-        raise ValueError("grid: give at least one parameter to scan, e.g. Omega=(1, 2, 0.1)")
+        raise ParameterError("grid", "give at least one parameter to scan, e.g. "
+                             "Omega=(1, 2, 0.1)")
     names = tuple(axes_all)
     model: Balancer | Scene = balancer
     if (isinstance(model, Scene) and model.native_effects() is None
             and not set(names) & set(SCENE_SCANNABLE)):
         model = model.balancer  # the same table, and a scan directory it can resume
     values = tuple(tuple(grid_values(n, s).tolist()) for n, s in axes_all.items())
+    _check.grid_points([len(v) for v in values], names, streamed=out is not None)
     if isinstance(patterns, str):
         patterns = (patterns,)
     if not patterns:
-        raise ValueError("patterns: give at least one solution type, e.g. ['R-R']")
+        raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
     if lazy and out is None:
         raise ParameterError("lazy", "a lazy table needs out= (it reads the chunk files)",
                              allowed="False without out", value=lazy)
@@ -555,7 +574,7 @@ def scan(  # noqa: E302 - overloads above
     chunk = -(-int(chunk) // block) * block
     local_threads = (os.cpu_count() or 1) if threads is None else int(threads)
     if local_threads < 1:
-        raise ValueError(f"threads: must be >= 1, got {threads}")
+        raise ParameterError("threads", f"must be >= 1, got {threads}")
     n0, auto = harmonics(N, target)
     options = (
         ("N", n0), ("auto", auto), ("N_max", int(N_max)), ("hill", bool(hill)),
@@ -651,7 +670,7 @@ def read_scan(  # noqa: E302 - overloads above
     ``polars.LazyFrame`` over the files (checked by their footers only: row data is read
     when the frame is collected).
     """
-    d = Path(path)
+    d = Path(_check.path("path", path))
     # In chunk order, also past chunk 99999 (where names stop sorting as numbers).
     def order(f: Path) -> tuple[int, str]:
         c = _chunk_index(f)

@@ -40,6 +40,8 @@ import sys
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
+from . import _check
+from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer, _is_number
 
 if sys.version_info >= (3, 11):
@@ -49,9 +51,7 @@ else:  # pragma: no cover
 
 
 def _num(where: str, v: Any) -> float:
-    if not _is_number(v) or not math.isfinite(v):
-        raise ValueError(f"{where}: must be a finite number, got {v!r}")
-    return float(v)
+    return _check.real(where, v, finite=True)
 
 
 @dataclass(frozen=True)
@@ -63,10 +63,8 @@ class Ramp:
     def __post_init__(self) -> None:
         for f in fields(self):
             object.__setattr__(self, f.name, _num(f"ramp.{f.name}", getattr(self, f.name)))
-        if self.to <= 0:
-            raise ValueError(f"ramp.to: must be > 0, got {self.to}")
-        if self.duration <= 0:
-            raise ValueError(f"ramp.duration: must be > 0, got {self.duration}")
+        _check.real("ramp.to", self.to, 0.0, lo_open=True)
+        _check.real("ramp.duration", self.duration, 0.0, lo_open=True)
 
 
 @dataclass(frozen=True)
@@ -79,8 +77,7 @@ class Impulse:
     def __post_init__(self) -> None:
         for f in fields(self):
             object.__setattr__(self, f.name, _num(f"impulse.{f.name}", getattr(self, f.name)))
-        if self.sharpness <= 0:
-            raise ValueError(f"impulse.sharpness: must be > 0, got {self.sharpness}")
+        _check.real("impulse.sharpness", self.sharpness, 0.0, lo_open=True)
 
 
 @dataclass(frozen=True)
@@ -106,14 +103,12 @@ class Tilt:
         for f in fields(self):
             object.__setattr__(self, f.name, _num(f"tilt.{f.name}", getattr(self, f.name)))
         for name in ("a", "b", "j_t"):
-            if getattr(self, name) <= 0:
-                raise ValueError(f"tilt.{name}: must be > 0, got {getattr(self, name)}")
+            _check.real(f"tilt.{name}", getattr(self, name), 0.0, lo_open=True)
         if not 0 <= self.j_z <= 2 * self.j_t:
-            raise ValueError(f"tilt.j_z: must be in [0, 2 j_t] = [0, {2 * self.j_t}] (a rigid "
-                             f"body's polar moment is at most the sum of the other two), "
-                             f"got {self.j_z}")
-        if self.zeta_r < 0:
-            raise ValueError(f"tilt.zeta_r: must be >= 0, got {self.zeta_r}")
+            raise ParameterError("tilt.j_z", f"must be in [0, 2 j_t] = [0, {2 * self.j_t}] (a "
+                                 "rigid body's polar moment is at most the sum of the other "
+                                 f"two), got {self.j_z}", allowed=f"[0, {2 * self.j_t}]")
+        _check.real("tilt.zeta_r", self.zeta_r, 0.0)
 
     @property
     def kappa_c(self) -> float:
@@ -140,22 +135,20 @@ class Scene:
 
     def __post_init__(self) -> None:
         if not isinstance(self.balancer, Balancer):
-            raise ValueError(f"balancer: must be a Balancer, got {type(self.balancer).__name__}")
-        object.__setattr__(self, "springs", _num("springs", self.springs))
-        object.__setattr__(self, "gravity", _num("gravity", self.gravity))
-        if self.springs < 0:
-            raise ValueError(f"springs: must be >= 0 (k_d / k), got {self.springs}")
+            raise ParameterTypeError("balancer", f"must be a Balancer, got "
+                                     f"{type(self.balancer).__name__}")
+        object.__setattr__(self, "springs", _check.real("springs", self.springs, 0.0))
+        object.__setattr__(self, "gravity", _check.real("gravity", self.gravity, 0.0))
         if self.springs > 0 and self.balancer.n_balls < 2:
-            raise ValueError("springs: ball springs need at least 2 balls")
-        if self.gravity < 0:
-            raise ValueError(f"gravity: must be >= 0, got {self.gravity}")
-        if self.spring_layout not in ("ring", "chain"):
-            raise ValueError(f"spring_layout: must be 'ring' or 'chain', "
-                             f"got {self.spring_layout!r}")
+            raise ParameterError("springs", "ball springs need at least 2 balls")
+        if not isinstance(self.spring_layout, str) or self.spring_layout not in ("ring", "chain"):
+            raise ParameterError("spring_layout", f"must be 'ring' or 'chain', "
+                                 f"got {self.spring_layout!r:.60}", allowed="ring, chain")
         for name, kind in (("ramp", Ramp), ("impulse", Impulse), ("tilt", Tilt)):
             v = getattr(self, name)
             if v is not None and not isinstance(v, kind):
-                raise ValueError(f"{name}: must be a {kind.__name__} or None")
+                raise ParameterTypeError(name, f"must be a {kind.__name__} or None, got "
+                                         f"{type(v).__name__}")
 
     # the interface the analyses use, shared with Balancer
     @property
@@ -179,6 +172,11 @@ class Scene:
         """A copy with fields changed; balancer fields (``Omega``, ``eta``, ...) and tilt
         fields (``j_t``, ``a``, ...) may be given directly; a single ``eta`` sets every
         ball's."""
+        known = _BALANCER_FIELDS | _TILT_FIELDS | {f.name for f in fields(Scene)}
+        for k in changes:
+            if k not in known:
+                raise ParameterError(k, "not a field of the scene, its balancer or its tilt "
+                                     f"(fields: {', '.join(sorted(known))})")
         bal = {k: changes.pop(k) for k in list(changes) if k in _BALANCER_FIELDS}
         if "eta" in bal and _is_number(bal["eta"]):
             bal["eta"] = (bal["eta"],) * self.n_balls  # one value: every ball, as in scans
@@ -187,7 +185,7 @@ class Scene:
             changes["balancer"] = self.balancer.replace(**bal).validate()
         if tl:
             if self.tilt is None:
-                raise ValueError(f"{', '.join(tl)}: the scene has no tilt to change")
+                raise ParameterError(next(iter(tl)), "the scene has no tilt to change")
             changes["tilt"] = replace(self.tilt, **tl)
         return replace(self, **changes)
 
@@ -263,50 +261,77 @@ def _toml_value(v: Any) -> str:
 _TABLES = {"springs": {"stiffness", "layout"}, "ramp": {"to", "start", "duration"},
            "gravity": {"g"}, "impulse": {"amplitude", "t0", "sharpness", "angle"},
            "tilt": {"a", "b", "j_t", "j_z", "zeta_r"}}
+_REQUIRED = {"springs": {"stiffness"}, "ramp": {"to"}, "gravity": {"g"},
+             "impulse": {"amplitude", "t0", "sharpness"}, "tilt": {"a", "b", "j_t", "j_z"}}
+#: A scene file is a few lines; anything much longer is the wrong file.
+MAX_SCENE_BYTES = 1 << 20
 _BALANCER_FIELDS = {f.name for f in fields(Balancer)}
 _TILT_FIELDS = {f.name for f in fields(Tilt)}
+
+
+#: Most balls a scene file may ask for with ``balls``.
+MAX_BALLS = 64
 
 
 def balancer_from_dict(d: dict[str, Any], where: str = "scene") -> Balancer:
     known = {f.name for f in fields(Balancer)} | {"balls"}
     unknown = sorted(set(d) - known)
     if unknown:
-        raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)} "
-                         f"(allowed: {', '.join(sorted(known))})")
+        raise ParameterError(unknown[0], f"{where}: unknown key(s) {', '.join(unknown)} "
+                             f"(allowed: {', '.join(sorted(known))})",
+                             allowed=", ".join(sorted(known)))
     d = dict(d)
     balls = d.pop("balls", None)
     if balls is not None:
-        if isinstance(balls, bool) or not isinstance(balls, int) or balls < 1:
-            raise ValueError(f"balls: must be an integer >= 1, got {balls!r}")
+        balls = _check.integer("balls", balls, 1, MAX_BALLS)
         eta = d.get("eta", 1.0)
         if _is_number(eta):
             d["eta"] = (float(eta),) * balls
         elif not isinstance(eta, list) or len(eta) != balls:
-            raise ValueError(f"eta: must be one number or {balls} numbers (balls = {balls})")
+            raise ParameterError("eta", f"must be one number or {balls} numbers "
+                                 f"(balls = {balls})")
     return Balancer(**d).validate()
 
 
 def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
     if not isinstance(d, dict):
-        raise ValueError(f"{where}: a scene is a table of keys, got {type(d).__name__}")
+        raise ParameterTypeError("scene", f"{where}: a scene is a table of keys, got "
+                                 f"{type(d).__name__}")
+    if not d:
+        # An empty file is more likely a mistake than a request for the default scene.
+        raise ParameterError("scene", f"{where}: the scene is empty; give at least the "
+                             "balancer's keys (e.g. Omega = 1.2, balls = 2)")
     tables = {k for k, v in d.items() if isinstance(v, dict)}
     unknown = sorted(tables - set(_TABLES) - {"balancer"})
     if unknown:
-        raise ValueError(f"{where}: unknown table(s) {', '.join(unknown)} "
-                         f"(allowed: balancer, {', '.join(_TABLES)})")
+        raise ParameterError(unknown[0], f"{where}: unknown table(s) {', '.join(unknown)} "
+                             f"(allowed: balancer, {', '.join(_TABLES)})",
+                             allowed="balancer, " + ", ".join(_TABLES))
+    not_tables = sorted(set(_TABLES) & (set(d) - tables))
+    if not_tables:
+        k = not_tables[0]
+        raise ParameterTypeError(k, f"{where}: '{k}' must be a table ([{k}] with keys "
+                                 f"{', '.join(sorted(_TABLES[k]))})")
+    if "balancer" in d and "balancer" not in tables:
+        raise ParameterTypeError("balancer", f"{where}: 'balancer' must be a table")
     if "balancer" in tables:
         flat = sorted(set(d) - tables)
         if flat:
-            raise ValueError(f"{where}: key(s) {', '.join(flat)} outside a table; put the "
-                             "balancer's keys in [balancer]")
+            raise ParameterError(flat[0], f"{where}: key(s) {', '.join(flat)} outside a "
+                                 "table; put the balancer's keys in [balancer]")
         b = balancer_from_dict(d["balancer"], where)
     else:
         b = balancer_from_dict({k: v for k, v in d.items() if k not in tables}, where)
-    for t in tables & set(_TABLES):
+    for t in sorted(tables & set(_TABLES)):
         extra = sorted(set(d[t]) - _TABLES[t])
         if extra:
-            raise ValueError(f"{t}: unknown key(s) {', '.join(extra)} "
-                             f"(allowed: {', '.join(sorted(_TABLES[t]))})")
+            raise ParameterError(f"{t}.{extra[0]}", f"{t}: unknown key(s) {', '.join(extra)} "
+                                 f"(allowed: {', '.join(sorted(_TABLES[t]))})",
+                                 allowed=", ".join(sorted(_TABLES[t])))
+        missing = sorted(k for k in _REQUIRED[t] if k not in d[t])
+        if missing:
+            raise ParameterError(f"{t}.{missing[0]}", f"{where}: [{t}] needs "
+                                 f"{', '.join(missing)}")
     try:
         return Scene(
             balancer=b,
@@ -318,14 +343,36 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
             tilt=Tilt(**d["tilt"]) if "tilt" in d else None,
         )
     except (KeyError, TypeError) as e:
-        raise ValueError(f"{where}: incomplete effect table ({e})") from e
+        raise ParameterError("scene", f"{where}: incomplete effect table ({e})") from e
 
 
 def load_scene(path: str | os.PathLike[str]) -> Scene:
-    """A scene from a TOML file (see the module's description of the format)."""
+    """A scene from a TOML file (see the module's description of the format); a file
+    that cannot be read or is not a scene is a :class:`ParameterError` naming ``path``
+    (or the key at fault)."""
+    _check.path("path", path)
     try:
         with open(path, "rb") as f:
-            d = tomllib.load(f)
+            data = f.read(MAX_SCENE_BYTES + 1)
+    except OSError as e:
+        raise ParameterError("path", f"cannot read the scene file {path}: "
+                             f"{e.strerror or e}", value=path) from e
+    if len(data) > MAX_SCENE_BYTES:
+        raise ParameterError("path", f"{path} is larger than {MAX_SCENE_BYTES} bytes: not a "
+                             "scene file", value=path)
+    try:
+        d = tomllib.loads(data.decode("utf-8"))
+    except UnicodeDecodeError as e:
+        raise ParameterError("path", f"{path} is not UTF-8 text (a binary file, or another "
+                             f"encoding such as UTF-16): {e.reason} at byte {e.start}",
+                             value=path) from e
     except tomllib.TOMLDecodeError as e:
-        raise ValueError(f"scene: {path} is not valid TOML: {e}") from e
+        raise ParameterError("path", f"{path} is not valid TOML: {e}", value=path) from e
+    except RecursionError as e:
+        raise ParameterError("path", f"{path} nests tables or arrays too deeply to be a "
+                             "scene", value=path) from e
+    if not d:
+        # An empty file is more likely a mistake than a request for the default scene.
+        raise ParameterError("path", f"{path} holds no keys; give at least the balancer's "
+                             "(e.g. Omega = 1.2, balls = 2)", value=path)
     return scene_from_dict(d, where=str(path))

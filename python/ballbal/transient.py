@@ -10,8 +10,10 @@ from typing import Any
 import numpy as np
 import polars as pl
 
+from . import _check
 from .analysis import simulate
 from .balance import balanced_state
+from .exceptions import NotAutonomousError, ParameterError
 from .model import Balancer
 from .scene import Ramp, Scene
 
@@ -32,13 +34,14 @@ class DisturbanceResponse:
 def _balanced_start(model: Balancer | Scene) -> np.ndarray:
     """The stable balanced state at the starting speed, where the disturbance begins."""
     if isinstance(model, Scene) and model.time_dependence is not None:
-        raise ValueError(
-            f"scene: the disturbance brings its own spin change, so the scene must be "
-            f"autonomous, but it has '{model.time_dependence}'")
+        raise NotAutonomousError(
+            model.time_dependence,
+            f"disturbance_response: the disturbance brings its own spin change, so the "
+            f"scene must be autonomous, but it has '{model.time_dependence}'")
     e = balanced_state(model)
     if e is None or e.stability != "stable":
-        raise ValueError(
-            f"balancer: the balanced state must exist and be stable at the starting speed "
+        raise ParameterError(
+            "balancer", f"the balanced state must exist and be stable at the starting speed "
             f"Omega = {model.Omega} (eta >= 1/2 and above the resonance), so that the "
             "disturbance starts from rest")
     return np.asarray(e.q, dtype=float)
@@ -62,10 +65,15 @@ def disturbance_response(
     ``balancer`` may be an autonomous scene (ball springs, a tilting disk): it starts at
     its stable balanced state (:func:`balanced_state`), and ``final_r`` is then that of
     the balanced state at ``to``, not 0, where springs leave a residual whirl."""
-    if not band > 0:
-        raise ValueError(f"band: must be > 0, got {band}")
-    if not t_end > start + duration:
-        raise ValueError(f"t_end: must be after the disturbance ends ({start + duration})")
+    _check.model("balancer", balancer)
+    to = _check.real("to", to, 0.0, lo_open=True)
+    start = _check.real("start", start, 0.0)
+    duration = _check.real("duration", duration, 0.0, lo_open=True)
+    t_end = _check.real("t_end", t_end, start + duration, lo_open=True)
+    band = _check.real("band", band, 0.0, lo_open=True)
+    dt = _check.real("dt", dt, 0.0, lo_open=True)
+    rtol = _check.real("rtol", rtol)
+    _check.samples_count(t_end, dt, duration_name="t_end")
     q = _balanced_start(balancer)
     y0 = np.concatenate([q, np.zeros(q.size)])
     ramp = Ramp(to=to, start=start, duration=duration)
@@ -99,8 +107,9 @@ def track_damping_study(
     settling time / mean peak (so both terms count alike); ``optimal`` marks its
     minimum."""
     rows = []
-    for zb in zeta_b:
-        res = disturbance_response(balancer.replace(zeta_b=float(zb)), to, **kw)
+    _check.model("balancer", balancer)
+    for zb in _check.reals("zeta_b", zeta_b):
+        res = disturbance_response(balancer.replace(zeta_b=zb), to, **kw)
         rows.append({"zeta_b": float(zb), "peak": res.peak, "settle_time": res.settle_time,
                      "final_r": res.final_r})
     df = pl.DataFrame(rows, schema={"zeta_b": pl.Float64, "peak": pl.Float64,
@@ -129,7 +138,7 @@ class RunUp:
 
 
 def run_up(
-    scene: Scene,
+    scene: Scene | Balancer,
     to: float,
     duration: float,
     *,
@@ -142,16 +151,23 @@ def run_up(
     004's run-up) and measure the whirl and tilt. The rotor starts centred and flat, the
     balls at rest relative to the disk at angles ``balls``, in track order (default:
     spread over +-1 rad about the unbalance, where a classic balancer's balls make the
-    resonance worst)."""
-    if not duration > 0:
-        raise ValueError(f"duration: must be > 0, got {duration}")
-    if not settle >= 0:
-        raise ValueError(f"settle: must be >= 0, got {settle}")
+    resonance worst). A plain :class:`Balancer` runs up as a scene without effects."""
+    _check.model("scene", scene)
+    if isinstance(scene, Balancer):
+        scene = Scene(balancer=scene)
+    to = _check.real("to", to, 0.0, lo_open=True)
+    duration = _check.real("duration", duration, 0.0, lo_open=True)
+    settle = _check.real("settle", settle, 0.0)
+    dt = _check.real("dt", dt, 0.0, lo_open=True)
+    rtol = _check.real("rtol", rtol)
+    _check.samples_count(duration + settle, dt,
+                         duration_name="duration" if duration >= settle else "settle")
     n = scene.n_balls
     if balls is None:
         balls = list(np.linspace(-1.0, 1.0, n)) if n > 1 else [1.0]
+    balls = [_check.real("balls", x, finite=True) for x in _check.reals("balls", balls)]
     if len(balls) != n:
-        raise ValueError(f"balls: needs {n} angles, got {len(balls)}")
+        raise ParameterError("balls", f"needs {n} angles, got {len(balls)}")
     sc = replace(scene, ramp=Ramp(to=to, start=0.0, duration=duration))
     d = len(sc.coordinates)
     y0 = np.zeros(2 * d)

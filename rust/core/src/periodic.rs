@@ -11,20 +11,34 @@ use crate::model::{first_order_rhs, Dynamics};
 use crate::ode::{solve_at, Dopri5, Options};
 use std::f64::consts::PI;
 
-/// Which balls rotate (`true`) and which oscillate, parsed from e.g. `"RR"`, `"R-O"`.
+/// Which balls rotate (`true`) and which oscillate, from the canonical pattern: one
+/// letter per ball, `R` (rotating) or `O` (oscillating), joined by `-` (`"R-O"`; `"R"`
+/// for one ball), as `pattern_string` writes it and scan tables store it. Other
+/// spellings (`"RR"`, `"r-r"`, `" R-R "`) are refused with the canonical form, so a
+/// pattern given and the `type` column it produces are the same string.
 pub fn parse_pattern(pattern: &str, n_balls: usize) -> crate::Result<Vec<bool>> {
+    let example = vec!["R"; n_balls.max(1)].join("-");
+    let allowed = format!("{n_balls} letters R or O joined by '-', e.g. \"{example}\"");
     let letters: Vec<char> = pattern
         .chars()
-        .filter(|c| !matches!(c, '-' | ' ' | '_'))
+        .filter(|c| !matches!(c, '-' | ' ' | '_' | '\t'))
         .map(|c| c.to_ascii_uppercase())
         .collect();
-    if letters.len() != n_balls || letters.iter().any(|c| *c != 'R' && *c != 'O') {
-        return Err(crate::Error::param(
-            "pattern",
-            format!("must give R (rotating) or O (oscillating) for each of the {n_balls} balls, e.g. \"R-R\", got {pattern:?}"),
-        ));
+    let readable = letters.len() == n_balls && letters.iter().all(|c| *c == 'R' || *c == 'O');
+    let canonical = letters
+        .iter()
+        .map(|c| c.to_string())
+        .collect::<Vec<_>>()
+        .join("-");
+    if readable && canonical == pattern {
+        return Ok(letters.into_iter().map(|c| c == 'R').collect());
     }
-    Ok(letters.into_iter().map(|c| c == 'R').collect())
+    let message = if readable {
+        format!("write {pattern:?} as \"{canonical}\" (the canonical form)")
+    } else {
+        format!("must give R (rotating) or O (oscillating) for each of the {n_balls} balls, joined by '-', e.g. \"{example}\", got {pattern:?}")
+    };
+    Err(crate::Error::param_range("pattern", message, allowed))
 }
 
 /// The R/O pattern of the balls, which are the last `n_balls` coordinates.
@@ -768,6 +782,24 @@ mod tests {
             );
         }
         println!("grid worst defect {worst_defect:.3e}");
+    }
+
+    #[test]
+    fn parse_pattern_takes_only_the_canonical_form() {
+        assert_eq!(parse_pattern("R-O", 2).unwrap(), vec![true, false]);
+        assert_eq!(parse_pattern("O", 1).unwrap(), vec![false]);
+        assert_eq!(parse_pattern("R-R-O", 3).unwrap(), vec![true, true, false]);
+        for bad in ["RR", "r-r", " R-R ", "R_R", "R--R", "R-R-", "R- R"] {
+            let e = parse_pattern(bad, 2).unwrap_err().to_string();
+            assert!(e.contains("\"R-R\""), "{bad:?}: {e}");
+        }
+        for bad in ["R-X", "R", "R-R-R", "", "Ř-R"] {
+            let e = parse_pattern(bad, 2).unwrap_err();
+            assert!(
+                matches!(&e, crate::Error::InvalidParameter { name, .. } if name == "pattern"),
+                "{bad:?}: {e}"
+            );
+        }
     }
 
     fn thesis(om: f64, eta: f64) -> Planar {

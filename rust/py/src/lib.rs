@@ -141,24 +141,29 @@ fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
 fn autonomous_scene(p: &Planar, effects: Effects, what: &str) -> PyResult<Option<Scene>> {
     let s = scene(p, effects)?;
     if let Some(sc) = &s {
-        require_autonomous(sc).map_err(|e| match e {
-            Error::NotAutonomous { effect } => Python::attach(|py| {
-                let msg = format!("{what}: {}", Error::NotAutonomous { effect: effect.clone() });
-                py.import("ballbal.exceptions")
-                    .and_then(|m| m.getattr("NotAutonomousError"))
-                    .and_then(|c| c.call1((effect, msg.clone())))
-                    .map(PyErr::from_value)
-                    .unwrap_or_else(|_| PyValueError::new_err(msg))
-            }),
-            e => to_py(e),
-        })?;
+        require_autonomous(sc).map_err(|e| not_autonomous(e, what))?;
     }
     Ok(s)
 }
 
+/// `NotAutonomousError` with the analysis named in its message.
+fn not_autonomous(e: Error, what: &str) -> PyErr {
+    match e {
+        Error::NotAutonomous { effect } => Python::attach(|py| {
+            let msg = format!("{what}: {}", Error::NotAutonomous { effect: effect.clone() });
+            py.import("ballbal.exceptions")
+                .and_then(|m| m.getattr("NotAutonomousError"))
+                .and_then(|c| c.call1((effect, msg.clone())))
+                .map(PyErr::from_value)
+                .unwrap_or_else(|_| PyValueError::new_err(msg))
+        }),
+        e => to_py(e),
+    }
+}
+
 fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]> {
     a.as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{name}: must be a contiguous float64 array")))
+        .map_err(|_| to_py(Error::param(name, "must be a contiguous float64 array")))
 }
 
 /// `(y, theta, accepted_steps, rejected_steps, rhs_evals)` of [`simulate`].
@@ -173,7 +178,8 @@ type Simulated<'py> = (
 /// Integrates from `y0` and returns `(y, theta, accepted_steps, rejected_steps,
 /// rhs_evals)`, `y` of shape `(len(t_eval), 2 d)`, `theta` the disk's angle at `t_eval`.
 #[pyfunction]
-#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, y0, t0, t_eval, rtol, atol, effects=None))]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, y0, t0, t_eval, rtol, atol, effects=None,
+                    max_steps=10_000_000))]
 #[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
@@ -189,6 +195,7 @@ fn simulate<'py>(
     rtol: f64,
     atol: Vec<f64>,
     effects: Effects,
+    max_steps: usize,
 ) -> PyResult<Simulated<'py>> {
     let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
     let sc = scene(&p, effects)?;
@@ -197,6 +204,7 @@ fn simulate<'py>(
     let opts = Options {
         rtol,
         atol,
+        max_steps,
         ..Default::default()
     };
     let traj = guarded(py, || match &sc {
@@ -263,8 +271,7 @@ fn balanced_states<'py>(
             Some(s) => s,
             None => Scene::new(p, 0.0, None, 0.0, None, None).map_err(to_py)?,
         };
-        require_autonomous(&sc)
-            .map_err(|e| PyValueError::new_err(format!("balanced_state: {e}")))?;
+        require_autonomous(&sc).map_err(|e| not_autonomous(e, "balanced_state"))?;
         scenes.push(sc);
     }
     // Each point is solved on its own from the planar perfect balance, so the result
@@ -560,9 +567,13 @@ fn orbit_closure(
     let c = slice(&coeffs, "coeffs")?.to_vec();
     let d = winding.len();
     if d == 0 || c.len() % d != 0 || (c.len() / d) % 2 != 1 {
-        return Err(PyValueError::new_err(
-            "coeffs: need (n + 2) x (2 N + 1) values",
-        ));
+        return Err(to_py(Error::param(
+            "coeffs",
+            format!(
+                "need {d} x (2 N + 1) values (one row per coordinate), got {}",
+                c.len()
+            ),
+        )));
     }
     let n_harm = (c.len() / d - 1) / 2;
     let sol = HbSolution::start(sol_omega, c, winding, n_harm, Status::Converged);
@@ -890,7 +901,7 @@ fn certificate_seconds() -> f64 {
 #[pyfunction]
 fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
     if lens.is_empty() || lens.contains(&0) {
-        return Err(PyValueError::new_err("grid: every parameter needs values"));
+        return Err(to_py(Error::param("grid", "every parameter needs values")));
     }
     Ok(ballbal_core::scan::default_chunk(&lens))
 }

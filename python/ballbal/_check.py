@@ -1,0 +1,254 @@
+"""Type checks of the public functions' arguments, before anything reaches the core.
+
+Python's own conversions fail with messages that do not name the parameter (``float("a")``:
+"could not convert string to float"), turn ``True`` into 1 and ``2.5`` into 2 without a
+word, and pyo3 raises ``OverflowError`` for a negative count. These helpers refuse such
+values with a :class:`ParameterTypeError` / :class:`ParameterError` that names the
+parameter and its allowed range. Value ranges that the core checks where it consumes the
+value stay in the core; the integer ranges here are the core's own, stated once more
+only so that a negative or huge count never reaches the conversion to ``usize``.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from .exceptions import ParameterError, ParameterTypeError
+
+#: Most points of a scan grid whose table is held in memory (a row of about 25 columns
+#: takes some 300 bytes: about 1.5 GB at this size); a scan streamed to ``out=`` holds
+#: one chunk at a time.
+MAX_GRID_POINTS = 5 * 10**6
+#: Most points of a scan grid streamed to a directory with ``out=``.
+MAX_STREAMED_POINTS = 10**9
+#: Most values of one scan axis (every axis's values are held, checked and stored in
+#: the scan directory's ``meta.json``).
+MAX_AXIS_VALUES = 10**6
+#: Most output times of one simulation (each a row of the returned table).
+MAX_SAMPLES = 10**7
+#: Most threads a scan may start.
+MAX_THREADS = 1024
+#: Largest integer a count may be (the core's counts are 64-bit).
+_MAX_COUNT = 2**62
+
+
+def _range_text(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> str:
+    def fmt(v: float) -> str:
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return f"{v:g}" if isinstance(v, float) else str(v)
+    return f"{'(' if lo_open else '['}{fmt(lo)}, {fmt(hi)}{')' if hi_open else ']'}"
+
+
+def is_real(v: Any) -> bool:
+    """A real number (numpy scalars included); a bool is not a parameter value."""
+    return isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_))
+
+
+def real(name: str, v: Any, lo: float = -math.inf, hi: float = math.inf, *,
+         lo_open: bool = False, hi_open: bool = False, finite: bool = False) -> float:
+    """``v`` as a float. Without bounds only the type is checked (the core checks the
+    value); with bounds (or ``finite``) the value must be finite and inside them."""
+    if not is_real(v):
+        raise ParameterTypeError(name, f"must be a number, got {type(v).__name__} {v!r:.60}",
+                                 value=v)
+    try:
+        x = float(v)
+    except OverflowError as e:  # an int beyond the float range
+        raise ParameterError(name, "is too large for a float", value=v) from e
+    bounded = finite or lo > -math.inf or hi < math.inf
+    if bounded:
+        ok = (math.isfinite(x) and (x > lo if lo_open else x >= lo)
+              and (x < hi if hi_open else x <= hi))
+        if not ok:
+            allowed = _range_text(lo, hi, lo_open, hi_open)
+            raise ParameterError(name, f"must be a finite number in {allowed}, got {x}",
+                                 allowed=allowed, value=v)
+    return x
+
+
+def integer(name: str, v: Any, lo: int = 0, hi: int = _MAX_COUNT) -> int:
+    """``v`` as an int in ``[lo, hi]``; floats (even 2.0), bools and strings are refused."""
+    if not isinstance(v, (numbers.Integral, np.integer)) or isinstance(v, (bool, np.bool_)):
+        raise ParameterTypeError(
+            name, f"must be an integer in {_range_text(lo, hi)}, got {type(v).__name__} "
+            f"{v!r:.60}", allowed=_range_text(lo, hi), value=v)
+    i = int(v)
+    if not lo <= i <= hi:
+        raise ParameterError(name, f"must be an integer in {_range_text(lo, hi)}, got {i}",
+                             allowed=_range_text(lo, hi), value=v)
+    return i
+
+
+def optional_integer(name: str, v: Any, lo: int = 0, hi: int = _MAX_COUNT) -> int | None:
+    return None if v is None else integer(name, v, lo, hi)
+
+
+def boolean(name: str, v: Any) -> bool:
+    """A bool (numpy's too); ``"no"`` or ``0`` are refused rather than read as truth values."""
+    if not isinstance(v, (bool, np.bool_)):
+        raise ParameterTypeError(name, f"must be True or False, got {v!r:.60}", value=v)
+    return bool(v)
+
+
+def string(name: str, v: Any) -> str:
+    if not isinstance(v, str):
+        raise ParameterTypeError(name, f"must be a string, got {type(v).__name__} {v!r:.60}",
+                                 value=v)
+    return v
+
+
+def model(name: str, v: Any) -> Any:
+    """A :class:`Balancer` or :class:`Scene` (what every analysis takes first)."""
+    from .model import Balancer
+    from .scene import Scene
+
+    if not isinstance(v, (Balancer, Scene)):
+        raise ParameterTypeError(
+            name, f"must be a ballbal.Balancer or ballbal.Scene, got {type(v).__name__}",
+            value=v)
+    return v
+
+
+def array(name: str, v: Any) -> np.ndarray:
+    """A flat float64 array of finite or non-finite numbers (the core checks values)."""
+    if isinstance(v, (str, bytes)) or v is None:
+        raise ParameterTypeError(name, f"must be a sequence of numbers, got {v!r:.60}",
+                                 value=v)
+    try:
+        a = np.asarray(v)
+        if a.dtype == object or a.dtype.kind not in "iuf":
+            raise TypeError(a.dtype)
+        return np.ascontiguousarray(a, dtype=np.float64).ravel()
+    except (TypeError, ValueError, OverflowError) as e:
+        raise ParameterTypeError(name, f"must be a sequence of numbers, got {v!r:.60}",
+                                 value=v) from e
+
+
+def reals(name: str, v: Any) -> list[float]:
+    """One number or a sequence of numbers, as a list."""
+    if is_real(v):
+        return [real(name, v)]
+    return [float(x) for x in array(name, v)]
+
+
+def path(name: str, v: Any) -> str | os.PathLike[str]:
+    """A file or directory name: a non-empty string or path object. An empty name would
+    mean the current directory, which is never what was meant."""
+    if not isinstance(v, (str, os.PathLike)):
+        raise ParameterTypeError(name, f"must be a path (str or os.PathLike), got "
+                                 f"{type(v).__name__}", value=v)
+    s = os.fspath(v)
+    if not isinstance(s, str) or not s.strip():
+        raise ParameterError(name, "must be a non-empty path", value=v)
+    if "\0" in s:
+        raise ParameterError(name, "must not contain a NUL character", value=v)
+    return v
+
+
+def patterns(name: str, v: Any) -> tuple[str, ...]:
+    """Solution types for a scan: one string or a sequence of strings, no repeats (a
+    repeated type would give two rows, converged and not_found, for one point)."""
+    if isinstance(v, str):
+        v = (v,)
+    if not isinstance(v, Sequence) and not isinstance(v, (set, frozenset, np.ndarray)):
+        raise ParameterTypeError(name, f"must be a list of solution types such as ['R-R'], "
+                                 f"got {type(v).__name__}", value=v)
+    out = tuple(v)
+    for p in out:
+        string(name, p)
+    seen: set[str] = set()
+    for p in out:
+        if p in seen:
+            raise ParameterError(name, f"{p!r} is given twice", value=v)
+        seen.add(p)
+    return out
+
+
+def samples_count(duration: float, dt: float, *, duration_name: str, dt_name: str = "dt") -> int:
+    """Number of output times of ``arange(0, duration, dt)``, refused before it is
+    allocated when above :data:`MAX_SAMPLES`."""
+    count = math.floor(duration / dt) + 1
+    if count > MAX_SAMPLES:
+        raise ParameterError(
+            duration_name, f"{duration:g} time units at {dt_name} = {dt:g} would give "
+            f"{count:.3g} output times, at most {MAX_SAMPLES:.0e}: shorten it or raise {dt_name}",
+            allowed=f"at most {MAX_SAMPLES:.0e} output times", value=duration)
+    return count
+
+
+def grid_points(counts: Sequence[int], names: Sequence[str], streamed: bool) -> int:
+    """The number of grid points, refused when above the limit for a table held in
+    memory (:data:`MAX_GRID_POINTS`) or streamed to ``out=`` (:data:`MAX_STREAMED_POINTS`)."""
+    for name, c in zip(names, counts, strict=True):
+        if c > MAX_AXIS_VALUES:
+            raise ParameterError(name, f"{c} values, at most {MAX_AXIS_VALUES:.0e} per axis",
+                                 allowed=f"at most {MAX_AXIS_VALUES:.0e} values", value=c)
+    limit = MAX_STREAMED_POINTS if streamed else MAX_GRID_POINTS
+    total = math.prod(counts)
+    if total > limit:
+        # Name the longest axis: the one to cut.
+        k = max(range(len(counts)), key=lambda i: counts[i])
+        where = "streamed to out=" if streamed else "held in memory (without out=)"
+        raise ParameterError(
+            names[k], f"the grid has {total:.3g} points, at most {limit:.0e} for a scan "
+            f"{where}", allowed=f"at most {limit:.0e} grid points", value=total)
+    return total
+
+
+def axis_count(name: str, steps: float) -> int:
+    """The number of values ``floor(steps) + 1`` of a ``(start, stop, step)`` axis with
+    ``steps = (stop - start) / step``, refused before they are made when this axis alone
+    exceeds :data:`MAX_AXIS_VALUES`."""
+    if not steps < MAX_AXIS_VALUES:  # also inf and NaN
+        raise ParameterError(
+            name, f"(start, stop, step) gives {steps + 1:.3g} values, at most "
+            f"{MAX_AXIS_VALUES:.0e} per axis", value=steps,
+            allowed=f"at most {MAX_AXIS_VALUES:.0e} values")
+    return int(math.floor(steps + 1e-9)) + 1
+
+
+def scan_arguments(balancer: Any, *, patterns: Any, N_max: Any, samples: Any, max_iter: Any,
+                   max_steps: Any, seeds: Any, starts: Any, chunk: Any, threads: Any,
+                   out: Any, hill: Any, floquet: Any, reals: dict[str, Any]) -> tuple[str, ...]:
+    """The type checks of :func:`ballbal.scan`'s arguments (value ranges the core checks
+    are left to it); returns the patterns as a tuple of distinct strings."""
+    model("balancer", balancer)
+    integer("N_max", N_max, 1, 256)
+    optional_integer("samples", samples, 1, 1 << 16)
+    integer("max_iter", max_iter, 1, 10_000)
+    integer("max_steps", max_steps, 1)
+    integer("seeds", seeds, 1, 10_000)
+    integer("starts", starts, 1, 10_000)
+    optional_integer("chunk", chunk, 1)
+    optional_integer("threads", threads, 1, MAX_THREADS)
+    if out is not None:
+        path("out", out)
+    boolean("hill", hill)
+    boolean("floquet", floquet)
+    for k, v in reals.items():
+        real(k, v)
+    p = _patterns_arg("patterns", patterns)
+    if not p:
+        raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
+    return p
+
+
+_patterns_arg = patterns
+
+
+def sequence(name: str, v: Any) -> list[Any]:
+    """The items of a list or tuple (or array); a string or a scalar is refused."""
+    if isinstance(v, (str, bytes)) or not isinstance(v, (Sequence, np.ndarray)):
+        raise ParameterTypeError(name, f"must be a list of values, got {type(v).__name__}",
+                                 value=v)
+    items = list(v)
+    if not items:
+        raise ParameterError(name, "must hold at least one value", value=v)
+    return items
