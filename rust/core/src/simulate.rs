@@ -81,7 +81,10 @@ mod tests {
         // Far more than 50 steps of the fastest motion (period ~ 5) fit in 1e4.
         match simulate(&p, &y0, 0.0, &[1e4], &opts) {
             Err(Error::Integration(m)) => assert!(m.contains("max_steps = 50"), "{m}"),
-            other => panic!("expected the budget to run out, got {:?}", other.map(|t| t.stats)),
+            other => panic!(
+                "expected the budget to run out, got {:?}",
+                other.map(|t| t.stats)
+            ),
         }
         opts.max_steps = 0;
         assert!(matches!(

@@ -150,7 +150,12 @@ fn autonomous_scene(p: &Planar, effects: Effects, what: &str) -> PyResult<Option
 fn not_autonomous(e: Error, what: &str) -> PyErr {
     match e {
         Error::NotAutonomous { effect } => Python::attach(|py| {
-            let msg = format!("{what}: {}", Error::NotAutonomous { effect: effect.clone() });
+            let msg = format!(
+                "{what}: {}",
+                Error::NotAutonomous {
+                    effect: effect.clone()
+                }
+            );
             py.import("ballbal.exceptions")
                 .and_then(|m| m.getattr("NotAutonomousError"))
                 .and_then(|c| c.call1((effect, msg.clone())))
