@@ -243,12 +243,13 @@ def scan_arguments(balancer: Any, *, patterns: Any, N_max: Any, samples: Any, ma
 _patterns_arg = patterns
 
 
-def sequence(name: str, v: Any) -> list[Any]:
-    """The items of a list or tuple (or array); a string or a scalar is refused."""
+def sequence(name: str, v: Any, *, empty: bool = False) -> list[Any]:
+    """The items of a list or tuple (or array); a string or a scalar is refused, and so
+    is an empty one unless ``empty`` (where an empty list means "none of these")."""
     if isinstance(v, (str, bytes)) or not isinstance(v, (Sequence, np.ndarray)):
         raise ParameterTypeError(name, f"must be a list of values, got {type(v).__name__}",
                                  value=v)
     items = list(v)
-    if not items:
+    if not items and not empty:
         raise ParameterError(name, "must hold at least one value", value=v)
     return items

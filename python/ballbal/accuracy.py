@@ -75,11 +75,11 @@ def accuracy_cost(
     """
     _check.model("balancer", balancer)
     _check.string("pattern", pattern)
-    N = [_check.integer("N", n, 1, 256) for n in _check.sequence("N", N)]
+    N = [_check.integer("N", n, 1, 256) for n in _check.sequence("N", N, empty=True)]
     multiples = [_check.real("samples", m, 0.0, 1 << 16, lo_open=True)
-                 for m in _check.sequence("samples", samples)]
-    tol = [_check.real("tol", t) for t in _check.sequence("tol", tol)]
-    rtol = [_check.real("rtol", r) for r in _check.sequence("rtol", rtol)]
+                 for m in _check.sequence("samples", samples, empty=True)]
+    tol = [_check.real("tol", t) for t in _check.sequence("tol", tol, empty=True)]
+    rtol = [_check.real("rtol", r) for r in _check.sequence("rtol", rtol, empty=True)]
     base_N = _check.integer("base_N", base_N, 1, 256)
     reference_N = _check.integer("reference_N", reference_N, 1, 256)
     neighbour = _check.real("neighbour", neighbour, finite=True)
