@@ -634,6 +634,10 @@ def _run(job: _Job, store: _Store | None, executor: Any, threads: int | None,
         elif todo:
             job.native(todo, local_threads, lambda c, d: keep(c, _frame(job.names, d)))
     except KeyboardInterrupt:
+        if store is not None:
+            # Ctrl-C can land between a chunk's atomic rename and `finished.add`: a
+            # file that exists is whole, so it belongs to the table returned now.
+            finished |= {c for c in todo if store.file(c).exists()}
         warnings.warn(
             ScanInterrupted(
                 f"scan interrupted: {len(finished)} of {n} chunks finished"
