@@ -565,6 +565,11 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
     let mut rn = max_abs(&r);
     let scale0 = max_abs(&x).max(1.0);
     for it in 1..=opts.max_iter {
+        // A cancelled solve's result is discarded by whoever cancelled it (see `cancel`).
+        if crate::cancel::cancelled() {
+            finish(&x, &mut out, Status::MaxIterations, rn, f64::INFINITY, it - 1);
+            return out;
+        }
         if !rn.is_finite() {
             finish(&x, &mut out, Status::Diverged, rn, f64::INFINITY, it - 1);
             return out;
