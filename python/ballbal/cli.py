@@ -195,6 +195,9 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as e:
         print(f"ballbal: error: {e}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("ballbal: interrupted", file=sys.stderr)
+        return 130
     return 0
 
 

@@ -437,6 +437,11 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let (om2, g) = (om * om, &mut self.g);
         for j in 0..d {
             for k in 0..d {
+                // A block takes a fraction of a second at hundreds of harmonics; a
+                // cancelled solve stops at the next Newton iteration (see `cancel`).
+                if crate::cancel::cancelled() {
+                    return;
+                }
                 // Skip blocks where the coordinates do not interact at all.
                 let idx = j * d + k;
                 let any = (0..s).any(|i| {

@@ -61,6 +61,12 @@ const STIFF_CALM: usize = 6;
 /// steps than this (seconds of work): an explicit method that is merely stability-limited
 /// for a short time still gives the right answer, just with small steps.
 const STIFF_STEPS_LEFT: f64 = 1e6;
+/// After this many steps the integrator forecasts, from its average step so far, the
+/// steps still needed, and stops when they exceed `FORECAST_FACTOR` times `max_steps`
+/// (an error in a second instead of after the whole step budget: a motion far faster
+/// than the time span, or a time span far too long).
+const FORECAST_AFTER: usize = 20_000;
+const FORECAST_FACTOR: f64 = 10.0;
 
 /// Tolerances and limits, named as in scipy.
 #[derive(Debug, Clone)]
@@ -321,6 +327,16 @@ impl Dopri5 {
                     calm += 1;
                     if calm >= STIFF_CALM {
                         stiff_run = 0;
+                    }
+                }
+                if stats.accepted >= FORECAST_AFTER && stats.accepted % 1024 == 0 && !last {
+                    let need = (t1 - t_new).abs() / ((t_new - t0).abs() / stats.accepted as f64);
+                    if need > FORECAST_FACTOR * opts.max_steps as f64 {
+                        return Err(Error::Integration(format!(
+                            "at the average step so far ({:.3e}) reaching t = {t1} needs about {need:.2e} more steps, far more than max_steps = {} (reached t = {t_new})",
+                            (t_new - t0).abs() / stats.accepted as f64,
+                            opts.max_steps
+                        )));
                     }
                 }
                 // Dense output is formed only when the observer interpolates.
@@ -608,6 +624,28 @@ mod tests {
         // Not stiff at all.
         let (ys, _) = solve_at(osc, 0.0, &[1.0, 0.0], &[1e4], &opts).unwrap();
         assert!(ys[0][0].is_finite());
+    }
+
+    #[test]
+    fn hopeless_step_budgets_fail_early() {
+        // A fast rotation whose steps are limited by accuracy, not stability: not stiff,
+        // but 1e3 time units need ~1e9 steps against a budget of 1e7.
+        let t = std::time::Instant::now();
+        let r = solve_at(
+            |_, y: &[f64], dy: &mut [f64]| {
+                dy[0] = 1e6 * y[1];
+                dy[1] = -1e6 * y[0];
+            },
+            0.0,
+            &[1.0, 0.0],
+            &[1000.0],
+            &Options::new(1e-6, 1e-9),
+        );
+        assert!(matches!(r, Err(Error::Integration(_))), "{r:?}");
+        assert!(t.elapsed().as_secs_f64() < 2.0);
+        // An absurd time span for a plain oscillator.
+        let r = solve_at(osc, 0.0, &[1.0, 0.0], &[1e300], &Options::default());
+        assert!(matches!(r, Err(Error::Integration(_))), "{r:?}");
     }
 
     #[test]
