@@ -372,7 +372,12 @@ fn balanced_states<'py>(
         let tok = cancel::current();
         Ok(scenes
             .par_iter()
-            .map(|s| cancel::with(tok.clone(), || s.balanced_state()))
+            .map(|s| {
+                // Each point is short: stop between points once cancelled.
+                cancel::with(tok.clone(), || {
+                    (!cancel::cancelled()).then(|| s.balanced_state()).flatten()
+                })
+            })
             .collect::<Vec<_>>())
     })?;
     eqs.into_iter()
