@@ -19,6 +19,10 @@ def simulate(
     y0: npt.NDArray[np.float64], t0: float, t_eval: npt.NDArray[np.float64], rtol: float,
     atol: list[float], effects: Effects = None, max_steps: int = 10_000_000,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
+def validate(
+    mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
+    effects: Effects = None,
+) -> None: ...
 def equilibria(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     effects: Effects = None,

@@ -117,6 +117,9 @@ class Equilibrium:
     neutral: int
     routh_hurwitz: bool | None
     char_poly: np.ndarray
+    #: False when the search's start budget (``max(600, 25 n)`` starts from 5 balls on)
+    #: cut it short: other equilibria may exist.
+    exhaustive: bool = True
 
 
 def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
@@ -127,7 +130,12 @@ def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
     track order (``b_1 <= ... <= b_n <= b_1 + 2 pi``: balls cannot pass each other),
     ``b_1`` in ``(-pi, pi]``, and identical balls relabelled round the ring count once;
     the one that continues the perfect balance (:func:`balanced_state`) is ``"balanced"``.
-    Scenes with a ramp, gravity or an impulse have none (an error naming the effect)."""
+    Scenes with a ramp, gravity or an impulse have none (an error naming the effect).
+
+    From three balls on the perfect balances form a family (``neutral > 0``), reported
+    once by one of its points. Up to four balls every start of a lattice is tried; from
+    five on the search tries ``max(600, 25 n)`` starts (balls together, then a
+    low-discrepancy sequence) and says so with ``exhaustive=False``."""
     _check.model("balancer", balancer)
     return [_equilibrium(d)
             for d in _native.equilibria(*balancer.native_args(), balancer.native_effects())]
@@ -138,7 +146,7 @@ def _equilibrium(d: dict[str, Any]) -> Equilibrium:
         kind=d["kind"], q=d["q"], residual=d["residual"],
         eigenvalues=d["eig_re"] + 1j * d["eig_im"], stability_index=d["index"],
         stability=d["stability"], neutral=d["neutral"], routh_hurwitz=d["routh_hurwitz"],
-        char_poly=d["char_poly"],
+        char_poly=d["char_poly"], exhaustive=d.get("exhaustive", True),
     )
 
 

@@ -294,6 +294,9 @@ def main(argv: list[str] | None = None) -> int:
     except BallbalError as e:
         # The numerics failed (IntegrationError, ...): not a usage error.
         return _report(e, 1)
+    except KeyboardInterrupt:
+        print("ballbal: interrupted", file=sys.stderr)
+        return 130
     return 0
 
 

@@ -82,9 +82,10 @@ class Balancer:
         return replace(self, **changes)
 
     def validate(self) -> Balancer:
+        """Check the parameters (the core's own checks, no analysis) and return self."""
         from . import _native
 
-        _native.equilibria(*self.native_args())
+        _native.validate(*self.native_args())
         return self
 
     @classmethod

@@ -52,6 +52,10 @@ pub struct Equilibrium {
     pub routh_hurwitz: Option<bool>,
     /// Characteristic polynomial, monic, highest power first (`a_0 = 1, ..., a_2d`).
     pub char_poly: Vec<f64>,
+    /// Whether the search that found it tried every start of its lattice (see
+    /// [`start_budget`]); `false`: the budget cut the search short and other
+    /// equilibria may exist. Always `true` for closed forms and single analyses.
+    pub exhaustive: bool,
 }
 
 /// Tolerance on the largest real part below which the verdict is `Marginal`.
@@ -116,7 +120,13 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
     } else {
         Verdict::Marginal
     };
-    let poly = char_poly(&k, &c, &m, d);
+    // The cofactor expansion's cost depends on the matrices' zero pattern and explodes
+    // past a few balls (0.2 s per equilibrium at 24 balls): beyond it, Hessenberg.
+    let poly = if d <= CHAR_POLY_COFACTOR_MAX {
+        char_poly(&k, &c, &m, d)
+    } else {
+        char_poly_hessenberg(&a, 2 * d)
+    };
     let rh = if neutral == 0 {
         Some(routh_hurwitz(&poly))
     } else {
@@ -141,6 +151,7 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
         neutral,
         routh_hurwitz: rh,
         char_poly: poly,
+        exhaustive: true,
     }
 }
 
@@ -154,11 +165,11 @@ fn classify(q: &[f64], o: usize) -> &'static str {
     if q[..o].iter().all(|v| v.abs() < 1e-6) {
         return "perfect_balance";
     }
+    if q.len() > o + 1 && q[o + 1..].iter().all(|&b| wrap(b - q[o]).abs() < 1e-7) {
+        return "together";
+    }
     if q.len() == o + 2 {
         let diff = wrap(q[o] - q[o + 1]);
-        if diff.abs() < 1e-7 {
-            return "together";
-        }
         if (diff.abs() - PI).abs() < 1e-7 {
             return "opposite";
         }
@@ -279,21 +290,36 @@ pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
     equilibria_of(p, equal_balls(p), true)
 }
 
-/// All equilibria of any autonomous model, by Newton from a deterministic set of starts.
-/// `equal`: the balls are identical (states that differ by relabelling are one);
-/// `family`: see [`analyse_model`].
+/// All equilibria of any autonomous model, by Newton from a deterministic set of starts
+/// (see [`starts`]). `equal`: the balls are identical (states that differ by relabelling
+/// are one); `family`: see [`analyse_model`]. With `family`, the perfect balances of three
+/// or more balls are one `(n - 2)`-parameter family: every start would land on another
+/// point of it, so it is reported once, by the first point found (`neutral > 0`).
 pub fn equilibria_of<D: Dynamics + ?Sized>(p: &D, equal: bool, family: bool) -> Vec<Equilibrium> {
     let mut found: Vec<(Vec<f64>, String)> = vec![];
     let o = p.first_ball();
-    for q0 in starts(p.ndof() - o, o) {
+    let n = p.ndof() - o;
+    let one_family = family && n >= 3;
+    let (starts, exhaustive) = starts(n, o);
+    for q0 in starts {
+        if crate::cancel::cancelled() {
+            break;
+        }
         if let Some(q) = newton_static(p, &q0) {
-            if !found.iter().any(|(f, _)| same_equilibrium(equal, o, f, &q)) {
-                let kind = classify(&q, o).to_string();
-                found.push((q, kind));
+            let kind = classify(&q, o);
+            if one_family && kind == "perfect_balance" {
+                if found.iter().any(|(_, k)| k == "perfect_balance") {
+                    continue;
+                }
+            } else if found.iter().any(|(f, _)| same_equilibrium(equal, o, f, &q)) {
+                continue;
             }
+            found.push((q, kind.to_string()));
         }
     }
-    sorted_analysed(p, found, family)
+    let mut out = sorted_analysed(p, found, family);
+    out.iter_mut().for_each(|e| e.exhaustive = exhaustive);
+    out
 }
 
 /// Equilibria of a model whose ball angles count turns (a ring of ball springs), found
@@ -313,6 +339,9 @@ pub fn equilibria_in_track_order<D: Dynamics + ?Sized>(
     let n = p.ndof() - o;
     let mut found: Vec<(Vec<f64>, String)> = vec![];
     for q0 in extra.iter().cloned().chain(ordered_starts(n, o)) {
+        if crate::cancel::cancelled() {
+            break;
+        }
         let Some(mut q) = newton_static(p, &q0) else {
             continue;
         };
@@ -345,6 +374,9 @@ pub fn equilibria_in_track_order<D: Dynamics + ?Sized>(
     found
 }
 
+/// Most starts of the track-order search.
+const ORDERED_STARTS_MAX: usize = 600;
+
 /// Starts in track order: the first ball at `per` angles, the others at increasing
 /// offsets from it drawn from a lattice of `m` points on `(0, 2 pi)`.
 fn ordered_starts(n: usize, o: usize) -> Vec<Vec<f64>> {
@@ -355,29 +387,36 @@ fn ordered_starts(n: usize, o: usize) -> Vec<Vec<f64>> {
         4 => (4, 8),
         _ => (2, n + 3),
     };
-    // Offsets: all increasing (n - 1)-subsets of the lattice, in lexicographic order.
+    // Offsets: increasing (n - 1)-subsets of the lattice, in lexicographic order, only
+    // as many as can be used (all C(n + 3, n - 1) of them were built before the cap:
+    // 20 million vectors and 45 s for 24 balls).
     let lattice: Vec<f64> = (0..m)
         .map(|k| 2.0 * PI * (k as f64 + 0.37) / m as f64)
         .collect();
-    let mut subsets: Vec<Vec<usize>> = vec![vec![]];
-    for _ in 1..n {
-        subsets = subsets
-            .into_iter()
-            .flat_map(|s| {
-                let from = s.last().map_or(0, |&l| l + 1);
-                (from..m).map(move |k| {
-                    let mut t = s.clone();
-                    t.push(k);
-                    t
-                })
-            })
-            .collect();
+    let k = n - 1;
+    let mut subsets: Vec<Vec<usize>> = vec![];
+    let mut c: Vec<usize> = (0..k).collect();
+    if k <= m {
+        loop {
+            subsets.push(c.clone());
+            if subsets.len() >= ORDERED_STARTS_MAX {
+                break;
+            }
+            // next combination: the rightmost entry that can grow, and the rest after it
+            let Some(i) = (0..k).rev().find(|&i| c[i] < m - k + i) else {
+                break;
+            };
+            c[i] += 1;
+            for j in i + 1..k {
+                c[j] = c[j - 1] + 1;
+            }
+        }
     }
     let mut out = vec![];
     'outer: for i in 0..per {
         let b1 = -PI + (i as f64 + 0.1) * 2.0 * PI / per as f64;
         for s in &subsets {
-            if out.len() >= 600 {
+            if out.len() >= ORDERED_STARTS_MAX {
                 break 'outer;
             }
             let mut q = vec![0.0; o + n];
@@ -446,26 +485,77 @@ fn sorted_analysed<D: Dynamics + ?Sized>(
         .collect()
 }
 
-fn starts(n: usize, o: usize) -> Vec<Vec<f64>> {
-    let per = match n {
+/// Most starts of the lattice search before it is cut to [`start_budget`].
+const LATTICE_MAX: u64 = 600;
+
+/// Newton starts of the equilibrium search for `n` balls: the whole lattice of `per^n`
+/// ball angles while it has at most [`LATTICE_MAX`] points (n <= 4: 24, 144, 216, 256
+/// starts); for more balls [`start_budget`] starts: every ball together at 24 angles,
+/// then a low-discrepancy (Kronecker) sequence over the torus of ball angles, so that
+/// every ball varies (a prefix of the lattice would move only the first few). Returns the
+/// starts and whether they are the whole lattice.
+fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
+    let per: u64 = match n {
         1 => 24,
         2 => 12,
         3 => 6,
         _ => 4,
     };
-    let total = (per as u64).pow(n as u32).min(600) as usize;
+    // 4^32 overflowed a u64 to 0 starts: equilibria() was empty from 32 balls on.
+    let lattice = u32::try_from(n)
+        .ok()
+        .and_then(|e| per.checked_pow(e))
+        .filter(|&t| t <= LATTICE_MAX);
+    if let Some(total) = lattice {
+        let per = per as usize;
+        let mut out = vec![];
+        for idx in 0..total as usize {
+            let mut q = vec![0.0; n + o];
+            let mut rem = idx;
+            for i in 0..n {
+                // Offset so that no start sits exactly on a symmetric (singular) point.
+                q[o + i] =
+                    -PI + (rem % per) as f64 * 2.0 * PI / per as f64 + 0.1 + 0.01 * i as f64;
+                rem /= per;
+            }
+            out.push(q);
+        }
+        return (out, true);
+    }
+    let budget = start_budget(n);
     let mut out = vec![];
-    for idx in 0..total {
+    for k in 0..24 {
         let mut q = vec![0.0; n + o];
-        let mut rem = idx;
+        let b = -PI + (k as f64 + 0.1) * 2.0 * PI / 24.0;
+        q[o..].iter_mut().for_each(|v| *v = b);
+        out.push(q);
+    }
+    // Roberts' R_n sequence: alpha_i = g^-(i+1), g the root of g^(n+1) = g + 1.
+    let mut g = 2.0f64;
+    for _ in 0..60 {
+        g = (1.0 + g).powf(1.0 / (n as f64 + 1.0));
+    }
+    let alpha: Vec<f64> = (0..n).map(|i| g.powi(-(i as i32 + 1))).collect();
+    for k in 1..=budget.saturating_sub(out.len()) {
+        let mut q = vec![0.0; n + o];
         for i in 0..n {
-            // Offset so that no start sits exactly on a symmetric (singular) point.
-            q[o + i] = -PI + (rem % per) as f64 * 2.0 * PI / per as f64 + 0.1 + 0.01 * i as f64;
-            rem /= per;
+            q[o + i] = -PI + 2.0 * PI * (0.5 + k as f64 * alpha[i]).fract();
         }
         out.push(q);
     }
-    out
+    (out, false)
+}
+
+/// Newton starts the equilibrium search tries for `n` balls when the lattice is too
+/// large (n >= 5): `max(600, 25 n)`, so that the search stays within seconds (each start
+/// costs one least-squares Newton solve, O(n^3)) while growing with the number of balls.
+pub fn start_budget(n: usize) -> usize {
+    600usize.max(25 * n)
+}
+
+/// Whether [`equilibria`] tries every start of its lattice for `n` balls (n <= 4).
+pub fn search_is_exhaustive(n: usize) -> bool {
+    starts(n, 0).1
 }
 
 // ---------- characteristic polynomial and Routh–Hurwitz ----------
@@ -527,6 +617,42 @@ pub fn char_poly(k: &[f64], c: &[f64], m: &[f64], d: usize) -> Vec<f64> {
     p
 }
 
+/// Largest `d` (coordinates) whose characteristic polynomial is expanded by cofactors.
+const CHAR_POLY_COFACTOR_MAX: usize = 8;
+
+/// Characteristic polynomial `det(s I - A)` of the row-major `n x n` matrix `a`, highest
+/// power first, in O(n^3): Householder reduction to Hessenberg form `H` (similar to `A`),
+/// then the recurrence on its leading minors `p_k(s) = (s - h_kk) p_{k-1}(s) -
+/// sum_{i<k} h_ik (h_{i+1,i} ... h_{k,k-1}) p_{i-1}(s)`. Independent of the eigenvalues'
+/// QR iteration. For the balancer `det(s^2 M + s C + K) = det M det(s I - A)`.
+pub fn char_poly_hessenberg(a: &[f64], n: usize) -> Vec<f64> {
+    let h = DMatrix::from_row_slice(n, n, a).hessenberg().h();
+    // p[k]: ascending coefficients of the k-th leading minor's polynomial.
+    let mut p: Vec<Vec<f64>> = vec![vec![1.0]];
+    for k in 0..n {
+        let prev = &p[k];
+        let mut next = vec![0.0; k + 2];
+        for (j, &c) in prev.iter().enumerate() {
+            next[j + 1] += c;
+            next[j] -= h[(k, k)] * c;
+        }
+        let mut prod = 1.0;
+        for i in (0..k).rev() {
+            prod *= h[(i + 1, i)];
+            let f = h[(i, k)] * prod;
+            if f != 0.0 {
+                for (j, &c) in p[i].iter().enumerate() {
+                    next[j] -= f * c;
+                }
+            }
+        }
+        p.push(next);
+    }
+    let mut out = p.pop().unwrap_or_default();
+    out.reverse();
+    out
+}
+
 /// Routh–Hurwitz: all roots in the open left half-plane iff every entry of the Routh
 /// array's first column is positive (for a monic polynomial). A zero entry means a
 /// root on or symmetric about the imaginary axis: not asymptotically stable.
@@ -574,7 +700,7 @@ mod tests {
             assert!(e.residual < 1e-13, "{} residual {}", e.kind, e.residual);
         }
         // Numeric multistart on the same balancer (bypassing the closed forms).
-        for q0 in starts(p.n_balls(), 2) {
+        for q0 in starts(p.n_balls(), 2).0 {
             if let Some(q) = newton_static(&p, &q0) {
                 assert!(
                     eqs.iter().any(|e| same_equilibrium(true, 2, &e.q, &q)),
@@ -639,6 +765,52 @@ mod tests {
     }
 
     #[test]
+    fn hessenberg_char_poly_matches_cofactors() {
+        // Three unequal balls off balance: d = 5, both routes apply.
+        let p = Planar::new(0.2, 0.05, &[0.1], 50.0, 1.4, &[0.4, 0.6, 0.5]).unwrap();
+        let q = [0.01, -0.02, 0.3, 2.0, -2.5];
+        let d = 5;
+        let z = vec![0.0; d];
+        let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        p.jacobians(0.0, &q, &z, &z, &mut k, &mut c, &mut m);
+        let mut a = vec![0.0; 4 * d * d];
+        let mut col = vec![0.0; 2 * d * d];
+        state_matrix(&p, 0.0, &q, &k, &c, &mut col, &mut a);
+        let cof = char_poly(&k, &c, &m, d);
+        let hes = char_poly_hessenberg(&a, 2 * d);
+        assert_eq!(cof.len(), hes.len());
+        for (u, v) in cof.iter().zip(&hes) {
+            assert!((u - v).abs() < 1e-8 * (1.0 + u.abs()), "{cof:?} vs {hes:?}");
+        }
+    }
+
+    /// 4^32 starts overflowed to none: equilibria() was empty from 32 balls on.
+    #[test]
+    fn many_balls_find_the_perfect_balance() {
+        for n in [31usize, 32, 40] {
+            let eta = 2.0 / n as f64;
+            let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &vec![eta; n]).unwrap();
+            let (st, exhaustive) = starts(n, 2);
+            assert_eq!(st.len(), start_budget(n));
+            assert!(!exhaustive);
+            let eqs = equilibria(&p);
+            let pb = eqs
+                .iter()
+                .find(|e| e.kind == "perfect_balance")
+                .expect("perfect balance");
+            // Closed form of the family: x = y = 0 and the balls' unbalance cancels the
+            // disk's, sum eta e^(i b) = -1.
+            let (cs, sn) = pb.q[2..]
+                .iter()
+                .fold((0.0, 0.0), |(a, b), &t| (a + eta * t.cos(), b + eta * t.sin()));
+            assert!(pb.q[0].abs() < 1e-10 && pb.q[1].abs() < 1e-10);
+            assert!((cs + 1.0).abs() < 1e-10 && sn.abs() < 1e-10, "{cs} {sn}");
+            assert_eq!(pb.neutral, n - 2);
+            assert!(eqs.iter().all(|e| !e.exhaustive));
+        }
+    }
+
+    #[test]
     fn track_order_starts_and_identity() {
         for n in 1..=6 {
             let st = ordered_starts(n, 2);
@@ -648,6 +820,11 @@ mod tests {
                 assert!(b.windows(2).all(|w| w[1] > w[0]) && b[n - 1] < b[0] + 2.0 * PI);
             }
         }
+        // Only the starts used are built (all C(27, 23) subsets took 45 s at 24 balls).
+        let t = std::time::Instant::now();
+        let st = ordered_starts(24, 2);
+        assert_eq!(st.len(), 600);
+        assert!(t.elapsed().as_secs_f64() < 1.0);
         let a = [0.1, -0.2, 1.0, 4.0, 5.5];
         // the same state a whole turn on, for any balls
         let turned = [0.1, -0.2, 1.0 + 2.0 * PI, 4.0 + 2.0 * PI, 5.5 + 2.0 * PI];
@@ -661,3 +838,4 @@ mod tests {
         assert!(!same_in_order(true, 2, &a, &wound));
     }
 }
+

@@ -446,6 +446,11 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let (om2, g) = (om * om, &mut self.g);
         for j in 0..d {
             for k in 0..d {
+                // A block takes a fraction of a second at hundreds of harmonics; a
+                // cancelled solve stops at the next Newton iteration (see `cancel`).
+                if crate::cancel::cancelled() {
+                    return;
+                }
                 // Skip blocks where the coordinates do not interact at all.
                 let idx = j * d + k;
                 let any = (0..s).any(|i| {
@@ -574,6 +579,11 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
     let mut rn = max_abs(&r);
     let scale0 = max_abs(&x).max(1.0);
     for it in 1..=opts.max_iter {
+        // A cancelled solve's result is discarded by whoever cancelled it (see `cancel`).
+        if crate::cancel::cancelled() {
+            finish(&x, &mut out, Status::MaxIterations, rn, f64::INFINITY, it - 1);
+            return out;
+        }
         if !rn.is_finite() {
             finish(&x, &mut out, Status::Diverged, rn, f64::INFINITY, it - 1);
             return out;

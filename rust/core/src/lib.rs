@@ -8,6 +8,7 @@
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod cancel;
 pub mod equilibria;
 pub mod error;
 pub mod floquet;

@@ -9,6 +9,7 @@
 // Stage loops index several arrays in lockstep; iterators would obscure the tableau.
 #![allow(clippy::needless_range_loop)]
 
+use crate::cancel;
 use crate::error::{Error, Result};
 
 const C2: f64 = 1.0 / 5.0;
@@ -48,6 +49,24 @@ const D4: f64 = -10690763975.0 / 1880347072.0;
 const D5: f64 = 701980252875.0 / 199316789632.0;
 const D6: f64 = -1453857185.0 / 822651844.0;
 const D7: f64 = 69997945.0 / 29380423.0;
+
+/// Hairer & Wanner's stiffness test for DOPRI5 (Solving ODEs II, IV.2; `dopri5.f`): a
+/// step is stability-limited when `h rho > 3.25`, `rho ~ |f(y7) - f(y6)| / |y7 - y6|`
+/// estimating the dominant eigenvalue from the last two stages; the problem is stiff
+/// after `STIFF_RUN` such accepted steps with fewer than `STIFF_CALM` in a row between.
+const STIFF_HRHO: f64 = 3.25;
+const STIFF_RUN: usize = 15;
+const STIFF_CALM: usize = 6;
+/// A stiff stretch is only an error when finishing at its step size would take more
+/// steps than this (seconds of work): an explicit method that is merely stability-limited
+/// for a short time still gives the right answer, just with small steps.
+const STIFF_STEPS_LEFT: f64 = 1e6;
+/// After this many steps the integrator forecasts, from its average step so far, the
+/// steps still needed, and stops when they exceed `FORECAST_FACTOR` times `max_steps`
+/// (an error in a second instead of after the whole step budget: a motion far faster
+/// than the time span, or a time span far too long).
+const FORECAST_AFTER: usize = 20_000;
+const FORECAST_FACTOR: f64 = 10.0;
 
 /// Tolerances and limits, named as in scipy.
 #[derive(Debug, Clone)]
@@ -223,7 +242,11 @@ impl Dopri5 {
         };
         let n = self.n;
         let mut rejected_last = false;
+        let (mut stiff_run, mut calm) = (0usize, 0usize);
         loop {
+            if (stats.accepted + stats.rejected) % 8 == 0 {
+                cancel::check()?;
+            }
             if stats.accepted + stats.rejected >= opts.max_steps {
                 return Err(Error::Integration(format!(
                     "more than max_steps = {} steps before t = {t1} (reached t = {t})",
@@ -282,6 +305,40 @@ impl Dopri5 {
                 }
                 let t_new = if last { t1 } else { t + hs };
                 stats.accepted += 1;
+                // `tmp` still holds the sixth stage's state (y6), `k[5]` = f(y6), k[6] = f(y7).
+                let (mut num, mut den) = (0.0, 0.0);
+                for i in 0..n {
+                    let a = self.k[6][i] - self.k[5][i];
+                    let b = self.y_new[i] - self.tmp[i];
+                    num += a * a;
+                    den += b * b;
+                }
+                if den > 0.0 && hs.abs() * (num / den).sqrt() > STIFF_HRHO {
+                    calm = 0;
+                    stiff_run += 1;
+                    let left = (t1 - t_new).abs() / hs.abs();
+                    if stiff_run >= STIFF_RUN && !last && left > STIFF_STEPS_LEFT {
+                        return Err(Error::Stiff(format!(
+                            "the step size is held at {:.3e} by stability (h rho > {STIFF_HRHO} on {stiff_run} steps) at t = {t_new}; {left:.2e} more steps to t = {t1}",
+                            hs.abs()
+                        )));
+                    }
+                } else {
+                    calm += 1;
+                    if calm >= STIFF_CALM {
+                        stiff_run = 0;
+                    }
+                }
+                if stats.accepted >= FORECAST_AFTER && stats.accepted % 1024 == 0 && !last {
+                    let need = (t1 - t_new).abs() / ((t_new - t0).abs() / stats.accepted as f64);
+                    if need > FORECAST_FACTOR * opts.max_steps as f64 {
+                        return Err(Error::Integration(format!(
+                            "at the average step so far ({:.3e}) reaching t = {t1} needs about {need:.2e} more steps, far more than max_steps = {} (reached t = {t_new})",
+                            (t_new - t0).abs() / stats.accepted as f64,
+                            opts.max_steps
+                        )));
+                    }
+                }
                 // Dense output is formed only when the observer interpolates.
                 let dense = Dense {
                     t0: t,
@@ -420,6 +477,24 @@ where
     Ok((out, stats))
 }
 
+/// `Err(Error::Stiff)` when integrating from `y0` towards `t1` proves stiff within the
+/// first `steps` steps, `Ok` otherwise (other failures are left to the integration that
+/// needs the answer to report). A cheap test before analyses that swallow integration
+/// failures (a guess simulation that fails is just "no guess").
+pub fn probe_stiffness<F>(f: F, t0: f64, y0: &[f64], t1: f64, opts: &Options, steps: usize) -> Result<()>
+where
+    F: FnMut(f64, &[f64], &mut [f64]),
+{
+    let opts = Options {
+        max_steps: steps,
+        ..opts.clone()
+    };
+    match Dopri5::new(y0.len()).integrate(f, t0, y0, t1, &opts, |_, _, _| true) {
+        Err(e @ (Error::Stiff(_) | Error::Cancelled)) => Err(e),
+        _ => Ok(()),
+    }
+}
+
 /// Output times must be finite, strictly monotone, and not before `t0`.
 pub fn check_times(t0: f64, t_eval: &[f64]) -> Result<()> {
     if !t0.is_finite() {
@@ -523,6 +598,64 @@ mod tests {
         let opts = Options::default();
         assert!(solve_at(osc, 0.0, &[1.0, 0.0], &[1.0, 0.5], &opts).is_err());
         assert!(solve_at(osc, 0.0, &[1.0, 0.0], &[f64::NAN], &opts).is_err());
+    }
+
+    /// Prothero–Robinson `y' = -lambda (y - cos t) - sin t`, smooth solution `cos t`:
+    /// stiff for large lambda, where only stability holds the explicit step down.
+    fn prothero(lambda: f64) -> impl FnMut(f64, &[f64], &mut [f64]) {
+        move |t, y, dy| dy[0] = -lambda * (y[0] - t.cos()) - t.sin()
+    }
+
+    #[test]
+    fn stiffness_is_detected_quickly() {
+        let opts = Options::new(1e-6, 1e-9);
+        let t = std::time::Instant::now();
+        let r = solve_at(prothero(1e7), 0.0, &[1.0], &[100.0], &opts);
+        assert!(matches!(r, Err(Error::Stiff(_))), "{r:?}");
+        assert!(t.elapsed().as_secs_f64() < 1.0);
+    }
+
+    #[test]
+    fn mild_or_short_stiffness_is_not_an_error() {
+        let opts = Options::new(1e-6, 1e-9);
+        // Stiff, but finishing costs far fewer steps than the limit: integrated.
+        let (ys, _) = solve_at(prothero(1e4), 0.0, &[1.0], &[10.0], &opts).unwrap();
+        assert!((ys[0][0] - 10f64.cos()).abs() < 1e-6);
+        // Not stiff at all.
+        let (ys, _) = solve_at(osc, 0.0, &[1.0, 0.0], &[1e4], &opts).unwrap();
+        assert!(ys[0][0].is_finite());
+    }
+
+    #[test]
+    fn hopeless_step_budgets_fail_early() {
+        // A fast rotation whose steps are limited by accuracy, not stability: not stiff,
+        // but 1e3 time units need ~1e9 steps against a budget of 1e7.
+        let t = std::time::Instant::now();
+        let r = solve_at(
+            |_, y: &[f64], dy: &mut [f64]| {
+                dy[0] = 1e6 * y[1];
+                dy[1] = -1e6 * y[0];
+            },
+            0.0,
+            &[1.0, 0.0],
+            &[1000.0],
+            &Options::new(1e-6, 1e-9),
+        );
+        assert!(matches!(r, Err(Error::Integration(_))), "{r:?}");
+        assert!(t.elapsed().as_secs_f64() < 2.0);
+        // An absurd time span for a plain oscillator.
+        let r = solve_at(osc, 0.0, &[1.0, 0.0], &[1e300], &Options::default());
+        assert!(matches!(r, Err(Error::Integration(_))), "{r:?}");
+    }
+
+    #[test]
+    fn a_cancelled_token_stops_the_integration() {
+        let tok = crate::cancel::Token::new();
+        tok.cancel();
+        let r = crate::cancel::with(Some(tok), || {
+            solve_at(osc, 0.0, &[1.0, 0.0], &[1e9], &Options::default())
+        });
+        assert_eq!(r.unwrap_err(), Error::Cancelled);
     }
 
     #[test]

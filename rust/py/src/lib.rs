@@ -11,7 +11,7 @@ use ballbal_core::periodic::{
     PeriodicOptions, MAX_CLOSURE, MAX_TAIL,
 };
 use ballbal_core::simulate::simulate as core_simulate;
-use ballbal_core::{Dynamics, Error, Planar, Scene, SpringLayout};
+use ballbal_core::{cancel, Dynamics, Error, Planar, Scene, SpringLayout};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -53,11 +53,91 @@ fn to_py(e: Error) -> PyErr {
     })
 }
 
-/// Runs `f` without the GIL and with panics contained.
+/// How often an entry point waiting for the core looks for Ctrl-C (and other signals).
+const POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// Runs `f` without the GIL, with panics contained (as `InternalError`) and with Ctrl-C
+/// working: see [`run_polled`]. A cancelled call raises `KeyboardInterrupt` and its
+/// partial result is dropped.
 fn guarded<T: Send, F: FnOnce() -> Result<T, Error> + Send>(py: Python<'_>, f: F) -> PyResult<T> {
-    py.detach(|| catch_unwind(AssertUnwindSafe(f)))
-        .map_err(panic_error)?
-        .map_err(to_py)
+    run_polled(
+        py,
+        |tok, _: &std::sync::mpsc::Sender<()>| cancel::with(Some(tok.clone()), f),
+        |()| Ok(()),
+    )
+}
+
+/// The one way the binding runs core work: `work` runs on a worker thread (given a
+/// cancellation token and a channel), while this thread, without the GIL, waits and
+/// checks for signals every [`POLL`] (only the main thread sees them) and hands every
+/// message the work sends to `on_msg` with the GIL. A signal's exception (Ctrl-C's
+/// `KeyboardInterrupt`), or `on_msg`'s first error, cancels the token; the core's long
+/// loops notice it within milliseconds, and that exception is raised once the worker
+/// has stopped. A panic in the work becomes `InternalError`.
+fn run_polled<T, M, W, H>(py: Python<'_>, work: W, mut on_msg: H) -> PyResult<T>
+where
+    T: Send,
+    M: Send,
+    W: FnOnce(&cancel::Token, &std::sync::mpsc::Sender<M>) -> Result<T, Error> + Send,
+    H: FnMut(M) -> PyResult<()>,
+{
+    use std::sync::mpsc;
+    let token = cancel::Token::new();
+    let (tx, rx) = mpsc::channel::<M>();
+    // `detach` needs a `Sync` capture; the receiver is only used from this thread.
+    let rx = std::sync::Mutex::new(rx);
+    let mut pending: Option<PyErr> = None;
+    let worker = std::thread::scope(|s| {
+        let tok = &token;
+        // The calling thread's stack size: the core was written for it.
+        let handle = std::thread::Builder::new()
+            .name("ballbal-core".into())
+            .stack_size(8 << 20)
+            .spawn_scoped(s, move || {
+                let tx = tx;
+                catch_unwind(AssertUnwindSafe(|| work(tok, &tx)))
+            });
+        let handle = match handle {
+            Ok(h) => h,
+            Err(e) => {
+                return Err(PyRuntimeError::new_err(format!(
+                    "could not start a worker thread: {e}"
+                )))
+            }
+        };
+        loop {
+            let msg = py.detach(|| rx.lock().expect("receiver lock").recv_timeout(POLL));
+            match msg {
+                // Messages that arrive after a cancellation are still handed over
+                // (a scan's chunks that finish are stored).
+                Ok(m) => {
+                    if let Err(e) = on_msg(m) {
+                        if pending.is_none() {
+                            token.cancel();
+                            pending = Some(e);
+                        }
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {
+                    if pending.is_none() {
+                        if let Err(e) = py.check_signals() {
+                            token.cancel();
+                            pending = Some(e);
+                        }
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+        }
+        Ok(py.detach(|| handle.join()))
+    })?;
+    if let Some(e) = pending {
+        return Err(e);
+    }
+    match worker {
+        Ok(Ok(r)) => r.map_err(to_py),
+        Ok(Err(p)) | Err(p) => Err(panic_error(p)),
+    }
 }
 
 fn panic_error(p: Box<dyn std::any::Any + Send>) -> PyErr {
@@ -235,6 +315,24 @@ fn simulate<'py>(
     ))
 }
 
+/// Checks the parameters (and effects) the way the core's constructors do, and nothing
+/// more: cheap, unlike an analysis (`Balancer.validate()` used to run the whole
+/// equilibrium search).
+#[pyfunction]
+#[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, effects=None))]
+fn validate(
+    mu: f64,
+    zeta: f64,
+    zeta_b: Vec<f64>,
+    delta: f64,
+    omega: f64,
+    eta: Vec<f64>,
+    effects: Effects,
+) -> PyResult<()> {
+    let p = planar(mu, zeta, zeta_b, delta, omega, eta)?;
+    scene(&p, effects).map(|_| ())
+}
+
 /// All equilibria with their stability, as a list of dicts.
 #[pyfunction]
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, effects=None))]
@@ -282,9 +380,16 @@ fn balanced_states<'py>(
     // Each point is solved on its own from the planar perfect balance, so the result
     // does not depend on the thread count.
     let eqs = guarded(py, || {
+        // rayon's threads do not inherit the cancellation token: hand it on.
+        let tok = cancel::current();
         Ok(scenes
             .par_iter()
-            .map(|s| s.balanced_state())
+            .map(|s| {
+                // Each point is short: stop between points once cancelled.
+                cancel::with(tok.clone(), || {
+                    (!cancel::cancelled()).then(|| s.balanced_state()).flatten()
+                })
+            })
             .collect::<Vec<_>>())
     })?;
     eqs.into_iter()
@@ -311,6 +416,7 @@ fn equilibrium_dict(py: Python<'_>, e: Equilibrium) -> PyResult<Bound<'_, PyDict
         d.set_item("neutral", e.neutral)?;
         d.set_item("routh_hurwitz", e.routh_hurwitz)?;
         d.set_item("char_poly", PyArray1::from_vec(py, e.char_poly))?;
+        d.set_item("exhaustive", e.exhaustive)?;
         Ok(d)
     }
 }
@@ -540,11 +646,37 @@ fn periodic<'py>(
     };
     let r = guarded(py, || {
         Ok(match &sc {
-            None => core_periodic(&p, &rotating, guess.as_ref(), &opts),
-            Some(sc) => core_periodic(sc, &rotating, guess.as_ref(), &opts),
+            None => {
+                stiff_guess(&p, guess.is_none(), &opts)?;
+                core_periodic(&p, &rotating, guess.as_ref(), &opts)
+            }
+            Some(sc) => {
+                stiff_guess(sc, guess.is_none(), &opts)?;
+                core_periodic(sc, &rotating, guess.as_ref(), &opts)
+            }
         })
     })?;
     solution_dict(py, r, p.n_balls())
+}
+
+/// `Err(Stiff)` when the guess simulations would be too stiff for the explicit
+/// integrator: the core counts a failed guess simulation as "no guess", which would hide
+/// the reason (after minutes, at these parameters).
+fn stiff_guess<D: Dynamics>(m: &D, simulates: bool, opts: &PeriodicOptions) -> Result<(), Error> {
+    if !simulates {
+        return Ok(());
+    }
+    let Some(y0) = ballbal_core::periodic::initial_states(m).into_iter().next() else {
+        return Ok(());
+    };
+    ballbal_core::ode::probe_stiffness(
+        |t, y, dy| ballbal_core::model::first_order_rhs(m, t, y, dy),
+        0.0,
+        &y0,
+        opts.guess.settle,
+        &Options::new(opts.guess.rtol, opts.guess.atol),
+        5000,
+    )
 }
 
 /// The "NI" check: max distance after one simulated period from the orbit's own state.
@@ -706,8 +838,9 @@ struct Columns<'a> {
     n_harm: usize,
 }
 
-/// Runs `spec`'s chunks on a worker thread and hands each finished one to `on_chunk`
-/// in this thread, checking for Ctrl-C while it waits.
+/// Runs `spec`'s chunks through [`run_polled`], handing each finished one to `on_chunk`.
+/// The scan cancels between rows with the token's flag (not the thread-local token: a
+/// row stopped half way would look like a row without a solution).
 fn run_scan<D: ballbal_core::scan::Family>(
     py: Python<'_>,
     spec: &ballbal_core::scan::ScanSpec<'_, D>,
@@ -716,60 +849,17 @@ fn run_scan<D: ballbal_core::scan::Family>(
     on_chunk: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
     use ballbal_core::scan::{scan_chunks, ScanRow};
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::mpsc;
-    let cancel = AtomicBool::new(false);
-    let (tx, rx) = mpsc::channel::<(usize, Vec<ScanRow>)>();
-    // `detach` needs a `Sync` capture; the receiver is only used from this thread.
-    let rx = std::sync::Mutex::new(rx);
-    let mut pending: Option<PyErr> = None;
-    let worker = std::thread::scope(|s| {
-        let cancel = &cancel;
-        let handle = s.spawn(move || {
-            catch_unwind(AssertUnwindSafe(|| {
-                scan_chunks(spec, &chunks, cancel, &|c, rows| {
-                    let _ = tx.send((c, rows));
-                })
-            }))
-        });
-        loop {
-            let msg = py.detach(|| {
-                rx.lock()
-                    .expect("receiver lock")
-                    .recv_timeout(std::time::Duration::from_millis(100))
-            });
-            match msg {
-                Ok((c, rows)) => {
-                    let r = scan_columns(py, cols, &rows)
-                        .and_then(|d| on_chunk.call1((c, d)).map(|_| ()));
-                    if let Err(e) = r {
-                        if pending.is_none() {
-                            cancel.store(true, Ordering::Relaxed);
-                            pending = Some(e);
-                        }
-                    }
-                }
-                Err(mpsc::RecvTimeoutError::Timeout) => {
-                    if pending.is_none() {
-                        if let Err(e) = py.check_signals() {
-                            cancel.store(true, Ordering::Relaxed);
-                            pending = Some(e);
-                        }
-                    }
-                }
-                Err(mpsc::RecvTimeoutError::Disconnected) => break,
-            }
-        }
-        handle.join()
-    });
-    if let Some(e) = pending {
-        return Err(e);
-    }
-    match worker {
-        Ok(Ok(Ok(()))) => Ok(()),
-        Ok(Ok(Err(e))) => Err(to_py(e)),
-        Ok(Err(p)) | Err(p) => Err(panic_error(p)),
-    }
+    run_polled(
+        py,
+        |tok, tx: &std::sync::mpsc::Sender<(usize, Vec<ScanRow>)>| {
+            scan_chunks(spec, &chunks, tok.flag(), &|c, rows| {
+                let _ = tx.send((c, rows));
+            })
+        },
+        |(c, rows)| {
+            scan_columns(py, cols, &rows).and_then(|d| on_chunk.call1((c, d)).map(|_| ()))
+        },
+    )
 }
 
 /// One chunk's rows as a dict of equally long lists (None where a value does not apply).
@@ -911,9 +1001,48 @@ fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
     Ok(ballbal_core::scan::default_chunk(&lens))
 }
 
+/// Loads NumPy's C API now, at import. `numpy` loads it on the first array it makes and
+/// panics if that fails, and it runs Python code to do so (`numpy.lib.NumpyVersion`):
+/// on the first native call of a process a Ctrl-C pending from the work just done
+/// raised `KeyboardInterrupt` inside it and reached Python as a `PanicException`.
+fn load_numpy_api(py: Python<'_>) -> PyResult<()> {
+    // The same Python steps first, where an exception (a Ctrl-C during the import)
+    // is raised as itself.
+    let version = py.import("numpy")?.getattr("__version__")?;
+    py.import("numpy.lib")?
+        .getattr("NumpyVersion")?
+        .call1((version,))?;
+    let mut last = String::new();
+    // A signal can still land in the microseconds between: its exception is gone by then
+    // (consumed by numpy's `expect`), but it is named in the panic message.
+    for _ in 0..3 {
+        match catch_unwind(|| numpy::npyffi::is_numpy_2(py)) {
+            Ok(_) => return Ok(()),
+            Err(p) => {
+                let msg = p
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                    .unwrap_or_default();
+                if msg.contains("KeyboardInterrupt") {
+                    return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+                        "interrupted while loading NumPy's C API",
+                    ));
+                }
+                last = msg;
+            }
+        }
+    }
+    Err(pyo3::exceptions::PyImportError::new_err(format!(
+        "ballbal: cannot load NumPy's C API: {last}"
+    )))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    load_numpy_api(m.py())?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(equilibria, m)?)?;
     m.add_function(wrap_pyfunction!(balanced_states, m)?)?;
     m.add_function(wrap_pyfunction!(periodic, m)?)?;

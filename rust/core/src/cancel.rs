@@ -1,0 +1,106 @@
+//! Cooperative cancellation of long computations (e.g. Ctrl-C in the Python layer).
+//!
+//! A caller installs a [`Token`] for the current thread with [`with`]; the core's long
+//! loops (the integrator's steps, harmonic-balance Newton iterations, equilibrium starts)
+//! poll [`cancelled`] and stop, with [`Error::Cancelled`] where they return a `Result`,
+//! early with a partial value otherwise. A partial value is meaningless: whoever cancels
+//! must discard the result of the call it cancelled.
+//!
+//! The token is thread-local so that the numerical signatures stay free of it; work
+//! handed to other threads (rayon) must carry it over with [`current`] and [`with`].
+//! Without an installed token nothing is ever cancelled, so code that does not know
+//! about cancellation (and parallel scans, which cancel between rows with their own
+//! flag) behaves exactly as before.
+
+use crate::error::{Error, Result};
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// A shared flag asking the computations that hold it to stop.
+#[derive(Debug, Clone, Default)]
+pub struct Token(Arc<AtomicBool>);
+
+impl Token {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+
+    /// The flag itself, for APIs that take one explicitly (the parallel scan).
+    pub fn flag(&self) -> &AtomicBool {
+        &self.0
+    }
+}
+
+thread_local! {
+    static CURRENT: RefCell<Option<Token>> = const { RefCell::new(None) };
+}
+
+/// Restores the previously installed token when dropped, also when `f` panics.
+struct Restore(Option<Token>);
+
+impl Drop for Restore {
+    fn drop(&mut self) {
+        let prev = self.0.take();
+        CURRENT.with(|c| *c.borrow_mut() = prev);
+    }
+}
+
+/// Runs `f` with `token` installed as this thread's token (`None`: not cancellable).
+pub fn with<R>(token: Option<Token>, f: impl FnOnce() -> R) -> R {
+    let prev = CURRENT.with(|c| std::mem::replace(&mut *c.borrow_mut(), token));
+    let _restore = Restore(prev);
+    f()
+}
+
+/// This thread's token, to hand on to work done on other threads.
+pub fn current() -> Option<Token> {
+    CURRENT.with(|c| c.borrow().clone())
+}
+
+/// Whether this thread's token asks to stop.
+pub fn cancelled() -> bool {
+    CURRENT.with(|c| c.borrow().as_ref().is_some_and(Token::is_cancelled))
+}
+
+/// `Err(Error::Cancelled)` once this thread's token asks to stop.
+pub fn check() -> Result<()> {
+    if cancelled() {
+        Err(Error::Cancelled)
+    } else {
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn token_is_per_thread_and_restored() {
+        let t = Token::new();
+        assert!(check().is_ok());
+        with(Some(t.clone()), || {
+            assert!(check().is_ok());
+            t.cancel();
+            assert_eq!(check(), Err(Error::Cancelled));
+            // Another thread does not see it unless handed over.
+            let tok = current();
+            std::thread::scope(|s| {
+                s.spawn(|| assert!(!cancelled()));
+                s.spawn(move || with(tok, || assert!(cancelled())));
+            });
+            with(None, || assert!(!cancelled()));
+            assert!(cancelled());
+        });
+        assert!(!cancelled());
+    }
+}
