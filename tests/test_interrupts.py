@@ -92,7 +92,8 @@ def test_sigint_at_first_native_call_never_panics(delay: float) -> None:
     assert lag < 1.0
 
 
-SPRING_SCENE = "[balancer]\neta = [" + ", ".join(["0.06"] * 40) + "]\n\n[springs]\nstiffness = 0.5\n"
+SPRING_SCENE = ("[balancer]\neta = [" + ", ".join(["0.06"] * 40)
+                + "]\n\n[springs]\nstiffness = 0.5\n")
 
 
 @pytest.mark.parametrize("cmd", [["periodic", "--N", "256"], ["equilibria", "--scene"]])
