@@ -497,10 +497,10 @@ fn sorted_analysed<D: Dynamics + ?Sized>(
 /// Most starts of the lattice search before it is cut to [`start_budget`].
 const LATTICE_MAX: u64 = 600;
 
-/// Newton starts of the equilibrium search for `n` balls: the whole lattice of `per^n`
-/// ball angles while it has at most [`LATTICE_MAX`] points (n <= 4: 24, 144, 216, 256
-/// starts); for more balls [`start_budget`] starts: every ball together at 24 angles,
-/// then a low-discrepancy (Kronecker) sequence over the torus of ball angles, so that
+/// Newton starts of the equilibrium search for `n` balls: from three balls on, every
+/// ball together at 24 angles; then the whole lattice of `per^n` ball angles while it has
+/// at most [`LATTICE_MAX`] points (n <= 4: 24, 144, 216, 256 starts), or else up to
+/// [`start_budget`] starts in all from a low-discrepancy (Kronecker) sequence over the torus of ball angles, so that
 /// every ball varies (a prefix of the lattice would move only the first few). Returns the
 /// starts and whether they are the whole lattice.
 fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
@@ -515,9 +515,19 @@ fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
         .ok()
         .and_then(|e| per.checked_pow(e))
         .filter(|&t| t <= LATTICE_MAX);
+    // All balls together at 24 angles: the together states, which the lattice of
+    // three or four balls misses (its points keep the balls apart).
+    let mut out = vec![];
+    if n >= 3 {
+        for k in 0..24 {
+            let mut q = vec![0.0; n + o];
+            let b = -PI + (k as f64 + 0.1) * 2.0 * PI / 24.0;
+            q[o..].iter_mut().for_each(|v| *v = b);
+            out.push(q);
+        }
+    }
     if let Some(total) = lattice {
         let per = per as usize;
-        let mut out = vec![];
         for idx in 0..total as usize {
             let mut q = vec![0.0; n + o];
             let mut rem = idx;
@@ -532,13 +542,6 @@ fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
         return (out, true);
     }
     let budget = start_budget(n);
-    let mut out = vec![];
-    for k in 0..24 {
-        let mut q = vec![0.0; n + o];
-        let b = -PI + (k as f64 + 0.1) * 2.0 * PI / 24.0;
-        q[o..].iter_mut().for_each(|v| *v = b);
-        out.push(q);
-    }
     // Roberts' R_n sequence: alpha_i = g^-(i+1), g the root of g^(n+1) = g + 1.
     let mut g = 2.0f64;
     for _ in 0..60 {
