@@ -21,7 +21,7 @@ CALLS = {
     "periodic_N256": 'periodic(Balancer(), "R-R", N=256)',
     "periodic_3balls_N160": 'periodic(Balancer(eta=(0.5,) * 3), "R-R-R", N=160)',
     "simulate_long": "simulate(Balancer(), t_eval=[0.0, 1e6])",
-    "equilibria_springs": "equilibria(Scene(Balancer(eta=(0.06,) * 40), springs=0.5))",
+    "equilibria_springs": "equilibria(Scene(Balancer(eta=(0.04,) * 64), springs=0.5))",
     # balanced states in parallel (rayon threads must see the cancellation too)
     "balance_map": "balance_map(Balancer(eta=(0.05,) * 24), Omega=[1.5] * 20000)",
     "verify": "_verify()",
@@ -92,7 +92,8 @@ def test_sigint_at_first_native_call_never_panics(delay: float) -> None:
     assert lag < 1.0
 
 
-SPRING_SCENE = "[balancer]\neta = [" + ", ".join(["0.06"] * 40) + "]\n\n[springs]\nstiffness = 0.5\n"
+SPRING_SCENE = ("[balancer]\neta = [" + ", ".join(["0.04"] * 64)
+                + "]\n\n[springs]\nstiffness = 0.5\n")
 
 
 @pytest.mark.parametrize("cmd", [["periodic", "--N", "256"], ["equilibria", "--scene"]])

@@ -17,12 +17,14 @@ def _unbalance(q: np.ndarray, eta: float) -> complex:
     return complex(sum(eta * np.cos(q[2:])), sum(eta * np.sin(q[2:])))
 
 
-def test_32_equal_balls_find_the_perfect_balance_and_the_together_states() -> None:
-    """4^32 starts overflowed to none: equilibria() was [] from 32 balls on."""
-    n, eta, Om, zeta, mu = 32, 2 / 32, 1.2, 0.05, 0.2
+@pytest.mark.parametrize("n", [3, 4, 32])
+def test_equal_balls_find_the_perfect_balance_and_the_together_states(n: int) -> None:
+    """4^32 starts overflowed to none: equilibria() was [] from 32 balls on; the lattice
+    of 3 and 4 balls missed the together states."""
+    eta, Om, zeta, mu = 2 / n, 1.2, 0.05, 0.2
     b = Balancer(mu=mu, zeta=zeta, Omega=Om, eta=(eta,) * n)
     eqs = equilibria(b)
-    assert eqs and not any(e.exhaustive for e in eqs)
+    assert eqs and all(e.exhaustive == (n <= 4) for e in eqs)
     pb = [e for e in eqs if e.kind == "perfect_balance"]
     assert len(pb) == 1 and pb[0].neutral == n - 2
     # The family's closed form: disk centre at rest on the axis, sum eta e^(i b) = -1.

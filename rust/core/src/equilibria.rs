@@ -230,11 +230,20 @@ pub fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>
     let mut q = q0.to_vec();
     let mut r = vec![0.0; d];
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    // Residuals of the last iterations: a Newton that has stopped improving (a nearly
+    // neutral direction cut off by the least-squares threshold) goes to the final test
+    // now instead of after all 60 iterations (most of a many-ball spring search's time).
+    let mut history: Vec<f64> = Vec::with_capacity(60);
     for _ in 0..60 {
         static_residual(p, &q, &mut r);
         let rn = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if !rn.is_finite() {
             return None;
+        }
+        history.push(rn);
+        let it = history.len();
+        if it > 16 && rn < 1e-9 && history[it - 9] <= 2.0 * rn {
+            break;
         }
         p.jacobians(0.0, &q, &z, &z, &mut k, &mut c, &mut m);
         let j = DMatrix::from_row_slice(d, d, &k);
@@ -488,10 +497,10 @@ fn sorted_analysed<D: Dynamics + ?Sized>(
 /// Most starts of the lattice search before it is cut to [`start_budget`].
 const LATTICE_MAX: u64 = 600;
 
-/// Newton starts of the equilibrium search for `n` balls: the whole lattice of `per^n`
-/// ball angles while it has at most [`LATTICE_MAX`] points (n <= 4: 24, 144, 216, 256
-/// starts); for more balls [`start_budget`] starts: every ball together at 24 angles,
-/// then a low-discrepancy (Kronecker) sequence over the torus of ball angles, so that
+/// Newton starts of the equilibrium search for `n` balls: from three balls on, every
+/// ball together at 24 angles; then the whole lattice of `per^n` ball angles while it has
+/// at most [`LATTICE_MAX`] points (n <= 4: 24, 144, 216, 256 starts), or else up to
+/// [`start_budget`] starts in all from a low-discrepancy (Kronecker) sequence over the torus of ball angles, so that
 /// every ball varies (a prefix of the lattice would move only the first few). Returns the
 /// starts and whether they are the whole lattice.
 fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
@@ -506,9 +515,19 @@ fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
         .ok()
         .and_then(|e| per.checked_pow(e))
         .filter(|&t| t <= LATTICE_MAX);
+    // All balls together at 24 angles: the together states, which the lattice of
+    // three or four balls misses (its points keep the balls apart).
+    let mut out = vec![];
+    if n >= 3 {
+        for k in 0..24 {
+            let mut q = vec![0.0; n + o];
+            let b = -PI + (k as f64 + 0.1) * 2.0 * PI / 24.0;
+            q[o..].iter_mut().for_each(|v| *v = b);
+            out.push(q);
+        }
+    }
     if let Some(total) = lattice {
         let per = per as usize;
-        let mut out = vec![];
         for idx in 0..total as usize {
             let mut q = vec![0.0; n + o];
             let mut rem = idx;
@@ -523,13 +542,6 @@ fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
         return (out, true);
     }
     let budget = start_budget(n);
-    let mut out = vec![];
-    for k in 0..24 {
-        let mut q = vec![0.0; n + o];
-        let b = -PI + (k as f64 + 0.1) * 2.0 * PI / 24.0;
-        q[o..].iter_mut().for_each(|v| *v = b);
-        out.push(q);
-    }
     // Roberts' R_n sequence: alpha_i = g^-(i+1), g the root of g^(n+1) = g + 1.
     let mut g = 2.0f64;
     for _ in 0..60 {

@@ -675,7 +675,9 @@ fn stiff_guess<D: Dynamics>(m: &D, simulates: bool, opts: &PeriodicOptions) -> R
         &y0,
         opts.guess.settle,
         &Options::new(opts.guess.rtol, opts.guess.atol),
-        5000,
+        // Stiffness from the parameters shows within the first few dozen steps; more
+        // would cost a normal call milliseconds (the whole settle time).
+        300,
     )
 }
 
