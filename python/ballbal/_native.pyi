@@ -24,12 +24,12 @@ _PlanarArgs = tuple[float, float, list[float], float, float, list[float]]
 
 __version__: str
 
+# simulate returns (y, theta, accepted steps, rejected steps, right-hand-side evaluations)
 def simulate(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     y0: npt.NDArray[np.float64], t0: float, t_eval: npt.NDArray[np.float64], rtol: float,
     atol: list[float], effects: _Effects = None, max_steps: int = 10_000_000,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
-# simulate returns (y, theta, accepted steps, rejected steps, right-hand-side evaluations)
 def validate(
     mu: float, zeta: float, zeta_b: list[float], delta: float, omega: float, eta: list[float],
     effects: _Effects = None,
