@@ -9,8 +9,11 @@ with the Pareto front) and the tables as Parquet.
 
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -20,20 +23,30 @@ import polars as pl  # noqa: E402
 
 import ballbal  # noqa: E402
 
+# BALLBAL_EXAMPLE_SMALL=1 (tests/test_examples.py): the standard case with a few settings
+# per knob, written into a temporary directory unless one is given.
+SMALL = os.environ.get("BALLBAL_EXAMPLE_SMALL") == "1"
+
 CASES = {
     "standard (Omega 1.2, eta 1.0)": ballbal.Balancer(Omega=1.2, eta=(1.0, 1.0)),
     "hard (Omega 1.0, eta 0.7)": ballbal.Balancer(Omega=1.0, eta=(0.7, 0.7)),
 }
+KNOBS: dict[str, Any] = {}
+if SMALL:
+    CASES = dict(list(CASES.items())[:1])
+    KNOBS = {"N": (2, 4), "samples": (8,), "tol": (1e-7,), "rtol": (1e-6,), "base_N": 6,
+             "reference_N": 10, "repeats": 1}
 
 
 def main() -> None:
-    out = Path(sys.argv[1] if len(sys.argv) > 1 else "accuracy_cost")
+    default = tempfile.mkdtemp(prefix="accuracy_cost-") if SMALL else "accuracy_cost"
+    out = Path(sys.argv[1] if len(sys.argv) > 1 else default)
     out.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(1, 2, figsize=(13, 4.8))
+    fig, axes = plt.subplots(1, len(CASES), figsize=(6.5 * len(CASES), 4.8), squeeze=False)
     pl.Config.set_tbl_rows(40)
     pl.Config.set_tbl_cols(12)
-    for ax, (name, b) in zip(axes, CASES.items(), strict=True):
-        df = ballbal.accuracy_cost(b, "R-R")
+    for ax, (name, b) in zip(axes[0], CASES.items(), strict=True):
+        df = ballbal.accuracy_cost(b, "R-R", **KNOBS)
         df.write_parquet(out / f"{name.split()[0]}.parquet")
         print(f"\n{name}: reference closure by simulation "
               f"{df['reference_closure'][0]:.1e}")

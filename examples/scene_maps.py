@@ -10,7 +10,9 @@ the stable R-R range shrinks as the springs stiffen.
 
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -22,7 +24,13 @@ import polars as pl  # noqa: E402
 import ballbal  # noqa: E402
 from ballbal.plot import scan_map  # noqa: E402
 
+# BALLBAL_EXAMPLE_SMALL=1 (tests/test_examples.py): 3 x 3 points a rotor, written into a
+# temporary directory unless one is given.
+SMALL = os.environ.get("BALLBAL_EXAMPLE_SMALL") == "1"
+
 GRID = {"Omega": (1.0, 2.0, 0.025), "springs": (0.0, 4e-5, 5e-6)}
+if SMALL:
+    GRID = {"Omega": (1.1, 1.3, 0.1), "springs": (0.0, 2e-5, 1e-5)}
 BALANCER = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
 ROTORS = {
     "planar disk": ballbal.Scene(balancer=BALANCER),
@@ -32,7 +40,8 @@ ROTORS = {
 
 
 def main() -> None:
-    out = Path(sys.argv[1] if len(sys.argv) > 1 else ".")
+    default = tempfile.mkdtemp(prefix="scene_maps-") if SMALL else "."
+    out = Path(sys.argv[1] if len(sys.argv) > 1 else default)
     out.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(13, 4.8), sharey=True)
     for ax, (label, scene) in zip(axes, ROTORS.items(), strict=True):

@@ -10,6 +10,8 @@ Run: python examples/seed004.py [--out seed004.png]   (about 5 s)
 """
 
 import argparse
+import os
+import tempfile
 import time
 
 import matplotlib.pyplot as plt
@@ -25,11 +27,17 @@ BASE = ballbal.Scene(
 )
 SPRINGS = 2e-5
 MAX_WHIRL = 0.1  # residual whirl (units of e) still counted as balanced
+# BALLBAL_EXAMPLE_SMALL=1 (tests/test_examples.py): maps of 9 x 5 points and a short
+# run-up, written into a temporary directory unless --out is given.
+SMALL = os.environ.get("BALLBAL_EXAMPLE_SMALL") == "1"
+SPEEDS, PLANE_POINTS = (9, 5) if SMALL else (77, None)
+RUN_UP, SETTLE = (100.0, 200.0) if SMALL else (300.0, 600.0)
 
 
 def maps(ax):
-    speeds = np.linspace(0.2, 4.0, 77)
-    planes = [("zeta_b", np.linspace(0.0, 0.4, 41)), ("eta", np.linspace(0.3, 2.0, 35))]
+    speeds = np.linspace(0.2, 4.0, SPEEDS)
+    planes = [("zeta_b", np.linspace(0.0, 0.4, PLANE_POINTS or 41)),
+              ("eta", np.linspace(0.3, 2.0, PLANE_POINTS or 35))]
     for col, (name, values) in enumerate(planes):
         for row, (springs, label) in enumerate(((0.0, "classic"), (SPRINGS, "ball springs"))):
             t = time.perf_counter()
@@ -50,7 +58,7 @@ def run_up(ax):
     start = BASE.replace(Omega=0.3, zeta=0.05, zeta_b=0.05,
                          tilt=ballbal.Tilt(a=1.5, b=2.5, j_t=0.3, j_z=0.5, zeta_r=0.05))
     for springs, label in ((0.0, "classic"), (SPRINGS, f"ball springs k_d/k = {SPRINGS:g}")):
-        r = ballbal.run_up(start.replace(springs=springs), 2.0, 300.0)
+        r = ballbal.run_up(start.replace(springs=springs), 2.0, RUN_UP, settle=SETTLE)
         tr = r.trajectory
         print(f"run-up 0.3 -> 2.0, {label}: peak whirl {r.peak_whirl:.2f} e at Omega "
               f"{r.peak_Omega:.2f}, peak tilt {r.peak_tilt / 50:.4f} rad; final whirl "
@@ -60,13 +68,15 @@ def run_up(ax):
     ax[0].set_ylabel("whirl hypot(x, y) / e")
     ax[1].set_ylabel("tilt (rad)")
     for a in ax:
-        a.set_xlabel("t w_n (spin ramps 0.3 -> 2.0 until 300)")
+        a.set_xlabel(f"t w_n (spin ramps 0.3 -> 2.0 until {RUN_UP:g})")
         a.legend()
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--out", default="seed004.png")
+    default = os.path.join(tempfile.mkdtemp(prefix="seed004-"), "seed004.png") if SMALL \
+        else "seed004.png"
+    ap.add_argument("--out", default=default)
     args = ap.parse_args()
     fig, ax = plt.subplots(3, 2, figsize=(10, 12))
     maps(ax)

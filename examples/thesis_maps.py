@@ -10,7 +10,9 @@ the R-R maps, the omega curves, and the tables as Parquet.
 
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -22,17 +24,26 @@ import polars as pl  # noqa: E402
 import ballbal  # noqa: E402
 from ballbal.plot import omega_curves, scan_map  # noqa: E402
 
+# BALLBAL_EXAMPLE_SMALL=1 (tests/test_examples.py): two maps of 3 x 3 points, written into
+# a temporary directory unless one is given.
+SMALL = os.environ.get("BALLBAL_EXAMPLE_SMALL") == "1"
+
 GRID = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
+ZETAS, ZETA_BS = (0.02, 0.05, 0.1), (0.05, 0.1, 0.2)
+if SMALL:
+    GRID = {"Omega": (1.1, 1.3, 0.1), "eta": (0.4, 1.0, 0.3)}
+    ZETAS, ZETA_BS = (0.05,), (0.05, 0.1)
 TYPES = ("R-R", "O-O", "R-O")
 
 
 def main() -> None:
-    out = Path(sys.argv[1] if len(sys.argv) > 1 else "thesis_maps")
+    default = tempfile.mkdtemp(prefix="thesis_maps-") if SMALL else "thesis_maps"
+    out = Path(sys.argv[1] if len(sys.argv) > 1 else default)
     out.mkdir(parents=True, exist_ok=True)
     overview, axes = plt.subplots(3, 3, figsize=(15, 12), sharex=True, sharey=True)
     summary = []
-    for i, zeta in enumerate((0.02, 0.05, 0.1)):
-        for j, zeta_b in enumerate((0.05, 0.1, 0.2)):
+    for i, zeta in enumerate(ZETAS):
+        for j, zeta_b in enumerate(ZETA_BS):
             b = ballbal.Balancer(mu=0.2, zeta=zeta, zeta_b=zeta_b, delta=50.0)
             df = ballbal.scan(b, patterns=TYPES, **GRID)
             df.write_parquet(out / f"map_zeta{zeta}_zetab{zeta_b}.parquet")

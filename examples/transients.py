@@ -11,7 +11,9 @@
 
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -22,15 +24,21 @@ import numpy as np  # noqa: E402
 
 import ballbal  # noqa: E402
 
+# BALLBAL_EXAMPLE_SMALL=1 (tests/test_examples.py): fewer dampings and shorter times,
+# written into a temporary directory unless one is given.
+SMALL = os.environ.get("BALLBAL_EXAMPLE_SMALL") == "1"
+ZETA_B = [0.05, 0.4] if SMALL else [0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4, 0.6, 0.8]
+STUDY_END, RESPONSE_END, RUN_UP_END = (400.0, 200.0, 500.0) if SMALL else (2000, 600, 800)
+
 
 def main() -> None:
-    out = Path(sys.argv[1] if len(sys.argv) > 1 else "transients")
+    default = tempfile.mkdtemp(prefix="transients-") if SMALL else "transients"
+    out = Path(sys.argv[1] if len(sys.argv) > 1 else default)
     out.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
 
     b = ballbal.Balancer(Omega=2.0, zeta=0.05, eta=(1.0, 1.0))
-    zb = [0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4, 0.6, 0.8]
-    df = ballbal.track_damping_study(b, zb, to=2.5, t_end=2000)
+    df = ballbal.track_damping_study(b, ZETA_B, to=2.5, t_end=STUDY_END)
     print(df)
     best = df.filter(df["optimal"])["zeta_b"][0]
     print(f"track damping with the best combined index: zeta_b = {best}")
@@ -42,8 +50,8 @@ def main() -> None:
     ax[0].set_ylabel("peak radial amplitude / e")
     ax0b.set_ylabel("settling time (1/w_n)")
     ax[0].set_title(f"speed disturbance 2.0 -> 2.5: best zeta_b = {best}")
-    for z in (0.02, best, 0.8):
-        r = ballbal.disturbance_response(b.replace(zeta_b=z), 2.5, t_end=600)
+    for z in (ZETA_B[0], best) if SMALL else (0.02, best, 0.8):
+        r = ballbal.disturbance_response(b.replace(zeta_b=z), 2.5, t_end=RESPONSE_END)
         tr = r.trajectory
         ax[1].plot(tr["t"], np.hypot(tr["x"], tr["y"]), lw=0.8, label=f"zeta_b = {z}")
     ax[1].set_xlabel("t (1/w_n)")
@@ -54,7 +62,7 @@ def main() -> None:
     base = ballbal.Balancer(Omega=0.3, zeta=0.05, zeta_b=0.05, eta=(1.0, 1.0))
     ramp = ballbal.Ramp(to=2.0, start=0.0, duration=300.0)
     y0 = [0.0, 0.0, 1.0, -1.0, 0.0, 0.0, 0.0, 0.0]
-    t = np.linspace(0, 800, 8001)
+    t = np.linspace(0, RUN_UP_END, int(10 * RUN_UP_END) + 1)
     for springs, label in ((0.0, "classic"), (2e-5, "ball springs k_d/k = 2e-5")):
         sc = ballbal.Scene(balancer=base, springs=springs, ramp=ramp)
         tr = ballbal.simulate(sc, y0, t)

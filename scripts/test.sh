@@ -11,6 +11,8 @@ export CARGO_TERM_COLOR=never
 stamp() { echo "== [$(( SECONDS / 60 ))m$(( SECONDS % 60 ))s] $*"; }
 stamp "cargo test (core, no Python)"
 cargo test --release -p ballbal-core
+stamp "cargo clippy"
+cargo clippy --release --all-targets -- -D warnings
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -23,7 +25,15 @@ wheel=$(ls "$work"/dist/ballbal-*.whl)
 stamp "install $(basename "$wheel") into a clean venv"
 "$py" -m venv "$work/venv"
 "$work/venv/bin/pip" install -q --upgrade pip
-"$work/venv/bin/pip" install -q "$wheel[test,plot]"
+"$work/venv/bin/pip" install -q "$wheel[test,plot,lint]"
+
+stamp "ruff, mypy, stubtest"
+"$work/venv/bin/ruff" check --no-cache python tests benchmarks examples scripts
+# The source package, typed against the venv's numpy and polars; ballbal._native is read
+# from python/ballbal/_native.pyi (mypy cannot read the extension, so a missing stub fails).
+"$work/venv/bin/python" -m mypy --cache-dir "$work/mypy-cache" python/ballbal
+# The stub against the installed extension module, from outside the source tree.
+(cd "$work" && "$work/venv/bin/python" -m mypy.stubtest ballbal._native)
 
 stamp "pytest against the installed package"
 cp -r tests "$work/tests"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, overload
 
 import numpy as np
 import polars as pl
@@ -26,6 +26,7 @@ def _state_names(model: Balancer | Scene) -> list[str]:
     return q + [f"d{c}" for c in q]
 
 
+@overload
 def simulate(
     balancer: Balancer | Scene,
     y0: Sequence[float] | np.ndarray | None = None,
@@ -36,7 +37,33 @@ def simulate(
     rtol: float = 1e-8,
     atol: float | Sequence[float] = 1e-10,
     max_steps: int = 10_000_000,
-) -> pl.DataFrame:
+    stats: Literal[False] = False,
+) -> pl.DataFrame: ...
+@overload
+def simulate(
+    balancer: Balancer | Scene,
+    y0: Sequence[float] | np.ndarray | None = None,
+    t_eval: Sequence[float] | np.ndarray | None = None,
+    *,
+    t_span: tuple[float, float] | None = None,
+    t0: float | None = None,
+    rtol: float = 1e-8,
+    atol: float | Sequence[float] = 1e-10,
+    max_steps: int = 10_000_000,
+    stats: Literal[True],
+) -> tuple[pl.DataFrame, dict[str, int]]: ...
+def simulate(
+    balancer: Balancer | Scene,
+    y0: Sequence[float] | np.ndarray | None = None,
+    t_eval: Sequence[float] | np.ndarray | None = None,
+    *,
+    t_span: tuple[float, float] | None = None,
+    t0: float | None = None,
+    rtol: float = 1e-8,
+    atol: float | Sequence[float] = 1e-10,
+    max_steps: int = 10_000_000,
+    stats: bool = False,
+) -> pl.DataFrame | tuple[pl.DataFrame, dict[str, int]]:
     """Integrate the equations of motion with the core's Dormand–Prince 5(4).
 
     ``y0 = (q, q')`` in the rotating frame, ``q = (x, y, b_1..b_n)`` (with a tilting disk
@@ -50,7 +77,16 @@ def simulate(
     ``max_steps`` bounds the integrator's steps (accepted and rejected); a simulation
     that needs more stops with an :class:`~ballbal.exceptions.IntegrationError` saying
     how far it got. At most ``1e7`` output times.
+
+    With ``stats=True`` returns ``(df, stats)``, ``stats`` the integrator's counts under
+    scipy's names: ``nfev`` (right-hand-side evaluations), ``naccept`` and ``nreject``
+    (accepted and rejected steps). The method has seven stages, the last of a step being
+    the first of the next (FSAL), so ``nfev = 6 (naccept + nreject) + 2``: one evaluation
+    at the start and one to choose the first step, as scipy's ``RK45`` counts.
     """
+    if not isinstance(stats, (bool, np.bool_)):
+        raise ParameterTypeError("stats", f"must be True or False, got {stats!r:.60}",
+                                 value=stats)
     _check.model("balancer", balancer)
     n = balancer.n_balls
     d = len(balancer.coordinates)
@@ -77,16 +113,19 @@ def simulate(
         t0 = span[0] if span is not None else 0.0
     t0 = _check.real("t0", t0, finite=True)
     steps = _check.integer("max_steps", max_steps, 1)
-    y, theta, *_ = _native.simulate(*balancer.native_args(), y0, t0, t,
-                                    _check.real("rtol", rtol), _atol(atol),
-                                    balancer.native_effects(), steps)
+    y, theta, naccept, nreject, nfev = _native.simulate(
+        *balancer.native_args(), y0, t0, t, _check.real("rtol", rtol), _atol(atol),
+        balancer.native_effects(), steps)
     cols: dict[str, Any] = {"t": t}
     for name, col in zip(_state_names(balancer), np.asarray(y).T, strict=True):
         cols[name] = col
     cols["theta"] = theta
     cols["X"] = cols["x"] * np.cos(theta) - cols["y"] * np.sin(theta)
     cols["Y"] = cols["x"] * np.sin(theta) + cols["y"] * np.cos(theta)
-    return pl.DataFrame(cols)
+    df = pl.DataFrame(cols)
+    if stats:
+        return df, {"nfev": nfev, "naccept": naccept, "nreject": nreject}
+    return df
 
 
 def _span(t_span: Any) -> tuple[float, float]:

@@ -73,8 +73,8 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     for key in ("status", "stability", "index", "whirl", "tilt", "residual"):
         cols[key] = []
     for i, (combo, d) in enumerate(zip(grid, results, strict=True)):
-        for n, v in zip(names, combo, strict=True):
-            cols[n].append(v)
+        for n, x in zip(names, combo, strict=True):
+            cols[n].append(x)
         if d is None:
             for key in ("stability", "index", "whirl", "tilt", "residual"):
                 cols[key].append(None)

@@ -79,9 +79,9 @@ def _model(a: argparse.Namespace) -> Balancer | Scene:
                              allowed=f"[1, {MAX_BALLS}]")
     if a.balls is not None and a.eta is not None and len(a.eta) > 1 and len(a.eta) != a.balls:
         raise ParameterError("balls", f"{a.balls} balls but {len(a.eta)} values of --eta")
-    eta = a.eta or [1.0]
+    eta: list[float] = a.eta or [1.0]
     eta = eta if len(eta) > 1 else eta * (2 if a.balls is None else a.balls)
-    return Balancer(**{**_DEFAULTS, **given}, eta=eta)
+    return Balancer(**{**_DEFAULTS, **given}, eta=tuple(eta))
 
 
 def _params(p: argparse.ArgumentParser) -> None:
@@ -126,6 +126,7 @@ def _print_periodic(b: Balancer | Scene, pattern: str, N: int) -> None:
     if not s.converged:
         print(f"  {pattern} N={N}: {s.status} after {s.iterations} iterations")
         return
+    assert s.multipliers is not None  # a converged solve has its multipliers
     mods = " ".join(f"{m:.4f}" for m in np.sort(np.abs(s.multipliers))[::-1])
     print(f"  {s.type} N={N}: omega={s.omega:.6f} (period {s.period:.3f}), {s.stability}; "
           f"|multipliers| {mods}; trivial error {s.trivial_error:.1e}; residual "

@@ -78,7 +78,12 @@ class Balancer:
         return None
 
     def replace(self, **changes: Any) -> Balancer:
+        """A copy with fields changed; a single number for ``eta`` sets every ball's
+        value (the number of balls stays; give a sequence to change it), as
+        :meth:`ballbal.Scene.replace` and scans do."""
         _unknown_fields(Balancer, changes)
+        if "eta" in changes and _is_number(changes["eta"]):
+            changes["eta"] = (changes["eta"],) * self.n_balls
         return replace(self, **changes)
 
     def validate(self) -> Balancer:

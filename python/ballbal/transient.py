@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import polars as pl
@@ -117,7 +117,8 @@ def track_damping_study(
     ok = df.filter(pl.col("settle_time").is_not_null())
     if ok.height == 0:
         return df.with_columns(index=pl.lit(None, dtype=pl.Float64), optimal=pl.lit(False))
-    scale = ok["settle_time"].mean() / ok["peak"].mean()
+    # polars types a mean as any literal; of a non-empty Float64 column it is a float
+    scale = cast(float, ok["settle_time"].mean()) / cast(float, ok["peak"].mean())
     df = df.with_columns(index=pl.col("peak") * scale + pl.col("settle_time"))
     best = df["index"].arg_min()
     return df.with_columns(optimal=pl.Series([i == best for i in range(df.height)]))

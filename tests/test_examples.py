@@ -1,0 +1,139 @@
+"""Every script in examples/ runs, small (BALLBAL_EXAMPLE_SMALL=1), so that none can rot:
+it exits 0, writes its figures as PNG files, and what it prints or saves agrees with
+values known independently (the thesis' published case, computed by shooting in the
+spec; closed forms). The test command points BALLBAL_REPO at the checkout, since the
+tests run from a copy."""
+
+import os
+import pathlib
+import re
+import struct
+import subprocess
+import sys
+from collections.abc import Callable
+
+import numpy as np
+import polars as pl
+import pytest
+
+REPO = pathlib.Path(os.environ.get("BALLBAL_REPO") or pathlib.Path(__file__).resolve().parents[1])
+EXAMPLES = REPO / "examples"
+
+# The spec's independent shooting value for the thesis' R-R case (mu 0.2, zeta 0.05,
+# zeta_b 0.05, delta 50, Omega 1.2, eta 1.0): omega and the largest nontrivial modulus.
+RR_OMEGA, RR_MODULUS = 0.25141, 0.8637
+
+
+def check_png(path: pathlib.Path) -> None:
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG"
+    assert data[12:16] == b"IHDR"
+    width, height = struct.unpack(">II", data[16:24])
+    assert width > 100 and height > 100, (path, width, height)
+
+
+def standard_rr(df: pl.DataFrame, **at: float) -> dict:
+    """The stable R-R row at the thesis' standard point (a map may hold other R-R)."""
+    sel = pl.lit(True)
+    for k, v in at.items():
+        sel = sel & ((pl.col(k) - v).abs() < 1e-9)
+    rows = df.filter(sel & (pl.col("type") == "R-R") & (pl.col("stability") == "stable"))
+    assert rows.height == 1, rows
+    return rows.row(0, named=True)
+
+
+def accuracy_cost(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    df = pl.read_parquet(out / "standard.parquet")
+    # The reference orbit closes after one period of an independent time simulation.
+    closure = float(re.search(r"reference closure by simulation (\S+)", stdout).group(1))
+    assert np.isclose(closure, df["reference_closure"][0], rtol=0.01) and closure < 1e-6
+    assert set(df["knob"]) == {"N", "samples", "tol", "rtol"}
+    assert df["verdict_ok"].all()
+    # Harmonic balance converges in N: 4 harmonics are far closer than 2.
+    n = df.filter(pl.col("knob") == "N").sort("value")["omega_error"].to_list()
+    assert n[1] < n[0] / 100 and n[1] < 1e-6
+    return [out / "accuracy_cost.png"]
+
+
+def thesis_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    df = pl.read_parquet(out / "map_zeta0.05_zetab0.05.parquet")
+    row = standard_rr(df, Omega=1.2, eta=1.0)
+    assert abs(row["omega"] - RR_OMEGA) < 1e-4
+    assert abs(row["max_modulus"] - RR_MODULUS) < 1e-3
+    # Closed form: the perfect balance exists where the two balls can cancel the
+    # unbalance, eta >= 1/2.
+    pb = df.unique(subset=["Omega", "eta"])
+    assert pb.height == 9
+    assert pb.filter(pl.col("pb_exists") != (pl.col("eta") >= 0.5)).height == 0
+    assert "zeta 0.05 zeta_b 0.05" in stdout and "R-R stable" in stdout
+    return [out / f for f in ("map_zeta0.05_zetab0.05.png", "map_zeta0.05_zetab0.1.png",
+                              "omega_vs_eta.png", "rr_maps.png")]
+
+
+def scene_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Without springs the planar scene is the thesis' balancer.
+    df = pl.read_parquet(out / "scene_map_planar.parquet")
+    row = standard_rr(df, Omega=1.2, springs=0.0)
+    assert abs(row["omega"] - RR_OMEGA) < 1e-4
+    assert abs(row["max_modulus"] - RR_MODULUS) < 1e-3
+    assert re.findall(r": (\d+) points", stdout) == ["9", "9"]
+    assert (out / "scene_map_tilt.parquet").exists()
+    return [out / "scene_maps.png"]
+
+
+def transients(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Above the resonance, with eta >= 1/2, the balls find the perfect balance again
+    # after the speed step and at the end of the classic run-up (automatic balancing).
+    table = stdout.split("track damping with")[0]
+    finals = [float(x) for x in re.findall(r"│\s*[\d.]+\s*┆[^┆]+┆[^┆]+┆\s*(\S+)\s*┆", table)]
+    assert len(finals) == 2 and max(finals) < 1e-3, finals
+    best = float(re.search(r"best combined index: zeta_b = (\S+)", stdout).group(1))
+    assert best in (0.05, 0.4)
+    run = dict(re.findall(r"run-up, (classic|ball springs)[^:]*: peak r = \S+ e, "
+                          r"final r = (\S+) e", stdout))
+    assert float(run["classic"]) < 1e-3, run
+    # Springs hold the balls off the balancing positions: a residual whirl stays.
+    assert float(run["ball springs"]) > 10 * float(run["classic"]), run
+    return [out / "transients.png"]
+
+
+def seed004(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    counts = re.findall(r"\): (\d+) points", stdout)
+    assert counts == ["45"] * 4, counts  # 9 speeds x 5 values, each map
+    final = dict(re.findall(r"run-up 0.3 -> 2.0, (classic|ball springs)[^:]*:.*final whirl "
+                            r"(\S+) e", stdout))
+    assert float(final["classic"]) < 0.01, final
+    assert "wrote" in stdout
+    return [out / "seed004.png"]
+
+
+CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "accuracy_cost.py": accuracy_cost,
+    "thesis_maps.py": thesis_maps,
+    "scene_maps.py": scene_maps,
+    "transients.py": transients,
+    "seed004.py": seed004,
+}
+
+
+def test_every_example_is_checked():
+    assert EXAMPLES.is_dir(), f"{EXAMPLES}: set BALLBAL_REPO to the repository checkout"
+    assert {p.name for p in EXAMPLES.glob("*.py")} == set(CHECKS)
+
+
+@pytest.mark.parametrize("name", sorted(CHECKS))
+def test_example_runs_small(name, tmp_path):
+    script = EXAMPLES / name
+    assert script.exists(), f"{script}: set BALLBAL_REPO to the repository checkout"
+    out = tmp_path / "out"
+    out.mkdir()
+    args = ["--out", str(out / "seed004.png")] if name == "seed004.py" else [str(out)]
+    env = {**os.environ, "BALLBAL_EXAMPLE_SMALL": "1", "MPLBACKEND": "Agg"}
+    # From tmp_path, so that nothing can land in the checkout.
+    res = subprocess.run([sys.executable, str(script), *args], cwd=tmp_path, env=env,
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    for png in CHECKS[name](out, res.stdout):
+        check_png(png)
+    assert not any(p.suffix == ".png" for p in tmp_path.iterdir())
+
