@@ -533,8 +533,7 @@ fn starts(n: usize, o: usize) -> (Vec<Vec<f64>>, bool) {
             let mut rem = idx;
             for i in 0..n {
                 // Offset so that no start sits exactly on a symmetric (singular) point.
-                q[o + i] =
-                    -PI + (rem % per) as f64 * 2.0 * PI / per as f64 + 0.1 + 0.01 * i as f64;
+                q[o + i] = -PI + (rem % per) as f64 * 2.0 * PI / per as f64 + 0.1 + 0.01 * i as f64;
                 rem /= per;
             }
             out.push(q);
@@ -812,9 +811,9 @@ mod tests {
                 .expect("perfect balance");
             // Closed form of the family: x = y = 0 and the balls' unbalance cancels the
             // disk's, sum eta e^(i b) = -1.
-            let (cs, sn) = pb.q[2..]
-                .iter()
-                .fold((0.0, 0.0), |(a, b), &t| (a + eta * t.cos(), b + eta * t.sin()));
+            let (cs, sn) = pb.q[2..].iter().fold((0.0, 0.0), |(a, b), &t| {
+                (a + eta * t.cos(), b + eta * t.sin())
+            });
             assert!(pb.q[0].abs() < 1e-10 && pb.q[1].abs() < 1e-10);
             assert!((cs + 1.0).abs() < 1e-10 && sn.abs() < 1e-10, "{cs} {sn}");
             assert_eq!(pb.neutral, n - 2);
@@ -850,4 +849,3 @@ mod tests {
         assert!(!same_in_order(true, 2, &a, &wound));
     }
 }
-

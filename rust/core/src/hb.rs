@@ -581,7 +581,14 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
     for it in 1..=opts.max_iter {
         // A cancelled solve's result is discarded by whoever cancelled it (see `cancel`).
         if crate::cancel::cancelled() {
-            finish(&x, &mut out, Status::MaxIterations, rn, f64::INFINITY, it - 1);
+            finish(
+                &x,
+                &mut out,
+                Status::MaxIterations,
+                rn,
+                f64::INFINITY,
+                it - 1,
+            );
             return out;
         }
         if !rn.is_finite() {

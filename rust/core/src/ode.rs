@@ -481,7 +481,14 @@ where
 /// first `steps` steps, `Ok` otherwise (other failures are left to the integration that
 /// needs the answer to report). A cheap test before analyses that swallow integration
 /// failures (a guess simulation that fails is just "no guess").
-pub fn probe_stiffness<F>(f: F, t0: f64, y0: &[f64], t1: f64, opts: &Options, steps: usize) -> Result<()>
+pub fn probe_stiffness<F>(
+    f: F,
+    t0: f64,
+    y0: &[f64],
+    t1: f64,
+    opts: &Options,
+    steps: usize,
+) -> Result<()>
 where
     F: FnMut(f64, &[f64], &mut [f64]),
 {

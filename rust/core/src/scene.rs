@@ -272,16 +272,14 @@ impl Scene {
             }
             _ => {
                 planar = self.planar.with_param(name, value).map_err(|e| match e {
-                    Error::InvalidParameter { name: n, message, .. }
-                        if message.starts_with("is not a") =>
-                    {
-                        Error::param(
-                            n,
-                            "is not a parameter of the scene (mu, zeta, zeta_b, delta, Omega, \
+                    Error::InvalidParameter {
+                        name: n, message, ..
+                    } if message.starts_with("is not a") => Error::param(
+                        n,
+                        "is not a parameter of the scene (mu, zeta, zeta_b, delta, Omega, \
                              eta, eta[i], zeta_b[i], springs, gravity; with a tilting disk \
                              a, b, j_t, j_z, zeta_r)",
-                        )
-                    }
+                    ),
                     e => e,
                 })?
             }

@@ -858,9 +858,7 @@ fn run_scan<D: ballbal_core::scan::Family>(
                 let _ = tx.send((c, rows));
             })
         },
-        |(c, rows)| {
-            scan_columns(py, cols, &rows).and_then(|d| on_chunk.call1((c, d)).map(|_| ()))
-        },
+        |(c, rows)| scan_columns(py, cols, &rows).and_then(|d| on_chunk.call1((c, d)).map(|_| ())),
     )
 }
 
