@@ -11,7 +11,10 @@ export CARGO_TERM_COLOR=never
 stamp() { echo "== [$(( SECONDS / 60 ))m$(( SECONDS % 60 ))s] $*"; }
 stamp "cargo test (core, no Python)"
 cargo test --release -p ballbal-core
-stamp "cargo clippy"
+stamp "cargo fmt --check, cargo clippy"
+if cargo fmt --version >/dev/null 2>&1; then
+  cargo fmt --all -- --check
+fi
 if cargo clippy --version >/dev/null 2>&1; then
   cargo clippy --release --all-targets -- -D warnings
 else
