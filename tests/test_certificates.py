@@ -159,6 +159,25 @@ def test_scan_rows_are_certified():
         assert simulated_closure(s, rtol=1e-9) < 0.75
 
 
+def test_scan_certificate_thresholds_are_options():
+    # A truncated series never satisfies the equations exactly (its defect is > 0), and
+    # RK45 at rtol 1e-6 cannot put the trivial multiplier within 1e-14 of 1: with those
+    # thresholds nothing may pass, whatever the default scan finds.
+    b = ballbal.Balancer(**REPRO, Omega=1.2, eta=(1.0, 1.0))
+    kw = dict(Omega=[1.1, 1.2], eta=[0.9, 1.0], patterns=["R-R"], threads=1)
+    default = ballbal.scan(b, **kw)
+    assert (default["status"] == "converged").sum() >= 3
+    tight = ballbal.scan(b, max_closure=1e-12, **kw)
+    assert (tight["status"] == "converged").sum() == 0
+    verdictless = ballbal.scan(b, max_trivial=1e-14, **kw)
+    ok = verdictless.filter(verdictless["status"] == "converged")
+    assert ok.height == (default["status"] == "converged").sum()
+    assert (ok["stability"] == "undetermined").all()
+    with pytest.raises(ParameterError) as info:
+        ballbal.scan(b, max_trivial=2.0, **kw)
+    assert info.value.parameter == "max_trivial"
+
+
 params = st.fixed_dictionaries({
     "mu": st.floats(0.1, 0.3), "zeta": st.floats(0.02, 0.1), "zeta_b": st.floats(0.03, 0.2),
     "delta": st.floats(20.0, 100.0), "eta": st.floats(0.7, 1.3),

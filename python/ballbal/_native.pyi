@@ -65,7 +65,8 @@ def scan(
     guess_rtol: float, auto: float | None, n_max: int, hill: bool, seeds: int, starts: int,
     chunk: int, max_tail: float, threads: int,
     chunks: list[int], on_chunk: Callable[[int, dict[str, Any]], None],
-    effects: _Effects = None, block: int | None = None,
+    effects: _Effects = None, block: int | None = None, max_closure: float = ...,
+    max_trivial: float = ...,
 ) -> None: ...
 def default_chunk(lens: list[int]) -> int: ...
 def certificate_seconds() -> float: ...

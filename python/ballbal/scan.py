@@ -129,6 +129,7 @@ class _Job:
             o["settle"], o["window"], o["guess_rtol"], o["auto"], o["N_max"], o["hill"],
             o["seeds"], o["starts"], self.chunk,
             o["max_tail"], threads, chunks, on_chunk, effects, self.block,
+            max_closure=o.get("max_closure", 6.0), max_trivial=o.get("max_trivial", 0.1),
         )
 
     def n_chunks(self) -> int:
@@ -465,6 +466,8 @@ def scan(  # noqa: E302 - overloads above
     seeds: int = 4,
     starts: int = 4,
     max_tail: float = 0.25,
+    max_closure: float = 6.0,
+    max_trivial: float = 0.1,
     block: int | None = None,
     chunk: int | None = None,
     threads: int | None = None,
@@ -497,7 +500,10 @@ def scan(  # noqa: E302 - overloads above
     the table depends on it and on nothing else of the layout. Coexisting solutions of
     one type get separate rows (``solution`` 0, 1, ...); a point and type with none gets
     one row with ``status="not_found"`` and nulls. ``max_tail`` refuses series whose
-    last harmonic is that large relative to the motion (``N`` too small).
+    last harmonic is that large relative to the motion (``N`` too small). Every solution
+    is certified as in :func:`~ballbal.periodic` (``max_closure``, ``max_trivial``, the
+    same defaults): a series that fails is neither reported nor continued, and a row
+    gets a stability verdict only with an accurate trivial multiplier.
 
     ``chunk``: values of the last axis per chunk, rounded up to whole blocks (default
     one block): the unit of progress, interruption, resumption, files and executor
@@ -532,7 +538,8 @@ def scan(  # noqa: E302 - overloads above
         max_steps=max_steps, seeds=seeds, starts=starts, chunk=chunk, threads=threads, out=out,
         hill=hill, floquet=floquet, reals=dict(
             target=target, tol=tol, step_tol=step_tol, rtol=rtol, atol=atol, margin=margin,
-            settle=settle, window=window, guess_rtol=guess_rtol, max_tail=max_tail))
+            settle=settle, window=window, guess_rtol=guess_rtol, max_tail=max_tail,
+            max_closure=max_closure, max_trivial=max_trivial))
     axes_all: dict[str, GridSpec] = dict(grid or {})
     for k, v in axes.items():
         if k in axes_all:
@@ -584,6 +591,7 @@ def scan(  # noqa: E302 - overloads above
         ("margin", float(margin)), ("max_steps", int(max_steps)), ("settle", float(settle)),
         ("window", float(window)), ("guess_rtol", float(guess_rtol)), ("seeds", int(seeds)),
         ("starts", int(starts)), ("max_tail", float(max_tail)),
+        ("max_closure", float(max_closure)), ("max_trivial", float(max_trivial)),
     )
     job = _Job(model, names, values, tuple(str(p) for p in patterns), options, block, chunk)
     # Validates everything (grid values, combinations, options) before any work.

@@ -730,7 +730,8 @@ fn orbit_closure(
 #[pyo3(signature = (mu, zeta, zeta_b, delta, omega, eta, names, values, patterns,
                     n_harm, samples, tol, step_tol, max_iter, floquet, f_rtol, f_atol, margin,
                     max_steps, settle, window, guess_rtol, auto, n_max, hill, seeds, starts,
-                    chunk, max_tail, threads, chunks, on_chunk, effects=None, block=None))]
+                    chunk, max_tail, threads, chunks, on_chunk, effects=None, block=None,
+                    max_closure=MAX_CLOSURE, max_trivial=MAX_TRIVIAL))]
 #[allow(clippy::too_many_arguments)]
 fn scan(
     py: Python<'_>,
@@ -768,6 +769,8 @@ fn scan(
     on_chunk: Bound<'_, PyAny>,
     effects: Effects,
     block: Option<usize>,
+    max_closure: f64,
+    max_trivial: f64,
 ) -> PyResult<()> {
     use ballbal_core::scan::ScanSpec;
     let lens: Vec<usize> = values.iter().map(Vec::len).collect();
@@ -798,9 +801,8 @@ fn scan(
         auto,
         n_max,
         hill,
-        // Scans certify with the core's defaults; `max_tail` is the scan's own.
-        MAX_CLOSURE,
-        MAX_TRIVIAL,
+        max_closure,
+        max_trivial,
         max_tail,
     )?;
     let cols = Columns {
