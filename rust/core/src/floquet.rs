@@ -173,16 +173,11 @@ pub fn monodromy<D: Dynamics + ?Sized>(
     for i in 0..n2 {
         y0[i * n2 + i] = 1.0;
     }
-    let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
-    let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
+    let (mut q, mut v, mut a) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
     let mut cols = vec![0.0; 2 * d * d];
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| {
-        sol.eval(om * t, &mut q, &mut qt, &mut qtt);
-        for j in 0..d {
-            v[j] = om * qt[j];
-            a[j] = om * om * qtt[j];
-        }
+        sol.eval_rates(om * t, &mut q, &mut v, &mut a);
         model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
         // Bottom half of A = [-M^-1 K, -M^-1 C], as 2d columns of length d.
         for j in 0..d {
@@ -310,17 +305,12 @@ pub fn separation_error<D: Dynamics + ?Sized>(
     // for a periodic integrand) at the harmonic-balance sample count.
     let s = crate::hb::default_samples(sol.n_harm).max(64);
     let om = sol.omega;
-    let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
-    let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
+    let (mut q, mut v, mut a) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
     let mut integral = 0.0;
     for p in 0..s {
         let tau = 2.0 * std::f64::consts::PI * p as f64 / s as f64;
-        sol.eval(tau, &mut q, &mut qt, &mut qtt);
-        for jj in 0..d {
-            v[jj] = om * qt[jj];
-            a[jj] = om * om * qtt[jj];
-        }
+        sol.eval_rates(tau, &mut q, &mut v, &mut a);
         let t = tau / om;
         model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
         // C e, then M^-1 (C e), then its component along e.
@@ -365,8 +355,7 @@ pub fn hill_multipliers<D: Dynamics + ?Sized>(
     // Enough samples to resolve A's harmonics up to 2H without aliasing.
     let s = (8 * n_hill + 8).max(64);
     let om = sol.omega;
-    let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
-    let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
+    let (mut q, mut v, mut a) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
     let mut cols = vec![0.0; 2 * d * d];
     let mut amat = vec![0.0; n2 * n2];
@@ -375,11 +364,7 @@ pub fn hill_multipliers<D: Dynamics + ?Sized>(
     let mut coef = vec![c64::new(0.0, 0.0); nk * n2 * n2];
     for j in 0..s {
         let tau = 2.0 * std::f64::consts::PI * j as f64 / s as f64;
-        sol.eval(tau, &mut q, &mut qt, &mut qtt);
-        for i in 0..d {
-            v[i] = om * qt[i];
-            a[i] = om * om * qtt[i];
-        }
+        sol.eval_rates(tau, &mut q, &mut v, &mut a);
         let t = tau / om;
         model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
         crate::linalg::state_matrix(model, t, &q, &k, &c, &mut cols, &mut amat);

@@ -252,6 +252,15 @@ impl HbSolution {
         &self.coeffs[j * l..(j + 1) * l]
     }
 
+    /// `q` and its rates in time, `dq/dt = omega dq/dtau`, `d2q/dt2 = omega^2 d2q/dtau2`,
+    /// at phase `tau`: what the model's residual and Jacobians take along the orbit.
+    pub fn eval_rates(&self, tau: f64, q: &mut [f64], v: &mut [f64], a: &mut [f64]) {
+        self.eval(tau, q, v, a);
+        let om = self.omega;
+        v.iter_mut().for_each(|x| *x *= om);
+        a.iter_mut().for_each(|x| *x *= om * om);
+    }
+
     /// `q, dq/dtau, d2q/dtau2` at phase `tau`.
     pub fn eval(&self, tau: f64, q: &mut [f64], qt: &mut [f64], qtt: &mut [f64]) {
         let sc = tau.sin_cos();
@@ -692,18 +701,13 @@ pub fn defect_closure<D: Dynamics + ?Sized>(model: &D, sol: &HbSolution, points:
     if !(om > 0.0 && om.is_finite()) || points == 0 {
         return f64::INFINITY;
     }
-    let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
-    let (mut v, mut a, mut f) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    let (mut q, mut v, mut a, mut f) = (vec![0.0; d], vec![0.0; d], vec![0.0; d], vec![0.0; d]);
     let mut sum = 0.0;
     for k in 0..points {
         // Half a step off a uniform grid of `points`: with `points` a multiple of the
         // collocation samples, none of these phases is a collocation time.
         let tau = 2.0 * PI * (k as f64 + 0.5) / points as f64;
-        sol.eval(tau, &mut q, &mut qt, &mut qtt);
-        for j in 0..d {
-            v[j] = om * qt[j];
-            a[j] = om * om * qtt[j];
-        }
+        sol.eval_rates(tau, &mut q, &mut v, &mut a);
         let t = tau / om;
         model.residual(t, &q, &v, &a, &mut f);
         model.solve_mass(t, &q, &mut f);
