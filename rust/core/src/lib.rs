@@ -1,28 +1,26 @@
 //! ballbal-core: nonlinear dynamics of automatic ball balancers.
 //!
-//! The pure-Rust engine behind the `ballbal` Python package: the planar n-ball
-//! balancer model, an adaptive Dormand–Prince integrator, equilibria with
-//! eigenvalue and Routh–Hurwitz stability, periodic solutions by modified
-//! incremental harmonic balance, Floquet multipliers and parallel scans.
+//! The pure-Rust engine behind the `ballbal` Python package. Layers depend one way:
+//!
+//! * [`model`]: the equations of motion ([`Dynamics`]), the planar balancer and scenes;
+//! * [`numerics`]: integrator, linear algebra, harmonic balance, Floquet multipliers;
+//! * [`analysis`]: simulation, equilibria, periodic solutions and their certificates;
+//! * [`scan`]: parallel parameter scans;
+//! * [`error`] and [`cancel`]: what every layer shares.
 
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod analysis;
 pub mod cancel;
-pub mod equilibria;
 pub mod error;
-pub mod floquet;
-pub mod hb;
-pub mod linalg;
 pub mod model;
-pub mod ode;
-pub mod periodic;
+pub mod numerics;
 pub mod scan;
-pub mod scene;
-pub mod simulate;
-#[rustfmt::skip]
-pub mod tilt_terms;
+
+// Short paths for the modules every layer uses.
+pub use analysis::{equilibria, periodic, simulate};
+pub use numerics::{floquet, hb, linalg, ode};
 
 pub use error::{Error, Result};
-pub use model::{Dynamics, Planar};
-pub use scene::{Scene, SpringLayout};
+pub use model::{Dynamics, Planar, Scene, SpringLayout};

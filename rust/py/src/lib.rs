@@ -180,7 +180,7 @@ type Effects = Option<(
 )>;
 
 fn scene(p: &Planar, effects: Effects) -> PyResult<Option<Scene>> {
-    use ballbal_core::scene::{Impulse, Ramp, Tilt};
+    use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
     let Some((springs, ramp, gravity, impulse, tilt, chain)) = effects else {
         return Ok(None);
     };
@@ -351,7 +351,7 @@ fn equilibria<'py>(
     let sc = autonomous_scene(&p, effects, "equilibria")?;
     let eqs = guarded(py, || {
         Ok(match &sc {
-            Some(s) => s.equilibria(),
+            Some(s) => ballbal_core::analysis::balanced::scene_equilibria(s),
             None => core_equilibria(&p),
         })
     })?;
@@ -387,7 +387,9 @@ fn balanced_states<'py>(
             .map(|s| {
                 // Each point is short: stop between points once cancelled.
                 cancel::with(tok.clone(), || {
-                    (!cancel::cancelled()).then(|| s.balanced_state()).flatten()
+                    (!cancel::cancelled())
+                        .then(|| ballbal_core::analysis::balanced::balanced_state(s))
+                        .flatten()
                 })
             })
             .collect::<Vec<_>>())

@@ -32,7 +32,7 @@
 //! where `A, B` are the disk's Euler tilts scaled by `delta` (the rim's axial
 //! displacement over `e`). The rotor and ball terms, including spin ramp and gravity,
 //! come from `scripts/derive_tilt.py`, which derives them from the Lagrangian and
-//! writes [`crate::tilt_terms`]; springs and the impulsive load are added here as for
+//! writes [`crate::model::tilt_terms`]; springs and the impulsive load are added here as for
 //! the planar disk. The shaft is massless, simply supported, the disk at distances
 //! `a`, `b` (over `r_t`) from the bearings: beam theory gives the translational
 //! stiffness `k = 3 E I (1/a^3 + 1/b^3)` (the `k` of `w_n`), the coupling
@@ -40,16 +40,12 @@
 //! `kappa_t = a^2 b^2 / (a^2 - a b + b^2)` (over `k r_t` and `k r_t^2`). With `a = b`
 //! the coupling vanishes and a disk started flat stays flat: the planar equations.
 
-use crate::equilibria::{
-    analyse_all, analyse_model, equal_balls, equilibria, equilibria_in_track_order, equilibria_of,
-    newton_static, Equilibrium,
-};
 use crate::error::{check_range, Error, Result};
-use crate::model::{Dynamics, Planar};
-use crate::tilt_terms::{
+use crate::model::tilt_terms::{
     ball_jacobians, ball_mass, ball_residual, rotor_jacobians, rotor_mass, rotor_residual,
     RotorConsts,
 };
+use crate::model::{Dynamics, Planar};
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
 
@@ -293,114 +289,6 @@ impl Scene {
             tilt,
         )
         .map(|s| s.with_spring_layout(self.spring_layout))
-    }
-
-    /// The balanced state and its stability (seed 004's "stable balanced region"): the
-    /// equilibrium that continues the planar balancer's perfect balance (`x = y = 0`,
-    /// balls cancelling the unbalance) to this scene. Springs whose rest spacing differs
-    /// from the balancing positions shift it to a nearly balanced state with a residual
-    /// whirl `hypot(x, y)`; it is followed from zero spring stiffness in steps. `None`
-    /// when the balls cannot balance the disk or the continuation fails.
-    pub fn balanced_state(&self) -> Option<Equilibrium> {
-        let q = self.balanced_q()?;
-        let kind = if self.springs > 0.0 {
-            "balanced"
-        } else {
-            "perfect_balance"
-        };
-        Some(analyse_model(self, &q, kind, self.springs == 0.0))
-    }
-
-    /// The balanced state's coordinates, unanalysed (see [`Self::balanced_state`]).
-    fn balanced_q(&self) -> Option<Vec<f64>> {
-        if self.time_dependence().is_some() {
-            return None;
-        }
-        let p = &self.planar;
-        let (n, o) = (p.n_balls(), self.off());
-        // Planar perfect balance: equal pairs have a closed form, otherwise Newton from
-        // balls fanned out opposite the unbalance.
-        let mut q = vec![0.0; n + 2];
-        if n == 2 && p.eta[0] == p.eta[1] {
-            if p.eta[0] < 0.5 {
-                return None;
-            }
-            let b = (-1.0 / (2.0 * p.eta[0])).acos();
-            // balls in track order, b_1 < b_2 < b_1 + 2 pi: springs unwound
-            q[2] = b;
-            q[3] = 2.0 * PI - b;
-        } else {
-            for i in 0..n {
-                q[2 + i] = PI + 1.6 * (i as f64 - (n as f64 - 1.0) / 2.0) / n as f64;
-            }
-            q = newton_static(p, &q)?;
-            if q[0].hypot(q[1]) > 1e-8 {
-                return None;
-            }
-        }
-        let mut start = vec![0.0; self.ndof()];
-        start[o..].copy_from_slice(&q[2..]);
-        if self.springs > 0.0 {
-            self.spring_homotopy(start)
-        } else {
-            newton_static(self, &start)
-        }
-    }
-
-    /// All equilibria found, each analysed, for an autonomous scene (empty otherwise).
-    /// Without springs as for the planar balancer; with springs those with the balls in
-    /// track order (see [`equilibria_in_track_order`]), the one that continues the
-    /// perfect balance (see [`Self::balanced_state`]) of kind `"balanced"`.
-    pub fn equilibria(&self) -> Vec<Equilibrium> {
-        if self.time_dependence().is_some() {
-            return vec![];
-        }
-        let p = &self.planar;
-        let equal = equal_balls(p);
-        if self.springs == 0.0 {
-            return match self.tilt {
-                None => equilibria(p),
-                Some(_) => equilibria_of(self, equal, true),
-            };
-        }
-        let balanced = self.balanced_q();
-        let extra: Vec<Vec<f64>> = balanced.iter().cloned().collect();
-        let mut found = equilibria_in_track_order(self, equal, &extra);
-        if let Some(b) = &balanced {
-            if let Some(f) = found
-                .iter_mut()
-                .find(|(q, _)| q.iter().zip(b).all(|(u, v)| (u - v).abs() < 1e-6))
-            {
-                f.1 = "balanced".into();
-            }
-        }
-        analyse_all(self, found, false)
-    }
-
-    /// Newton along spring stiffness `0 -> self.springs`, halving steps that fail.
-    fn spring_homotopy(&self, mut q: Vec<f64>) -> Option<Vec<f64>> {
-        let mut at: f64 = 0.0;
-        let mut step: f64 = 0.125;
-        while at < 1.0 {
-            let next = (at + step).min(1.0);
-            let mut sc = self.clone();
-            sc.springs = self.springs * next;
-            match newton_static(&sc, &q) {
-                // a continuation step must not jump to another winding of the springs
-                Some(qn) if qn.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1.0) => {
-                    q = qn;
-                    at = next;
-                    step = (step * 2.0).min(0.25);
-                }
-                _ => {
-                    step /= 2.0;
-                    if step < 1e-6 {
-                        return None;
-                    }
-                }
-            }
-        }
-        Some(q)
     }
 
     /// `(Omega(t), Omega'(t), theta(t))`, with `theta(0) = 0`.

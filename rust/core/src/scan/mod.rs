@@ -63,7 +63,7 @@ impl Family for Scene {
         Scene::with_param(self, name, value)
     }
     fn balance(&self) -> Option<Equilibrium> {
-        self.balanced_state()
+        crate::analysis::balanced::balanced_state(self)
     }
 }
 
@@ -821,7 +821,7 @@ mod tests {
         // a = b: no coupling, a flat disk stays flat; every planar orbit is an orbit of
         // the scene with A = B = 0, and the scan must find it with the same omega.
         let base = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
-        let tilt = crate::scene::Tilt {
+        let tilt = crate::model::scene::Tilt {
             a: 2.0,
             b: 2.0,
             j_t: 0.15,
@@ -865,7 +865,7 @@ mod tests {
         assert!(e.to_string().contains("parameter of the scene"), "{e}");
         let e = Family::with_param(&sc, "springs", -1.0).err().unwrap();
         assert!(e.to_string().starts_with("springs"), "{e}");
-        let ramp = crate::scene::Ramp {
+        let ramp = crate::model::scene::Ramp {
             to: 2.0,
             start: 0.0,
             duration: 10.0,

@@ -1,0 +1,7 @@
+//! Analyses a user asks for, built on the numerics: time simulation, equilibria and
+//! their stability, periodic solutions with their certificates.
+
+pub mod balanced;
+pub mod equilibria;
+pub mod periodic;
+pub mod simulate;

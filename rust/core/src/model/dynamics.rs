@@ -1,0 +1,69 @@
+//! The balancer's equations of motion in the disk-fixed rotating frame.
+//!
+//! Every analysis (time simulation, equilibria, harmonic balance, Floquet) works on
+//! the implicit residual `F(t, q, v, a) = M(q) a + g(q, v)`, with `v = q'`, `a = q''`,
+//! and its three Jacobians `K = dF/dq`, `C = dF/dv`, `M = dF/da`. Harmonic balance
+//! never needs `M^-1`; simulation solves `F(t, q, v, a) = 0` for `a`. A model that adds
+//! physical effects only has to supply this residual and its Jacobians.
+//!
+//! Coordinates: `q = (x, y, b_1, ..., b_n)`; see `shared/spec/model.md` section 2.
+//! Ball rows are divided by `m_i = mu eta_i` so that light balls do not make the
+//! harmonic-balance Jacobian badly scaled.
+
+/// The dynamics interface shared by every analysis.
+pub trait Dynamics: Send + Sync {
+    /// Number of generalised coordinates `d`.
+    fn ndof(&self) -> usize;
+    /// Residual `F(t, q, v, a)` into `out` (length `d`).
+    fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]);
+    /// Row-major `d x d` Jacobians `K = dF/dq`, `C = dF/dv`, `M = dF/da` at `(t, q, v, a)`.
+    #[allow(clippy::too_many_arguments)]
+    fn jacobians(
+        &self,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    );
+    /// Solves `M(q) z = rhs` in place (`M = dF/da`).
+    fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]);
+    /// Solves `M(q) Z = B` in place for `B` stored as consecutive columns of length `d`.
+    /// Models override it to factor `M` once for all columns.
+    fn solve_mass_columns(&self, t: f64, q: &[f64], cols: &mut [f64]) {
+        let d = self.ndof();
+        for c in cols.chunks_mut(d) {
+            self.solve_mass(t, q, c);
+        }
+    }
+    /// Accelerations solving `F(t, q, v, a) = 0`: `a = -M^-1 F(t, q, v, 0)`.
+    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]);
+    /// `None` when the equations do not depend on `t`; otherwise the effect responsible.
+    fn time_dependence(&self) -> Option<String> {
+        None
+    }
+    /// The disk's spin `Omega` at rest of any spin profile: simulated starts begin at
+    /// rest in the ground frame, i.e. with ball rates `-Omega`.
+    fn base_spin(&self) -> f64 {
+        0.0
+    }
+    /// Index of the first ball angle in `q` (the coordinates before it are the rotor's).
+    fn first_ball(&self) -> usize {
+        2
+    }
+    /// Whether ball angles that differ by whole turns are the same state (not so when
+    /// springs count the turns).
+    fn angles_modulo_turns(&self) -> bool {
+        true
+    }
+}
+
+/// First-order right-hand side `y' = f(t, y)` with `y = (q, v)`.
+pub fn first_order_rhs<D: Dynamics + ?Sized>(model: &D, t: f64, y: &[f64], dy: &mut [f64]) {
+    let d = model.ndof();
+    let (q, v) = y.split_at(d);
+    dy[..d].copy_from_slice(v);
+    model.accel(t, q, v, &mut dy[d..]);
+}

@@ -1,0 +1,8 @@
+//! Numerical methods, generic over [`crate::model::Dynamics`]: the integrator, small
+//! dense linear algebra, harmonic balance and Floquet multipliers. Nothing here knows
+//! a concrete model.
+
+pub mod floquet;
+pub mod hb;
+pub mod linalg;
+pub mod ode;
