@@ -5,8 +5,9 @@ Python's own conversions fail with messages that do not name the parameter (``fl
 word, and pyo3 raises ``OverflowError`` for a negative count. These helpers refuse such
 values with a :class:`ParameterTypeError` / :class:`ParameterError` that names the
 parameter and its allowed range. Value ranges that the core checks where it consumes the
-value stay in the core; the integer ranges here are the core's own, stated once more
-only so that a negative or huge count never reaches the conversion to ``usize``.
+value stay in the core (the option classes of :mod:`ballbal.options` check types only);
+a count is refused here only when negative or huge, so that it never reaches the
+conversion to ``usize``.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 # ballbal.Balancer or ballbal.Scene and the options the dataclasses of ballbal.options,
 # read by attribute. pyo3 accepts any sequence for a `Vec`; the stub asks for lists, as
 # the facade passes them.
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -27,7 +27,7 @@ def simulate(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
 def validate(model: Balancer | Scene) -> None: ...
 def equilibria(model: Balancer | Scene) -> list[dict[str, Any]]: ...
-def balanced_states(models: list[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
+def balanced_states(models: Sequence[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
 def periodic(
     model: Balancer | Scene, pattern: str, options: PeriodicOptions,
     guess: tuple[float, npt.NDArray[np.float64]] | None = None,

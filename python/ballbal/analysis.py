@@ -219,8 +219,8 @@ class PeriodicSolution:
     max_modulus: float | None
     trivial_error: float | None
     floquet_steps: int | None
-    #: The Newton matrix's smallest over largest pivot at the solution (scan tables'
-    #: column of the same name); tiny values mean a nearly singular system.
+    #: The last Newton matrix's largest over smallest LU pivot, a lower bound of its
+    #: condition number (the scan tables' column of the same name).
     pivot_ratio: float
     tail: float = float("nan")
     target_met: bool | None = None

@@ -281,9 +281,20 @@ def with_keywords(options: Any, where: str, kwargs: dict[str, Any],
         part, name = _LEGACY[k]
         parts.setdefault(part, {})[name] = v
     top = parts.pop("", {})
-    for part, changes in parts.items():
-        top[part] = replace(getattr(options, part), **changes)
-    return replace(options, **top)
+    part = ""
+    try:
+        for part, changes in parts.items():
+            top[part] = replace(getattr(options, part), **changes)
+        part = ""
+        return replace(options, **top)
+    except ParameterError as e:
+        # Name the keyword as the caller typed it (``floquet``, not ``monodromy``).
+        typed = [k for k in kw if _LEGACY[k][1] == e.parameter
+                 and _LEGACY[k][0] == part]
+        if typed and typed[0] != e.parameter:
+            raise type(e)(typed[0], e.message.removeprefix(f"{e.parameter}:").strip(),
+                          allowed=e.allowed, value=e.value) from e
+        raise
 
 
 PERIODIC_KEYWORDS = frozenset(k for k in _LEGACY

@@ -554,8 +554,9 @@ def scan(  # noqa: E302 - overloads above
     elif not isinstance(execution, Execution):
         raise ParameterTypeError("execution", f"must be a ballbal.Execution, got "
                                  f"{type(execution).__name__}", value=execution)
-    given = {k: v for k, v in (("chunk", chunk), ("threads", threads), ("out", out),
-                               ("executor", executor)) if v is not None}
+    given: dict[str, Any] = {k: v for k, v in (("chunk", chunk), ("threads", threads),
+                                               ("out", out), ("executor", executor))
+                             if v is not None}
     if progress is not False:
         given["progress"] = progress
     if lazy is not False:

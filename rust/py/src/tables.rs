@@ -39,8 +39,9 @@ impl Cell {
     }
 }
 
-/// The schema's names, in the order of [`solution_cells`]. `pivot_ratio` is the
-/// Newton matrix's smallest over largest pivot (stored scan tables use the name).
+/// The schema's names, in the order of [`solution_cells`]. `pivot_ratio` is the last
+/// Newton matrix's largest over smallest LU pivot, a lower bound of its condition
+/// number (`PeriodicSolution.condition` before; stored scan tables use this name).
 pub const SOLUTION_FIELDS: [&str; 19] = [
     "status",
     "omega",
