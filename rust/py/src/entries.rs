@@ -63,7 +63,10 @@ pub fn simulate<'py>(
         max_steps,
         ..Default::default()
     };
-    let traj = guarded(py, || dispatch!(&m, d => core_simulate(d, &y0, t0, &te, &opts)))?;
+    let traj = guarded(
+        py,
+        || dispatch!(&m, d => core_simulate(d, &y0, t0, &te, &opts)),
+    )?;
     let cols = y0.len();
     let flat: Vec<f64> = traj.y.into_iter().flatten().collect();
     let arr = PyArray1::from_vec(py, flat).reshape([te.len(), cols])?;
@@ -165,7 +168,13 @@ fn start(m: &Model, rotating: &[bool], w: f64, c: &[f64]) -> PyResult<HbSolution
         winding[o + i] = if r { -1.0 } else { 0.0 };
     }
     let nh = (c.len() / d - 1) / 2;
-    Ok(HbSolution::start(w, c.to_vec(), winding, nh, Status::NoGuess))
+    Ok(HbSolution::start(
+        w,
+        c.to_vec(),
+        winding,
+        nh,
+        Status::NoGuess,
+    ))
 }
 
 /// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers;
@@ -243,7 +252,10 @@ pub fn orbit_closure(
     }
     let n_harm = (c.len() / d - 1) / 2;
     let sol = HbSolution::start(omega, c, winding, n_harm, Status::Converged);
-    guarded(py, || dispatch!(&m, x => closure_error(x, &sol, rtol, atol)))
+    guarded(
+        py,
+        || dispatch!(&m, x => closure_error(x, &sol, rtol, atol)),
+    )
 }
 
 /// Parallel scan of a parameter grid, chunk by chunk. `options` is a
