@@ -30,7 +30,7 @@ pub trait CoreResult<T> {
 
 impl<T> CoreResult<T> for Result<T, Error> {
     fn py(self) -> PyResult<T> {
-        self.map_err(to_py)
+        self.map_err(|e| CoreError(e).into())
     }
 }
 
