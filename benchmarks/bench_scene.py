@@ -36,7 +36,7 @@ def main() -> None:
     hb = {N: best_time(lambda N=N: ballbal.periodic(b, "R-R", N=N, guess=seed, floquet=False,
                                                       hill=False), 40) for N in (3, 8)}
     # right-hand sides the integrator evaluated: time per evaluation, all else included
-    evals = ballbal._native.simulate(*b.native_args(), y0, 0.0, t, 1e-8, [1e-10])[4]
+    evals = ballbal.simulate(b, y0, t, rtol=1e-8, atol=1e-10, stats=True)[1]["nfev"]
     print(f"ballbal {ballbal.__version__}: planar balancer")
     print(f"  simulate 1000 time units (rtol 1e-8):  {sim * 1e3:8.3f} ms "
           f"({evals} right-hand sides, {sim / evals * 1e9:.0f} ns each)")

@@ -47,7 +47,9 @@ NAMES = {
     "settle", "window", "coeffs",
     # scans and maps
     "patterns", "guess_rtol", "seeds", "starts", "max_tail", "chunk", "threads", "out",
-    "grid", "axes", "chunks",
+    "grid", "axes", "chunks", "block",
+    # the option classes (ballbal.options) and the names the core gives their fields
+    "options", "execution", "monodromy", "guess_atol", "lazy", "executor", "progress",
     # transients and accuracy
     "to", "start", "duration", "t_end", "band", "dt", "base_N", "reference_N", "neighbour",
     "repeats",

@@ -162,7 +162,7 @@ def test_effects_at_zero_equal_the_planar_model():
     b = FULL.balancer
     off = ballbal.Scene(balancer=b, ramp=ballbal.Ramp(to=b.Omega, start=0.0, duration=3.0),
                         impulse=ballbal.Impulse(amplitude=0.0, t0=1.0, sharpness=1.0))
-    assert off.native_effects() is not None  # the scene path really runs
+    assert off._effects_on()  # the scene path really runs
     t = np.linspace(0, 50, 101)
     a = ballbal.simulate(b, t_span=(0, 50))
     c = ballbal.simulate(off, t_span=(0, 50))
@@ -230,7 +230,7 @@ def test_scene_files_round_trip(tmp_path):
     flat = tmp_path / "flat.toml"
     flat.write_text("mu = 0.2\nOmega = 1.3\neta = 0.9\nballs = 3\n")
     sc = ballbal.load_scene(flat)
-    assert sc.balancer.eta == (0.9, 0.9, 0.9) and sc.native_effects() is None
+    assert sc.balancer.eta == (0.9, 0.9, 0.9) and not sc._effects_on()
 
 
 @pytest.mark.parametrize(("text", "parameter"), [
@@ -313,7 +313,7 @@ def test_track_damping_trade_off_of_seed_001():
 def test_disturbance_needs_a_stable_balanced_state_and_an_autonomous_scene():
     with pytest.raises(ballbal.exceptions.ParameterError) as info:
         ballbal.disturbance_response(ballbal.Balancer(Omega=1.2), to=1.5)
-    assert info.value.parameter == "balancer"
+    assert info.value.parameter == "model"
     with pytest.raises(ballbal.exceptions.NotAutonomousError) as e:
         ballbal.disturbance_response(ballbal.Scene(gravity=0.1), to=1.5)
     assert e.value.effect == "gravity"

@@ -13,6 +13,14 @@ from .analysis import (
 from .balance import balance_map, balanced_state, plot_balance_map
 from .exceptions import ScanInterrupted
 from .model import Balancer, from_seed003, zeta_from_log_decrement
+from .options import (
+    Execution,
+    Floquet,
+    GuessSearch,
+    HarmonicBalance,
+    PeriodicOptions,
+    ScanOptions,
+)
 from .scan import read_scan, scan, scan_meta
 from .scene import Impulse, Ramp, Scene, Tilt, load_scene
 from .transient import (
@@ -27,11 +35,17 @@ __all__ = [
     "Balancer",
     "DisturbanceResponse",
     "Equilibrium",
+    "Execution",
+    "Floquet",
+    "GuessSearch",
+    "HarmonicBalance",
     "Impulse",
     "ScanInterrupted",
+    "PeriodicOptions",
     "PeriodicSolution",
     "Ramp",
     "RunUp",
+    "ScanOptions",
     "Scene",
     "Tilt",
     "__version__",

@@ -5,17 +5,20 @@ Python's own conversions fail with messages that do not name the parameter (``fl
 word, and pyo3 raises ``OverflowError`` for a negative count. These helpers refuse such
 values with a :class:`ParameterTypeError` / :class:`ParameterError` that names the
 parameter and its allowed range. Value ranges that the core checks where it consumes the
-value stay in the core; the integer ranges here are the core's own, stated once more
-only so that a negative or huge count never reaches the conversion to ``usize``.
+value stay in the core (the option classes of :mod:`ballbal.options` check types only);
+a count is refused here only when negative or huge, so that it never reaches the
+conversion to ``usize``.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 import os
-from collections.abc import Sequence
-from typing import Any
+import warnings
+from collections.abc import Callable, Sequence
+from typing import Any, ParamSpec, TypeVar
 
 import numpy as np
 
@@ -214,33 +217,6 @@ def axis_count(name: str, steps: float) -> int:
     return int(math.floor(steps + 1e-9)) + 1
 
 
-def scan_arguments(balancer: Any, *, patterns: Any, N_max: Any, samples: Any, max_iter: Any,
-                   max_steps: Any, seeds: Any, starts: Any, chunk: Any, threads: Any,
-                   out: Any, hill: Any, floquet: Any, reals: dict[str, Any]) -> tuple[str, ...]:
-    """The type checks of :func:`ballbal.scan`'s arguments (value ranges the core checks
-    are left to it); returns the patterns as a tuple of distinct strings."""
-    model("balancer", balancer)
-    integer("N_max", N_max, 1, 256)
-    optional_integer("samples", samples, 1, 1 << 16)
-    integer("max_iter", max_iter, 1, 10_000)
-    integer("max_steps", max_steps, 1)
-    integer("seeds", seeds, 1, 10_000)
-    integer("starts", starts, 1, 10_000)
-    optional_integer("chunk", chunk, 1)
-    optional_integer("threads", threads, 1, MAX_THREADS)
-    if out is not None:
-        path("out", out)
-    boolean("hill", hill)
-    boolean("floquet", floquet)
-    for k, v in reals.items():
-        real(k, v)
-    p = _patterns_arg("patterns", patterns)
-    if not p:
-        raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
-    return p
-
-
-_patterns_arg = patterns
 
 
 def sequence(name: str, v: Any, *, empty: bool = False) -> list[Any]:
@@ -253,3 +229,25 @@ def sequence(name: str, v: Any, *, empty: bool = False) -> list[Any]:
     if not items and not empty:
         raise ParameterError(name, "must hold at least one value", value=v)
     return items
+
+
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def renamed_model(old: str) -> Callable[[Callable[_P, _R]], Callable[_P, _R]]:
+    """Accepts the first argument's former keyword name ``old`` (``balancer=``,
+    ``scene=``) with a :class:`DeprecationWarning`; the argument is now ``model``
+    in every analysis."""
+    def wrap(f: Callable[_P, _R]) -> Callable[_P, _R]:
+        @functools.wraps(f)
+        def call(*args: _P.args, **kwargs: _P.kwargs) -> _R:
+            if old in kwargs:
+                if args or "model" in kwargs:
+                    raise TypeError(f"{f.__name__}() got multiple values for argument 'model'")
+                warnings.warn(f"{f.__name__}({old}=...) is deprecated: the first argument "
+                              "is called 'model'", DeprecationWarning, stacklevel=2)
+                kwargs["model"] = kwargs.pop(old)
+            return f(*args, **kwargs)
+        return call
+    return wrap

@@ -38,8 +38,9 @@ def _coeff_error(c: np.ndarray, ref: np.ndarray) -> float:
     return float(np.max(np.abs(pad - padr)) / max(1.0, float(np.max(np.abs(ref)))))
 
 
+@_check.renamed_model("balancer")
 def accuracy_cost(
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     pattern: str = "R-R",
     *,
     N: Sequence[int] = (1, 2, 3, 4, 5, 6, 8, 10, 12, 16),
@@ -53,7 +54,7 @@ def accuracy_cost(
     guess: PeriodicSolution | None = None,
 ) -> pl.DataFrame:
     """Error against time for each accuracy knob at one point, as a polars table
-    (``balancer`` may be an autonomous scene).
+    (``model`` may be an autonomous scene).
 
     Knobs, each varied with the others at a high-accuracy baseline (``base_N``
     harmonics, default samples, Newton tol 1e-10, RK45 rtol 1e-9): ``N``; ``samples``
@@ -73,7 +74,7 @@ def accuracy_cost(
     ``verdict_ok`` is null where either verdict is ``undetermined`` (no verdict is not a
     wrong verdict); ``closure``, ``separation_error`` and ``stability`` are columns.
     """
-    _check.model("balancer", balancer)
+    _check.model("model", model)
     _check.string("pattern", pattern)
     N = [_check.integer("N", n, 1, 256) for n in _check.sequence("N", N, empty=True)]
     multiples = [_check.real("samples", m, 0.0, 1 << 16, lo_open=True)
@@ -89,17 +90,17 @@ def accuracy_cost(
                                  f"{type(guess).__name__}", value=guess)
     tight: dict[str, Any] = dict(tol=1e-12, step_tol=1e-10, rtol=1e-11, atol=1e-13, hill=False)
     if guess is None:
-        start = periodic(balancer, pattern, N=8, hill=False)
+        start = periodic(model, pattern, N=8, hill=False)
         if not start.converged:
             raise ParameterError("pattern", f"no {pattern} solution found at this point by "
                              f"simulation (status {start.status}); pass guess=")
         guess = start
-    ref = periodic(balancer, pattern, N=reference_N, guess=guess, **tight)
+    ref = periodic(model, pattern, N=reference_N, guess=guess, **tight)
     if not ref.converged or ref.multipliers is None:
         raise ParameterError("reference_N", f"the N = {reference_N} solve did not converge "
                          f"(status {ref.status})")
     closure = ref.verify(rtol=1e-11, atol=1e-13)
-    near_b = balancer.replace(Omega=balancer.Omega - neighbour)
+    near_b = model.replace(Omega=model.Omega - neighbour)
     near = periodic(near_b, pattern, N=reference_N, guess=ref, hill=False)
     warm = near if near.converged else ref
 
@@ -120,7 +121,7 @@ def accuracy_cost(
         times = []
         for _ in range(repeats):
             t0 = time.perf_counter()
-            s = periodic(balancer, pattern, guess=warm, hill=False, **kw)
+            s = periodic(model, pattern, guess=warm, hill=False, **kw)
             times.append(time.perf_counter() - t0)
         ok = s.converged and s.multipliers is not None
         errors: dict[str, float | None] = dict.fromkeys(

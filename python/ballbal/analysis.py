@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, overload
@@ -12,6 +13,7 @@ import polars as pl
 from . import _check, _native
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
+from .options import PERIODIC_DEFAULTS, PERIODIC_KEYWORDS, PeriodicOptions, with_keywords
 from .scene import Scene
 
 Stability = Literal["stable", "unstable", "undetermined"]
@@ -28,7 +30,7 @@ def _state_names(model: Balancer | Scene) -> list[str]:
 
 @overload
 def simulate(
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     y0: Sequence[float] | np.ndarray | None = None,
     t_eval: Sequence[float] | np.ndarray | None = None,
     *,
@@ -41,7 +43,7 @@ def simulate(
 ) -> pl.DataFrame: ...
 @overload
 def simulate(
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     y0: Sequence[float] | np.ndarray | None = None,
     t_eval: Sequence[float] | np.ndarray | None = None,
     *,
@@ -52,8 +54,9 @@ def simulate(
     max_steps: int = 10_000_000,
     stats: Literal[True],
 ) -> tuple[pl.DataFrame, dict[str, int]]: ...
+@_check.renamed_model("balancer")
 def simulate(
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     y0: Sequence[float] | np.ndarray | None = None,
     t_eval: Sequence[float] | np.ndarray | None = None,
     *,
@@ -67,7 +70,7 @@ def simulate(
     """Integrate the equations of motion with the core's Dormand–Prince 5(4).
 
     ``y0 = (q, q')`` in the rotating frame, ``q = (x, y, b_1..b_n)`` (with a tilting disk
-    ``(x, y, A, B, b_1..b_n)``: ``balancer.coordinates``); default: the thesis' start, at
+    ``(x, y, A, B, b_1..b_n)``: ``model.coordinates``); default: the thesis' start, at
     rest in the ground frame, balls spread over half the track. The
     state is given at ``t0`` (default ``t_span[0]``, else 0). Give output times ``t_eval``
     (strictly monotone, not before ``t0``) or ``t_span`` for 1001 evenly spaced outputs.
@@ -87,16 +90,16 @@ def simulate(
     if not isinstance(stats, (bool, np.bool_)):
         raise ParameterTypeError("stats", f"must be True or False, got {stats!r:.60}",
                                  value=stats)
-    _check.model("balancer", balancer)
-    n = balancer.n_balls
-    d = len(balancer.coordinates)
+    _check.model("model", model)
+    n = model.n_balls
+    d = len(model.coordinates)
     if y0 is None:
         y0 = np.zeros(2 * d)
         y0[d - n : d] = np.linspace(0.0, np.pi, n, endpoint=False) + 0.3
-        y0[2 * d - n :] = -balancer.Omega
+        y0[2 * d - n :] = -model.Omega
     y0 = _check.array("y0", y0)
     if y0.size != 2 * d:
-        raise ParameterError("y0", f"needs 2 x {d} values ({', '.join(balancer.coordinates)} "
+        raise ParameterError("y0", f"needs 2 x {d} values ({', '.join(model.coordinates)} "
                              f"and their rates), got {y0.size}")
     span = None if t_span is None else _span(t_span)
     if t_eval is None:
@@ -114,10 +117,9 @@ def simulate(
     t0 = _check.real("t0", t0, finite=True)
     steps = _check.integer("max_steps", max_steps, 1)
     y, theta, naccept, nreject, nfev = _native.simulate(
-        *balancer.native_args(), y0, t0, t, _check.real("rtol", rtol), _atol(atol),
-        balancer.native_effects(), steps)
+        model, y0, t0, t, _check.real("rtol", rtol), _atol(atol), steps)
     cols: dict[str, Any] = {"t": t}
-    for name, col in zip(_state_names(balancer), np.asarray(y).T, strict=True):
+    for name, col in zip(_state_names(model), np.asarray(y).T, strict=True):
         cols[name] = col
     cols["theta"] = theta
     cols["X"] = cols["x"] * np.cos(theta) - cols["y"] * np.sin(theta)
@@ -161,7 +163,8 @@ class Equilibrium:
     exhaustive: bool = True
 
 
-def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
+@_check.renamed_model("balancer")
+def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
     """All equilibria (perfect balance first), with eigenvalues, the relative-stability
     index (largest real part) and, where defined, the Routh–Hurwitz verdict.
 
@@ -175,9 +178,8 @@ def equilibria(balancer: Balancer | Scene) -> list[Equilibrium]:
     once by one of its points. Up to four balls every start of a lattice is tried; from
     five on the search tries ``max(600, 25 n)`` starts (balls together, then a
     low-discrepancy sequence) and says so with ``exhaustive=False``."""
-    _check.model("balancer", balancer)
-    return [_equilibrium(d)
-            for d in _native.equilibria(*balancer.native_args(), balancer.native_effects())]
+    _check.model("model", model)
+    return [_equilibrium(d) for d in _native.equilibria(model)]
 
 
 def _equilibrium(d: dict[str, Any]) -> Equilibrium:
@@ -217,7 +219,9 @@ class PeriodicSolution:
     max_modulus: float | None
     trivial_error: float | None
     floquet_steps: int | None
-    condition: float
+    #: The last Newton matrix's largest over smallest LU pivot, a lower bound of its
+    #: condition number (the scan tables' column of the same name).
+    pivot_ratio: float
     tail: float = float("nan")
     target_met: bool | None = None
     hill_multipliers: np.ndarray | None = None
@@ -226,6 +230,13 @@ class PeriodicSolution:
     closure: float | None = None
     separation_error: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def condition(self) -> float:
+        """Deprecated name of :attr:`pivot_ratio`."""
+        warnings.warn("PeriodicSolution.condition is deprecated: use pivot_ratio (the scan "
+                      "tables' name)", DeprecationWarning, stacklevel=2)
+        return self.pivot_ratio
 
     @property
     def converged(self) -> bool:
@@ -277,51 +288,30 @@ class PeriodicSolution:
         if self.omega is None:
             raise ValueError(f"nothing to verify: status {self.status}")
         return _native.orbit_closure(
-            *self.balancer.native_args(), self.omega, np.ascontiguousarray(self.coeffs.ravel()),
-            [float(w) for w in self.winding], float(rtol), float(atol),
-            self.balancer.native_effects(),
-        )
+            self.balancer, self.omega, np.ascontiguousarray(self.coeffs.ravel()),
+            [float(w) for w in self.winding], _check.real("rtol", rtol),
+            _check.real("atol", atol))
 
 
-def harmonics(N: int | str, target: float) -> tuple[int, float | None]:
-    """``(starting N, target or None)`` from ``N`` = an integer or ``"auto"``."""
-    if isinstance(N, str):
-        if N != "auto":
-            raise ParameterError("N", f"must be an integer in [1, 256] or 'auto', got {N!r:.60}",
-                                 allowed="[1, 256] or 'auto'", value=N)
-        return 3, _check.real("target", target)
-    if isinstance(N, (bool, np.bool_)) or not isinstance(N, (int, np.integer)):
-        raise ParameterTypeError("N", f"must be an integer in [1, 256] or 'auto', got "
-                                 f"{N!r:.60}", allowed="[1, 256] or 'auto'", value=N)
-    return _check.integer("N", N, 1, 256), None
-
-
+@_check.renamed_model("balancer")
 def periodic(
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     pattern: str = "R-R",
     *,
-    N: int | str = 3,
-    target: float = 1e-6,
-    N_max: int = 32,
-    hill: bool = True,
-    samples: int | None = None,
-    tol: float = 1e-10,
-    step_tol: float = 1e-8,
-    max_iter: int = 50,
+    options: PeriodicOptions | None = None,
     guess: PeriodicSolution | tuple[float, np.ndarray] | None = None,
-    floquet: bool = True,
-    rtol: float = 1e-8,
-    atol: float = 1e-10,
-    margin: float = 1e-6,
-    max_steps: int = 200_000,
-    settle: float = 1500.0,
-    window: float = 2500.0,
-    max_closure: float = 6.0,
-    max_trivial: float = 0.1,
-    max_tail: float = 0.25,
+    **keywords: Any,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
     per ball) by Newton–IHB with ``N`` harmonics, and its Floquet multipliers.
+
+    ``options``: a :class:`~ballbal.PeriodicOptions` (harmonic balance, Floquet, guess
+    search, certificates; default :data:`ballbal.options.PERIODIC_DEFAULTS`). The flat
+    keywords below are still accepted and change those options: ``N, target, N_max,
+    samples, tol, step_tol, max_iter`` (:class:`~ballbal.HarmonicBalance`), ``floquet``
+    (its ``monodromy``), ``hill, rtol, atol, margin, max_steps, max_trivial``
+    (:class:`~ballbal.Floquet`), ``settle, window, guess_rtol, guess_atol``
+    (:class:`~ballbal.GuessSearch`), ``max_closure, max_tail``.
 
     Without ``guess`` the start comes from a time simulation (``settle`` time units for
     transients, then up to ``window`` to measure the period). ``guess`` may be a previous
@@ -364,8 +354,14 @@ def periodic(
     ``window`` up to 1e5, ...) raise :class:`~ballbal.exceptions.ParameterError` naming
     them.
     """
-    _check.model("balancer", balancer)
+    _check.model("model", model)
     _check.string("pattern", pattern)
+    if options is None:
+        options = PERIODIC_DEFAULTS
+    elif not isinstance(options, PeriodicOptions):
+        raise ParameterTypeError("options", f"must be a ballbal.PeriodicOptions, got "
+                                 f"{type(options).__name__}", value=options)
+    options = with_keywords(options, "periodic", keywords, PERIODIC_KEYWORDS)
     go: float | None = None
     gc: np.ndarray | None = None
     if guess is not None:
@@ -380,31 +376,19 @@ def periodic(
             raise ParameterTypeError("guess", "must be a PeriodicSolution or (omega, coeffs), "
                                      f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
-    n0, auto = harmonics(N, target)
-    d = _native.periodic(
-        *balancer.native_args(), pattern, n0,
-        _check.optional_integer("samples", samples, 1, 1 << 16),
-        _check.real("tol", tol), _check.real("step_tol", step_tol),
-        _check.integer("max_iter", max_iter, 1, 10_000), go, gc,
-        _check.boolean("floquet", floquet), _check.real("rtol", rtol),
-        _check.real("atol", atol), _check.real("margin", margin),
-        _check.integer("max_steps", max_steps, 1), _check.real("settle", settle),
-        _check.real("window", window), 1e-9, auto, _check.integer("N_max", N_max, 1, 256),
-        _check.boolean("hill", hill), _check.real("max_closure", max_closure),
-        _check.real("max_trivial", max_trivial), _check.real("max_tail", max_tail),
-        balancer.native_effects(),
-    )
-    mult = d["mult_re"] + 1j * d["mult_im"] if "mult_re" in d else None
+    d = _native.periodic(model, pattern, options,
+                         None if go is None or gc is None else (go, gc))
+    mult = d["mult_re"] + 1j * d["mult_im"] if d["mult_re"] is not None else None
     hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None
     return PeriodicSolution(
         tail=d["tail"], target_met=d["target_met"], hill_multipliers=hill_m,
-        hill_stability=d.get("hill_stability"), verdicts_disagree=d["verdicts_disagree"],
-        balancer=balancer, status=d["status"], type=d["type"], omega=d["omega"],
+        hill_stability=d["hill_stability"], verdicts_disagree=d["verdicts_disagree"],
+        balancer=model, status=d["status"], type=d["type"], omega=d["omega"],
         coeffs=d["coeffs"], winding=d["winding"], N=d["N"], samples=d["samples"],
         residual=d["residual"], iterations=d["iterations"], multipliers=mult,
-        stability=d["stability"], max_modulus=d.get("max_modulus"),
-        trivial_error=d.get("trivial_error"), floquet_steps=d.get("floquet_steps"),
-        condition=d["pivot_ratio"], closure=d["closure"],
+        stability=d["stability"], max_modulus=d["max_modulus"],
+        trivial_error=d["trivial_error"], floquet_steps=d["floquet_steps"],
+        pivot_ratio=d["pivot_ratio"], closure=d["closure"],
         separation_error=d["separation_error"],
         info={"floquet_error": d["floquet_error"], "last_omega": d["last_omega"]},
     )

@@ -25,7 +25,7 @@ def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
     residual whirl is ``hypot(x, y)`` (in units of ``e``); it is followed from zero
     spring stiffness. Needs an autonomous scene."""
     _check.model("model", model)
-    d = _native.balanced_states([(model.native_args(), model.native_effects())])[0]
+    d = _native.balanced_states([model])[0]
     return None if d is None else _equilibrium(d)
 
 
@@ -59,15 +59,12 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
             raise ParameterError(name, "needs a non-empty list of finite numbers")
         values.append([float(x) for x in v])
     _check.grid_points([len(v) for v in values], names, streamed=False)
-    points: list[Any] = []
     grid = list(itertools.product(*values))
-    for combo in grid:
-        sc = scene.replace(**dict(zip(names, combo, strict=True)))
-        points.append((sc.native_args(), sc.native_effects()))
+    points = [scene.replace(**dict(zip(names, combo, strict=True))) for combo in grid]
     results = _native.balanced_states(points)
     # Tell "the balls cannot balance the disk" from "the continuation to this scene failed".
     missing = [i for i, d in enumerate(results) if d is None]
-    planar_ok = _native.balanced_states([(points[i][0], None) for i in missing])
+    planar_ok = _native.balanced_states([points[i].balancer for i in missing])
     failed = {i for i, d in zip(missing, planar_ok, strict=True) if d is not None}
     cols: dict[str, list[Any]] = {n: [] for n in names}
     for key in ("status", "stability", "index", "whirl", "tilt", "residual"):

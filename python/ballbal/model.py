@@ -63,19 +63,10 @@ class Balancer:
     def n_balls(self) -> int:
         return len(self.eta)
 
-    def native_args(self) -> tuple[float, float, list[float], float, float, list[float]]:
-        zb = [self.zeta_b] if isinstance(self.zeta_b, float) else list(self.zeta_b)
-        return (float(self.mu), float(self.zeta), zb, float(self.delta), float(self.Omega),
-                list(self.eta))
-
     @property
     def coordinates(self) -> list[str]:
         """Names of the generalised coordinates, in the state's order."""
         return ["x", "y"] + [f"b{i + 1}" for i in range(self.n_balls)]
-
-    def native_effects(self) -> None:
-        """A plain balancer has no effects (see :class:`ballbal.scene.Scene`)."""
-        return None
 
     def replace(self, **changes: Any) -> Balancer:
         """A copy with fields changed; a single number for ``eta`` sets every ball's
@@ -90,7 +81,7 @@ class Balancer:
         """Check the parameters (the core's own checks, no analysis) and return self."""
         from . import _native
 
-        _native.validate(*self.native_args())
+        _native.validate(self)
         return self
 
     @classmethod

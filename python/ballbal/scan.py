@@ -27,7 +27,6 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from .analysis import harmonics
 from .exceptions import (
     ParameterError,
     ParameterTypeError,
@@ -36,6 +35,7 @@ from .exceptions import (
     ScanStoreWarning,
 )
 from .model import Balancer
+from .options import SCAN_DEFAULTS, SCAN_KEYWORDS, Execution, ScanOptions, with_keywords
 from .scene import Scene
 
 try:
@@ -112,25 +112,22 @@ class _Job:
     names: tuple[str, ...]
     values: tuple[tuple[float, ...], ...]
     patterns: tuple[str, ...]
-    options: tuple[tuple[str, Any], ...]
-    #: Values of the last axis per continuation block (the numerical unit) and per
-    #: chunk (whole blocks: the unit of files, progress and interruption).
-    block: int
+    #: With ``block`` set: values of the last axis per continuation block (the
+    #: numerical unit).
+    options: ScanOptions
+    #: Values of the last axis per chunk (whole blocks: the unit of files, progress and
+    #: interruption).
     chunk: int
+
+    @property
+    def block(self) -> int:
+        assert self.options.block is not None
+        return self.options.block
 
     def native(self, chunks: list[int], threads: int,
                on_chunk: Callable[[int, dict[str, Any]], None]) -> None:
-        o = dict(self.options)
-        effects = self.model.effects_tuple() if isinstance(self.model, Scene) else None
-        _native.scan(
-            *self.model.native_args(), list(self.names), [list(v) for v in self.values],
-            list(self.patterns), o["N"], o["samples"], o["tol"], o["step_tol"],
-            o["max_iter"], o["floquet"], o["rtol"], o["atol"], o["margin"], o["max_steps"],
-            o["settle"], o["window"], o["guess_rtol"], o["auto"], o["N_max"], o["hill"],
-            o["seeds"], o["starts"], self.chunk,
-            o["max_tail"], threads, chunks, on_chunk, effects, self.block,
-            max_closure=o.get("max_closure", 6.0), max_trivial=o.get("max_trivial", 0.1),
-        )
+        _native.scan(self.model, list(self.names), [list(v) for v in self.values],
+                     list(self.patterns), self.options, self.chunk, threads, chunks, on_chunk)
 
     def n_chunks(self) -> int:
         return math.ceil(len(self.values[-1]) / self.chunk)
@@ -146,9 +143,28 @@ class _Job:
             **({"scene": self.model.to_dict()} if isinstance(self.model, Scene)
                else {"balancer": asdict(self.model)}),
             "grid": {n: list(v) for n, v in zip(self.names, self.values, strict=True)},
-            "patterns": list(self.patterns), "options": dict(self.options),
+            "patterns": list(self.patterns), "options": _meta_options(self.options),
             "block": self.block, "chunk": self.chunk,
         }
+
+
+def _meta_options(o: ScanOptions) -> dict[str, Any]:
+    """The options as ``meta.json`` records them (the scan's fingerprint): the flat
+    keywords of before the option classes, in their order, so that directories written
+    then resume; ``guess_atol`` only where it is not ``guess_rtol / 1000`` (what those
+    keywords implied)."""
+    h, f, g = o.harmonic_balance, o.floquet, o.guess
+    d: dict[str, Any] = {
+        "N": h._start, "auto": h._auto_target, "N_max": h.N_max, "hill": f.hill,
+        "samples": h.samples, "tol": h.tol, "step_tol": h.step_tol, "max_iter": h.max_iter,
+        "floquet": f.monodromy, "rtol": f.rtol, "atol": f.atol, "margin": f.margin,
+        "max_steps": f.max_steps, "settle": g.settle, "window": g.window,
+        "guess_rtol": g.rtol, "seeds": g.seeds, "starts": g.starts, "max_tail": o.max_tail,
+        "max_closure": o.max_closure, "max_trivial": f.max_trivial,
+    }
+    if g.atol != g.rtol * 1e-3:
+        d["guess_atol"] = g.atol
+    return d
 
 
 def _frame(names: Sequence[str], d: dict[str, Any]) -> pl.DataFrame:
@@ -439,36 +455,17 @@ def _as_completed(futures: list[Any]) -> Iterable[Any]:
 
 
 @overload
-def scan(balancer: Balancer | Scene, *, lazy: Literal[False] = ...,
+def scan(model: Balancer | Scene, *, lazy: Literal[False] = ...,
          **kwargs: Any) -> pl.DataFrame: ...
 @overload
-def scan(balancer: Balancer | Scene, *, lazy: Literal[True], **kwargs: Any) -> pl.LazyFrame: ...
+def scan(model: Balancer | Scene, *, lazy: Literal[True], **kwargs: Any) -> pl.LazyFrame: ...
+@_check.renamed_model("balancer")
 def scan(  # noqa: E302 - overloads above
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     *,
     patterns: Sequence[str] = ("R-R",),
-    N: int | str = 3,
-    target: float = 1e-4,
-    N_max: int = 32,
-    hill: bool = False,
-    samples: int | None = None,
-    tol: float = 1e-10,
-    step_tol: float = 1e-8,
-    max_iter: int = 50,
-    floquet: bool = True,
-    rtol: float = 1e-6,
-    atol: float = 1e-9,
-    margin: float = 1e-6,
-    max_steps: int = 20_000,
-    settle: float = 1000.0,
-    window: float = 2000.0,
-    guess_rtol: float = 1e-5,
-    seeds: int = 4,
-    starts: int = 4,
-    max_tail: float = 0.25,
-    max_closure: float = 6.0,
-    max_trivial: float = 0.1,
-    block: int | None = None,
+    options: ScanOptions | None = None,
+    execution: Execution | None = None,
     chunk: int | None = None,
     threads: int | None = None,
     progress: bool | Callable[[int, int], Any] = False,
@@ -476,15 +473,26 @@ def scan(  # noqa: E302 - overloads above
     lazy: bool = False,
     executor: Any = None,
     grid: Mapping[str, GridSpec] | None = None,
-    **axes: GridSpec,
+    **axes_and_options: Any,
 ) -> pl.DataFrame | pl.LazyFrame:
-    """Scan parameters of ``balancer`` over a grid and return one row per solution found.
+    """Scan parameters of ``model`` over a grid and return one row per solution found.
 
     Axes are keywords (``Omega=(1.0, 2.0, 0.1), eta=np.arange(0.4, 1.51, 0.1)``) or a
     ``grid`` mapping (needed for ``"eta[0]"``); each is a sequence, ``(start, stop, step)``
     or ``"start:stop:step"``. Any number of axes; the first varies fastest in the table.
 
-    ``balancer`` may be an autonomous :class:`Scene` (ball springs, a tilting disk): its
+    ``options``: a :class:`~ballbal.ScanOptions` (what is computed; default
+    :data:`ballbal.options.SCAN_DEFAULTS`, whose tolerances and guess search differ from
+    :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`). The flat keywords
+    of :func:`~ballbal.periodic` (``N, target, N_max, hill, samples, tol, step_tol,
+    max_iter, floquet, rtol, atol, margin, max_steps, settle, window, guess_rtol,
+    guess_atol, max_tail, max_closure, max_trivial``) and ``seeds, starts, block`` are
+    still accepted beside the axes and change those options. ``execution``: an
+    :class:`~ballbal.Execution` (where it runs: ``threads, chunk, executor, progress,
+    out, lazy``); the keywords of the same names override it. Execution never changes
+    the table.
+
+    ``model`` may be an autonomous :class:`Scene` (ball springs, a tilting disk): its
     ``springs`` and tilt fields ``a``, ``b``, ``j_t``, ``j_z``, ``zeta_r`` can be axes
     too, and ``pb_exists``, ``pb_stable`` then describe its balanced state (see
     :func:`balanced_state`). A scene with a ramp, gravity or an impulse is time
@@ -503,7 +511,9 @@ def scan(  # noqa: E302 - overloads above
     last harmonic is that large relative to the motion (``N`` too small). Every solution
     is certified as in :func:`~ballbal.periodic` (``max_closure``, ``max_trivial``, the
     same defaults): a series that fails is neither reported nor continued, and a row
-    gets a stability verdict only with an accurate trivial multiplier.
+    gets a stability verdict only with an accurate trivial multiplier. The solution
+    columns have the names and meaning of :class:`~ballbal.PeriodicSolution`'s fields
+    (``pivot_ratio``, ...); the multipliers are a list of ``{re, im}``.
 
     ``chunk``: values of the last axis per chunk, rounded up to whole blocks (default
     one block): the unit of progress, interruption, resumption, files and executor
@@ -533,15 +543,33 @@ def scan(  # noqa: E302 - overloads above
     Limits (checked before any work): at most 1e6 values per axis, 5e6 grid points for a
     table held in memory and 1e9 for one streamed to ``out=``.
     """
-    patterns = _check.scan_arguments(
-        balancer, patterns=patterns, N_max=N_max, samples=samples, max_iter=max_iter,
-        max_steps=max_steps, seeds=seeds, starts=starts, chunk=chunk, threads=threads, out=out,
-        hill=hill, floquet=floquet, reals=dict(
-            target=target, tol=tol, step_tol=step_tol, rtol=rtol, atol=atol, margin=margin,
-            settle=settle, window=window, guess_rtol=guess_rtol, max_tail=max_tail,
-            max_closure=max_closure, max_trivial=max_trivial))
+    _check.model("model", model)
+    if options is None:
+        options = SCAN_DEFAULTS
+    elif not isinstance(options, ScanOptions):
+        raise ParameterTypeError("options", f"must be a ballbal.ScanOptions, got "
+                                 f"{type(options).__name__}", value=options)
+    if execution is None:
+        execution = Execution()
+    elif not isinstance(execution, Execution):
+        raise ParameterTypeError("execution", f"must be a ballbal.Execution, got "
+                                 f"{type(execution).__name__}", value=execution)
+    given: dict[str, Any] = {k: v for k, v in (("chunk", chunk), ("threads", threads),
+                                               ("out", out), ("executor", executor))
+                             if v is not None}
+    if progress is not False:
+        given["progress"] = progress
+    if lazy is not False:
+        given["lazy"] = lazy
+    if given:
+        execution = replace(execution, **given)
+    opts = {k: axes_and_options.pop(k) for k in list(axes_and_options) if k in SCAN_KEYWORDS}
+    options = with_keywords(options, "scan", opts, SCAN_KEYWORDS)
+    p = _check.patterns("patterns", patterns)
+    if not p:
+        raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
     axes_all: dict[str, GridSpec] = dict(grid or {})
-    for k, v in axes.items():
+    for k, v in axes_and_options.items():
         if k in axes_all:
             raise ParameterError(k, "given twice (keyword and grid)")
         axes_all[k] = v
@@ -549,57 +577,37 @@ def scan(  # noqa: E302 - overloads above
         raise ParameterError("grid", "give at least one parameter to scan, e.g. "
                              "Omega=(1, 2, 0.1)")
     names = tuple(axes_all)
-    model: Balancer | Scene = balancer
-    if (isinstance(model, Scene) and model.native_effects() is None
+    if (isinstance(model, Scene) and not model._effects_on()
             and not set(names) & set(SCENE_SCANNABLE)):
         model = model.balancer  # the same table, and a scan directory it can resume
     values = tuple(tuple(grid_values(n, s).tolist()) for n, s in axes_all.items())
-    _check.grid_points([len(v) for v in values], names, streamed=out is not None)
-    if isinstance(patterns, str):
-        patterns = (patterns,)
-    if not patterns:
-        raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
-    if lazy and out is None:
+    ex = execution
+    _check.grid_points([len(v) for v in values], names, streamed=ex.out is not None)
+    if ex.lazy and ex.out is None:
         raise ParameterError("lazy", "a lazy table needs out= (it reads the chunk files)",
-                             allowed="False without out", value=lazy)
-    if out is not None and str(out) == "":
-        raise ParameterError("out", "give a directory name", value=out)
-    default = _native.default_chunk([len(v) for v in values])
+                             allowed="False without out", value=ex.lazy)
+    block = options.block
     if block is None:
-        block = default
-    if int(block) < 1:
+        block = _native.default_chunk([len(v) for v in values])
+    if block < 1:
         raise ParameterError("block", f"must be >= 1, got {block}", allowed=">= 1",
                              value=block)
-    block = int(block)
-    chunk_given = chunk is not None
-    if chunk is None:
-        chunk = block
-    if int(chunk) < 1:
-        raise ParameterError("chunk", f"must be >= 1, got {chunk}", allowed=">= 1",
-                             value=chunk)
+    chunk_given = ex.chunk is not None
+    n_chunk = block if ex.chunk is None else ex.chunk
+    if n_chunk < 1:
+        raise ParameterError("chunk", f"must be >= 1, got {n_chunk}", allowed=">= 1",
+                             value=n_chunk)
     # Whole blocks per chunk: a split block would continue less (see the Rust core).
-    chunk = -(-int(chunk) // block) * block
-    local_threads = (os.cpu_count() or 1) if threads is None else int(threads)
-    if local_threads < 1:
-        raise ParameterError("threads", f"must be >= 1, got {threads}")
-    n0, auto = harmonics(N, target)
-    options = (
-        ("N", n0), ("auto", auto), ("N_max", int(N_max)), ("hill", bool(hill)),
-        ("samples", None if samples is None else int(samples)),
-        ("tol", float(tol)), ("step_tol", float(step_tol)), ("max_iter", int(max_iter)),
-        ("floquet", bool(floquet)), ("rtol", float(rtol)), ("atol", float(atol)),
-        ("margin", float(margin)), ("max_steps", int(max_steps)), ("settle", float(settle)),
-        ("window", float(window)), ("guess_rtol", float(guess_rtol)), ("seeds", int(seeds)),
-        ("starts", int(starts)), ("max_tail", float(max_tail)),
-        ("max_closure", float(max_closure)), ("max_trivial", float(max_trivial)),
-    )
-    job = _Job(model, names, values, tuple(str(p) for p in patterns), options, block, chunk)
+    n_chunk = -(-n_chunk // block) * block
+    local_threads = (os.cpu_count() or 1) if ex.threads is None else ex.threads
+    job = _Job(model, names, values, tuple(str(x) for x in p),
+               replace(options, block=block), n_chunk)
     # Validates everything (grid values, combinations, options) before any work.
     job.native([], 1, lambda _c, _d: None)
 
-    store = _Store(out, job, chunk_given) if out is not None else None
+    store = _Store(ex.out, job, chunk_given) if ex.out is not None else None
     try:
-        return _run(job, store, executor, threads, local_threads, progress, lazy)
+        return _run(job, store, ex.executor, ex.threads, local_threads, ex.progress, ex.lazy)
     finally:
         if store is not None:
             store.close()

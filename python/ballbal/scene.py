@@ -159,9 +159,6 @@ class Scene:
     def Omega(self) -> float:  # noqa: N802 - the thesis' symbol
         return self.balancer.Omega
 
-    def native_args(self) -> tuple[float, float, list[float], float, float, list[float]]:
-        return self.balancer.native_args()
-
     @property
     def coordinates(self) -> list[str]:
         """Names of the generalised coordinates, in the state's order."""
@@ -189,21 +186,10 @@ class Scene:
             changes["tilt"] = replace(self.tilt, **tl)
         return replace(self, **changes)
 
-    def native_effects(self) -> tuple[Any, ...] | None:
-        """The effects for the core; None when there are none (the planar code runs)."""
-        if (self.springs == 0 and self.ramp is None and self.gravity == 0
-                and self.impulse is None and self.tilt is None):
-            return None
-        return self.effects_tuple()
-
-    def effects_tuple(self) -> tuple[Any, ...]:
-        """The effects for the core, even when all are off (a scan may switch one on)."""
-        ramp = None if self.ramp is None else (self.ramp.to, self.ramp.start, self.ramp.duration)
-        imp = None if self.impulse is None else (
-            self.impulse.amplitude, self.impulse.t0, self.impulse.sharpness, self.impulse.angle)
-        tl = None if self.tilt is None else (
-            self.tilt.a, self.tilt.b, self.tilt.j_t, self.tilt.j_z, self.tilt.zeta_r)
-        return (self.springs, ramp, self.gravity, imp, tl, self.spring_layout == "chain")
+    def _effects_on(self) -> bool:
+        """Whether any effect is on (else every analysis runs the planar code)."""
+        return bool(self.springs != 0 or self.ramp is not None or self.gravity != 0
+                    or self.impulse is not None or self.tilt is not None)
 
     @property
     def time_dependence(self) -> str | None:

@@ -41,14 +41,15 @@ def _balanced_start(model: Balancer | Scene) -> np.ndarray:
     e = balanced_state(model)
     if e is None or e.stability != "stable":
         raise ParameterError(
-            "balancer", f"the balanced state must exist and be stable at the starting speed "
+            "model", f"the balanced state must exist and be stable at the starting speed "
             f"Omega = {model.Omega} (eta >= 1/2 and above the resonance), so that the "
             "disturbance starts from rest")
     return np.asarray(e.q, dtype=float)
 
 
+@_check.renamed_model("balancer")
 def disturbance_response(
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     to: float,
     *,
     start: float = 10.0,
@@ -58,14 +59,14 @@ def disturbance_response(
     dt: float = 0.1,
     rtol: float = 1e-8,
 ) -> DisturbanceResponse:
-    """Start at the stable perfect balance at ``balancer.Omega``, change the spin to
+    """Start at the stable perfect balance at ``model.Omega``, change the spin to
     ``to`` linearly over ``duration`` from ``start`` (seed 001: 100 rad/s in 0.11 s), and
     measure the radial vibration. ``band`` is in units of the eccentricity ``e``.
 
-    ``balancer`` may be an autonomous scene (ball springs, a tilting disk): it starts at
+    ``model`` may be an autonomous scene (ball springs, a tilting disk): it starts at
     its stable balanced state (:func:`balanced_state`), and ``final_r`` is then that of
     the balanced state at ``to``, not 0, where springs leave a residual whirl."""
-    _check.model("balancer", balancer)
+    _check.model("model", model)
     to = _check.real("to", to, 0.0, lo_open=True)
     start = _check.real("start", start, 0.0)
     duration = _check.real("duration", duration, 0.0, lo_open=True)
@@ -74,11 +75,11 @@ def disturbance_response(
     dt = _check.real("dt", dt, 0.0, lo_open=True)
     rtol = _check.real("rtol", rtol)
     _check.samples_count(t_end, dt, duration_name="t_end")
-    q = _balanced_start(balancer)
+    q = _balanced_start(model)
     y0 = np.concatenate([q, np.zeros(q.size)])
     ramp = Ramp(to=to, start=start, duration=duration)
-    scene = (replace(balancer, ramp=ramp) if isinstance(balancer, Scene)
-             else Scene(balancer=balancer, ramp=ramp))
+    scene = (replace(model, ramp=ramp) if isinstance(model, Scene)
+             else Scene(balancer=model, ramp=ramp))
     t = np.arange(0.0, t_end + dt / 2, dt)
     df = simulate(scene, y0, t, rtol=rtol, atol=rtol * 1e-2)
     r = np.hypot(df["x"].to_numpy(), df["y"].to_numpy())
@@ -96,8 +97,9 @@ def disturbance_response(
                                trajectory=df)
 
 
+@_check.renamed_model("balancer")
 def track_damping_study(
-    balancer: Balancer | Scene,
+    model: Balancer | Scene,
     zeta_b: Sequence[float],
     to: float,
     **kw: Any,
@@ -107,9 +109,9 @@ def track_damping_study(
     settling time / mean peak (so both terms count alike); ``optimal`` marks its
     minimum."""
     rows = []
-    _check.model("balancer", balancer)
+    _check.model("model", model)
     for zb in _check.reals("zeta_b", zeta_b):
-        res = disturbance_response(balancer.replace(zeta_b=zb), to, **kw)
+        res = disturbance_response(model.replace(zeta_b=zb), to, **kw)
         rows.append({"zeta_b": float(zb), "peak": res.peak, "settle_time": res.settle_time,
                      "final_r": res.final_r})
     df = pl.DataFrame(rows, schema={"zeta_b": pl.Float64, "peak": pl.Float64,
@@ -138,8 +140,9 @@ class RunUp:
     trajectory: pl.DataFrame
 
 
+@_check.renamed_model("scene")
 def run_up(
-    scene: Scene | Balancer,
+    model: Scene | Balancer,
     to: float,
     duration: float,
     *,
@@ -148,14 +151,13 @@ def run_up(
     dt: float = 0.5,
     rtol: float = 1e-8,
 ) -> RunUp:
-    """Spin the scene's rotor up from ``scene.Omega`` to ``to`` over ``duration`` (seed
+    """Spin the scene's rotor up from ``model.Omega`` to ``to`` over ``duration`` (seed
     004's run-up) and measure the whirl and tilt. The rotor starts centred and flat, the
     balls at rest relative to the disk at angles ``balls``, in track order (default:
     spread over +-1 rad about the unbalance, where a classic balancer's balls make the
     resonance worst). A plain :class:`Balancer` runs up as a scene without effects."""
-    _check.model("scene", scene)
-    if isinstance(scene, Balancer):
-        scene = Scene(balancer=scene)
+    _check.model("model", model)
+    scene = Scene(balancer=model) if isinstance(model, Balancer) else model
     to = _check.real("to", to, 0.0, lo_open=True)
     duration = _check.real("duration", duration, 0.0, lo_open=True)
     settle = _check.real("settle", settle, 0.0)

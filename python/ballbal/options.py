@@ -1,0 +1,306 @@
+"""The analyses' options as frozen dataclasses, mirroring the core's option structs.
+
+The native module reads these objects by attribute; their values are checked by the
+core (errors name the option), these classes check only types. One vocabulary:
+``rtol``/``atol`` are always integration tolerances (relative, absolute) of the
+Dormand–Prince integrator that uses them: :class:`Floquet`'s of the monodromy,
+:class:`GuessSearch`'s of the simulations that find starts. Mathematics (what is
+computed) is apart from execution (:class:`Execution`: where and how it runs, which
+never changes a result).
+
+``periodic()`` and ``scan()`` mean the same by every option but differ in some
+defaults, on purpose: a scan solves thousands of points, continues each solution to
+its neighbours (so its starts only need to land in Newton's basin) and keeps the
+verdicts that are certain at its looser tolerances. :data:`PERIODIC_DEFAULTS` and
+:data:`SCAN_DEFAULTS` are the two sets; the differences:
+
+====================================  =================  ===============
+option                                ``periodic()``     ``scan()``
+====================================  =================  ===============
+``HarmonicBalance.target`` (auto)     1e-6               1e-4
+``Floquet.rtol``, ``atol``            1e-8, 1e-10        1e-6, 1e-9
+``Floquet.max_steps``                 200 000            20 000
+``Floquet.hill``                      True               False
+``GuessSearch.settle``, ``window``    1500, 2500         1000, 2000
+``GuessSearch.rtol``, ``atol``        1e-9, 1e-11        1e-5, 1e-8
+====================================  =================  ===============
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields, replace
+from typing import Any, Literal
+
+from . import _check
+from .exceptions import ParameterError, ParameterTypeError
+
+#: Harmonics ``N = "auto"`` starts from.
+AUTO_START = 3
+
+
+def _reals(obj: Any, *names: str) -> None:
+    for n in names:
+        object.__setattr__(obj, n, _check.real(n, getattr(obj, n)))
+
+
+def _counts(obj: Any, *names: str) -> None:
+    # Non-negative only: the range is the core's; a negative count cannot reach it.
+    for n in names:
+        object.__setattr__(obj, n, _check.integer(n, getattr(obj, n)))
+
+
+def _flags(obj: Any, *names: str) -> None:
+    for n in names:
+        object.__setattr__(obj, n, _check.boolean(n, getattr(obj, n)))
+
+
+def _nested(obj: Any, name: str, kind: type) -> None:
+    v = getattr(obj, name)
+    if not isinstance(v, kind):
+        raise ParameterTypeError(name, f"must be a ballbal.{kind.__name__}, got "
+                                 f"{type(v).__name__}", value=v)
+
+
+@dataclass(frozen=True)
+class HarmonicBalance:
+    """Newton–IHB (the core's ``HbOptions`` and ``AutoHarmonics``).
+
+    ``N``: harmonics, or ``"auto"``: start at :data:`AUTO_START` and raise N (solving
+    from the last) until the highest harmonic relative to the motion (``tail``) and the
+    trivial multiplier's distance from 1 are below ``target``, at most ``N_max``
+    (``target`` and ``N_max`` apply to ``"auto"`` only). ``samples``: time samples per
+    period (None: the core's default for N). Newton stops when the residual's max-norm
+    is below ``tol`` and the last step's below ``step_tol``, or after ``max_iter``
+    iterations.
+    """
+
+    N: int | Literal["auto"] = 3
+    target: float = 1e-6
+    N_max: int = 32
+    samples: int | None = None
+    tol: float = 1e-10
+    step_tol: float = 1e-8
+    max_iter: int = 50
+
+    def __post_init__(self) -> None:
+        if isinstance(self.N, str):
+            if self.N != "auto":
+                raise ParameterError("N", f"must be an integer in [1, 256] or 'auto', got "
+                                     f"{self.N!r:.60}", allowed="[1, 256] or 'auto'",
+                                     value=self.N)
+        else:
+            object.__setattr__(self, "N", _check.integer("N", self.N))
+        _reals(self, "target", "tol", "step_tol")
+        _counts(self, "N_max", "max_iter")
+        object.__setattr__(self, "samples", _check.optional_integer("samples", self.samples))
+
+    @property
+    def _start(self) -> int:
+        return AUTO_START if self.N == "auto" else int(self.N)
+
+    @property
+    def _auto_target(self) -> float | None:
+        return self.target if self.N == "auto" else None
+
+
+@dataclass(frozen=True)
+class Floquet:
+    """Stability of a periodic solution (the core's ``FloquetOptions``, and Hill's
+    method).
+
+    ``monodromy``: integrate the monodromy matrix over one period (Dormand–Prince at
+    ``rtol``, ``atol``, at most ``max_steps`` steps; a longer integration ends in
+    ``floquet_error`` and an undetermined verdict). A verdict needs the largest
+    non-trivial modulus further than ``max(margin, trivial_error)`` from 1, and no
+    verdict is given unless the trivial multiplier is within ``max_trivial`` of 1.
+    ``hill``: a second estimate by Hill's method (eigenvalues of the Hill matrix, no
+    integration), judged with the same ``margin`` and ``max_trivial`` (with
+    ``monodromy=False`` the core judges it with its defaults, 1e-6 and 0.1). The values
+    are checked even with ``monodromy=False``.
+    """
+
+    rtol: float = 1e-8
+    atol: float = 1e-10
+    margin: float = 1e-6
+    max_steps: int = 200_000
+    max_trivial: float = 0.1
+    monodromy: bool = True
+    hill: bool = True
+
+    def __post_init__(self) -> None:
+        _reals(self, "rtol", "atol", "margin", "max_trivial")
+        _counts(self, "max_steps")
+        _flags(self, "monodromy", "hill")
+
+
+@dataclass(frozen=True)
+class GuessSearch:
+    """Starts for Newton from time simulations (the core's ``GuessOptions``).
+
+    Each start is simulated for ``settle`` time units (transients), then up to
+    ``window`` more to measure the period, at integration tolerances ``rtol``,
+    ``atol``. A scan simulates ``starts`` initial states at ``seeds`` points per axis
+    (``periodic()`` tries the core's fixed set of starts and ignores both).
+    """
+
+    settle: float = 1500.0
+    window: float = 2500.0
+    rtol: float = 1e-9
+    # rtol / 100 computed as periodic() always did (1e-11 itself is one ulp away).
+    atol: float = 1e-9 * 1e-2
+    seeds: int = 4
+    starts: int = 4
+
+    def __post_init__(self) -> None:
+        _reals(self, "settle", "window", "rtol", "atol")
+        _counts(self, "seeds", "starts")
+
+
+@dataclass(frozen=True)
+class PeriodicOptions:
+    """Everything :func:`ballbal.periodic` computes with (the core's
+    ``PeriodicOptions``). ``max_closure``: largest integrated ODE defect of a converged
+    series (above: ``not_closed``); ``max_tail``: largest highest-harmonic ratio (above:
+    ``truncated``). See :func:`ballbal.periodic` for the certificates."""
+
+    harmonic_balance: HarmonicBalance = field(default_factory=HarmonicBalance)
+    floquet: Floquet = field(default_factory=Floquet)
+    guess: GuessSearch = field(default_factory=GuessSearch)
+    max_closure: float = 6.0
+    max_tail: float = 0.25
+
+    def __post_init__(self) -> None:
+        _nested(self, "harmonic_balance", HarmonicBalance)
+        _nested(self, "floquet", Floquet)
+        _nested(self, "guess", GuessSearch)
+        _reals(self, "max_closure", "max_tail")
+
+
+def _scan_floquet() -> Floquet:
+    return Floquet(rtol=1e-6, atol=1e-9, max_steps=20_000, hill=False)
+
+
+def _scan_guess() -> GuessSearch:
+    return GuessSearch(settle=1000.0, window=2000.0, rtol=1e-5, atol=1e-5 * 1e-3)
+
+
+@dataclass(frozen=True)
+class ScanOptions:
+    """Everything :func:`ballbal.scan` computes with: a periodic solve's options (with
+    the scan's defaults, see the module's table) and ``block``, the values of the last
+    axis per continuation block (None: about 1024 points, fixed by the grid's shape).
+    ``block`` is mathematics, not execution: continuation does not cross block edges,
+    so smaller blocks find fewer continued solutions."""
+
+    harmonic_balance: HarmonicBalance = field(
+        default_factory=lambda: HarmonicBalance(target=1e-4))
+    floquet: Floquet = field(default_factory=_scan_floquet)
+    guess: GuessSearch = field(default_factory=_scan_guess)
+    max_closure: float = 6.0
+    max_tail: float = 0.25
+    block: int | None = None
+
+    def __post_init__(self) -> None:
+        _nested(self, "harmonic_balance", HarmonicBalance)
+        _nested(self, "floquet", Floquet)
+        _nested(self, "guess", GuessSearch)
+        _reals(self, "max_closure", "max_tail")
+        if self.block is not None:
+            object.__setattr__(self, "block", _check.integer("block", self.block))
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where and how a scan runs; none of it changes the table.
+
+    ``threads``: cores for the core's parallel loop (default: all here; 1 per task on
+    an ``executor``). ``chunk``: values of the last axis per chunk, rounded up to whole
+    blocks (default one block): the unit of progress, interruption, resumption, files
+    and executor tasks. ``executor``: a ``concurrent.futures`` executor or Dask
+    ``Client`` running the chunks as tasks. ``progress``: True for a progress bar, or a
+    callable ``f(done_points, total_points)``. ``out``: a directory the chunks are
+    written to (and resumed from); ``lazy``: return a ``polars.LazyFrame`` over its
+    files.
+    """
+
+    threads: int | None = None
+    chunk: int | None = None
+    executor: Any = None
+    progress: bool | Callable[[int, int], Any] = False
+    out: str | os.PathLike[str] | None = None
+    lazy: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "threads", _check.optional_integer(
+            "threads", self.threads, 1, _check.MAX_THREADS))
+        object.__setattr__(self, "chunk", _check.optional_integer("chunk", self.chunk))
+        if self.out is not None:
+            _check.path("out", self.out)
+        _flags(self, "lazy")
+
+
+PERIODIC_DEFAULTS = PeriodicOptions()
+SCAN_DEFAULTS = ScanOptions()
+
+#: The keyword arguments ``periodic()`` and ``scan()`` took before the option classes,
+#: still accepted: where each goes.
+_LEGACY: dict[str, tuple[str, str]] = {
+    "N": ("harmonic_balance", "N"), "target": ("harmonic_balance", "target"),
+    "N_max": ("harmonic_balance", "N_max"), "samples": ("harmonic_balance", "samples"),
+    "tol": ("harmonic_balance", "tol"), "step_tol": ("harmonic_balance", "step_tol"),
+    "max_iter": ("harmonic_balance", "max_iter"),
+    "floquet": ("floquet", "monodromy"), "hill": ("floquet", "hill"),
+    "rtol": ("floquet", "rtol"), "atol": ("floquet", "atol"),
+    "margin": ("floquet", "margin"), "max_steps": ("floquet", "max_steps"),
+    "max_trivial": ("floquet", "max_trivial"),
+    "settle": ("guess", "settle"), "window": ("guess", "window"),
+    "guess_rtol": ("guess", "rtol"), "guess_atol": ("guess", "atol"),
+    "seeds": ("guess", "seeds"), "starts": ("guess", "starts"),
+    "max_closure": ("", "max_closure"), "max_tail": ("", "max_tail"), "block": ("", "block"),
+}
+
+
+def with_keywords(options: Any, where: str, kwargs: dict[str, Any],
+                  allowed: frozenset[str]) -> Any:
+    """``options`` with the keyword arguments of the flat, older interface applied.
+    ``guess_rtol`` alone also sets the guess's ``atol`` as that interface did (``rtol /
+    100`` for ``periodic()``, ``rtol / 1000`` for ``scan()``)."""
+    for k in kwargs:
+        if k not in allowed:
+            raise TypeError(f"{where}() got an unexpected keyword argument {k!r}")
+    if not kwargs:
+        return options
+    kw = dict(kwargs)
+    if "guess_rtol" in kw and "guess_atol" not in kw:
+        r = _check.real("guess_rtol", kw["guess_rtol"])
+        kw["guess_atol"] = r * (1e-3 if isinstance(options, ScanOptions) else 1e-2)
+    parts: dict[str, dict[str, Any]] = {}
+    for k, v in kw.items():
+        part, name = _LEGACY[k]
+        parts.setdefault(part, {})[name] = v
+    top = parts.pop("", {})
+    part = ""
+    try:
+        for part, changes in parts.items():
+            top[part] = replace(getattr(options, part), **changes)
+        part = ""
+        return replace(options, **top)
+    except ParameterError as e:
+        # Name the keyword as the caller typed it (``floquet``, not ``monodromy``).
+        typed = [k for k in kw if _LEGACY[k][1] == e.parameter
+                 and _LEGACY[k][0] == part]
+        if typed and typed[0] != e.parameter:
+            raise type(e)(typed[0], e.message.removeprefix(f"{e.parameter}:").strip(),
+                          allowed=e.allowed, value=e.value) from e
+        raise
+
+
+PERIODIC_KEYWORDS = frozenset(k for k in _LEGACY
+                              if k not in ("seeds", "starts", "block"))
+SCAN_KEYWORDS = frozenset(_LEGACY)
+
+
+def option_names(cls: type) -> list[str]:
+    return [f.name for f in fields(cls)]

@@ -1,0 +1,356 @@
+//! The native entry points. Each takes the Python model (`ballbal.Balancer` or
+//! `ballbal.Scene`) and option dataclasses as they are, builds and validates the core
+//! model once, chooses planar or scene once ([`dispatch!`]) and runs the core off the
+//! GIL.
+
+use crate::convert::{dispatch, slice, Model, ModelArgs, PeriodicArgs};
+use crate::errors::{not_autonomous, CoreResult};
+use crate::run::{guarded, run_polled};
+use crate::tables::{equilibrium_dict, scan_columns, solution_dict, Columns};
+use ballbal_core::equilibria::equilibria as core_equilibria;
+use ballbal_core::hb::{HbSolution, Status};
+use ballbal_core::ode::Options;
+use ballbal_core::periodic::{
+    closure_error, parse_pattern, periodic as core_periodic, require_autonomous, PeriodicOptions,
+};
+use ballbal_core::scan::{Family, ScanRow, ScanSpec};
+use ballbal_core::simulate::simulate as core_simulate;
+use ballbal_core::{cancel, Dynamics, Error};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The model, built for an analysis that needs an autonomous one (`what` names it in
+/// the error).
+fn autonomous(model: &ModelArgs, always_scene: bool, what: &str) -> PyResult<Model> {
+    let m = model.build(always_scene).py()?;
+    if let Model::Scene(s) = &m {
+        require_autonomous(s).map_err(|e| not_autonomous(e, what))?;
+    }
+    Ok(m)
+}
+
+/// `(y, theta, accepted_steps, rejected_steps, rhs_evals)` of [`simulate`].
+type Simulated<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyArray1<f64>>,
+    usize,
+    usize,
+    usize,
+);
+
+/// Integrates from `y0` and returns `(y, theta, accepted_steps, rejected_steps,
+/// rhs_evals)`, `y` of shape `(len(t_eval), 2 d)`, `theta` the disk's angle at `t_eval`.
+#[pyfunction]
+#[pyo3(signature = (model, y0, t0, t_eval, rtol, atol, max_steps))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    model: ModelArgs,
+    y0: PyReadonlyArray1<'py, f64>,
+    t0: f64,
+    t_eval: PyReadonlyArray1<'py, f64>,
+    rtol: f64,
+    atol: Vec<f64>,
+    max_steps: usize,
+) -> PyResult<Simulated<'py>> {
+    let m = model.build(false).py()?;
+    let y0 = slice(&y0, "y0")?.to_vec();
+    let te = slice(&t_eval, "t_eval")?.to_vec();
+    let opts = Options {
+        rtol,
+        atol,
+        max_steps,
+        ..Default::default()
+    };
+    let traj = guarded(
+        py,
+        || dispatch!(&m, d => core_simulate(d, &y0, t0, &te, &opts)),
+    )?;
+    let cols = y0.len();
+    let flat: Vec<f64> = traj.y.into_iter().flatten().collect();
+    let arr = PyArray1::from_vec(py, flat).reshape([te.len(), cols])?;
+    let theta: Vec<f64> = te
+        .iter()
+        .map(|&t| match &m {
+            Model::Scene(s) => s.spin(t).2,
+            Model::Planar(p) => p.omega_s * t,
+        })
+        .collect();
+    Ok((
+        arr.into_any(),
+        PyArray1::from_vec(py, theta),
+        traj.stats.accepted,
+        traj.stats.rejected,
+        traj.stats.rhs_evals,
+    ))
+}
+
+/// Checks the model the way the core's constructors do, and nothing more: cheap,
+/// unlike an analysis.
+#[pyfunction]
+pub fn validate(model: ModelArgs) -> PyResult<()> {
+    model.build(false).py().map(|_| ())
+}
+
+/// All equilibria with their stability, as a list of dicts.
+#[pyfunction]
+pub fn equilibria<'py>(py: Python<'py>, model: ModelArgs) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let m = autonomous(&model, false, "equilibria")?;
+    let eqs = guarded(py, || {
+        Ok(match &m {
+            Model::Scene(s) => ballbal_core::analysis::balanced::scene_equilibria(s),
+            Model::Planar(p) => core_equilibria(p),
+        })
+    })?;
+    eqs.into_iter().map(|e| equilibrium_dict(py, e)).collect()
+}
+
+/// The balanced state of each model, in parallel: a dict like `equilibria`'s, or
+/// `None` where the balls cannot balance the disk.
+#[pyfunction]
+pub fn balanced_states<'py>(
+    py: Python<'py>,
+    models: Vec<ModelArgs>,
+) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
+    use rayon::prelude::*;
+    let mut scenes = Vec::with_capacity(models.len());
+    for m in &models {
+        match autonomous(m, true, "balanced_state")? {
+            Model::Scene(s) => scenes.push(s),
+            Model::Planar(_) => unreachable!("built as a scene"),
+        }
+    }
+    // Each point is solved on its own from the planar perfect balance, so the result
+    // does not depend on the thread count.
+    let eqs = guarded(py, || {
+        // rayon's threads do not inherit the cancellation token: hand it on.
+        let tok = cancel::current();
+        Ok(scenes
+            .par_iter()
+            .map(|s| {
+                // Each point is short: stop between points once cancelled.
+                cancel::with(tok.clone(), || {
+                    (!cancel::cancelled())
+                        .then(|| ballbal_core::analysis::balanced::balanced_state(s))
+                        .flatten()
+                })
+            })
+            .collect::<Vec<_>>())
+    })?;
+    eqs.into_iter()
+        .map(|e| e.map(|e| equilibrium_dict(py, e)).transpose())
+        .collect()
+}
+
+/// A start for Newton from `(omega, coefficients)`, checked against the model.
+fn start(m: &Model, rotating: &[bool], w: f64, c: &[f64]) -> PyResult<HbSolution> {
+    let (d, o) = dispatch!(m, x => (x.ndof(), x.first_ball()));
+    if !c.len().is_multiple_of(d) || (c.len() / d) % 2 != 1 {
+        return Err(Error::param(
+            "guess",
+            format!(
+                "coefficients: need shape (coordinates, 2 N + 1) = ({d}, odd), got {} values",
+                c.len()
+            ),
+        ))
+        .py();
+    }
+    if !(w.is_finite() && w > 0.0) || c.iter().any(|v| !v.is_finite()) {
+        return Err(Error::param(
+            "guess",
+            "omega must be > 0 and every coefficient finite",
+        ))
+        .py();
+    }
+    let mut winding = vec![0.0; d];
+    for (i, &r) in rotating.iter().enumerate() {
+        winding[o + i] = if r { -1.0 } else { 0.0 };
+    }
+    let nh = (c.len() / d - 1) / 2;
+    Ok(HbSolution::start(
+        w,
+        c.to_vec(),
+        winding,
+        nh,
+        Status::NoGuess,
+    ))
+}
+
+/// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers;
+/// `guess` is `(omega, coefficients)` or `None` (a simulated start).
+#[pyfunction]
+#[pyo3(signature = (model, pattern, options, guess=None))]
+pub fn periodic<'py>(
+    py: Python<'py>,
+    model: ModelArgs,
+    pattern: &str,
+    options: PeriodicArgs,
+    guess: Option<(f64, PyReadonlyArray1<'py, f64>)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = autonomous(&model, false, "periodic")?;
+    let rotating = parse_pattern(pattern, m.n_balls()).py()?;
+    let opts = options.to_core()?;
+    let guess = match &guess {
+        Some((w, c)) => Some(start(&m, &rotating, *w, slice(c, "guess")?)?),
+        None => None,
+    };
+    let r = guarded(py, || {
+        dispatch!(&m, d => {
+            stiff_guess(d, guess.is_none(), &opts)?;
+            Ok(core_periodic(d, &rotating, guess.as_ref(), &opts))
+        })
+    })?;
+    solution_dict(py, r, m.n_balls())
+}
+
+/// `Err(Stiff)` when the guess simulations would be too stiff for the explicit
+/// integrator: the core counts a failed guess simulation as "no guess", which would hide
+/// the reason (after minutes, at these parameters).
+fn stiff_guess<D: Dynamics>(m: &D, simulates: bool, opts: &PeriodicOptions) -> Result<(), Error> {
+    if !simulates {
+        return Ok(());
+    }
+    let Some(y0) = ballbal_core::periodic::initial_states(m).into_iter().next() else {
+        return Ok(());
+    };
+    ballbal_core::ode::probe_stiffness(
+        |t, y, dy| ballbal_core::model::first_order_rhs(m, t, y, dy),
+        0.0,
+        &y0,
+        opts.guess.settle,
+        &Options::new(opts.guess.rtol, opts.guess.atol),
+        // Stiffness from the parameters shows within the first few dozen steps; more
+        // would cost a normal call milliseconds (the whole settle time).
+        300,
+    )
+}
+
+/// The "NI" check: max distance after one simulated period from the orbit's own state.
+#[pyfunction]
+pub fn orbit_closure(
+    py: Python<'_>,
+    model: ModelArgs,
+    omega: f64,
+    coeffs: PyReadonlyArray1<'_, f64>,
+    winding: Vec<f64>,
+    rtol: f64,
+    atol: f64,
+) -> PyResult<f64> {
+    let m = model.build(false).py()?;
+    let c = slice(&coeffs, "coeffs")?.to_vec();
+    let d = winding.len();
+    if d == 0 || !c.len().is_multiple_of(d) || (c.len() / d) % 2 != 1 {
+        return Err(Error::param(
+            "coeffs",
+            format!(
+                "need {d} x (2 N + 1) values (one row per coordinate), got {}",
+                c.len()
+            ),
+        ))
+        .py();
+    }
+    let n_harm = (c.len() / d - 1) / 2;
+    let sol = HbSolution::start(omega, c, winding, n_harm, Status::Converged);
+    guarded(
+        py,
+        || dispatch!(&m, x => closure_error(x, &sol, rtol, atol)),
+    )
+}
+
+/// Parallel scan of a parameter grid, chunk by chunk. `options` is a
+/// `ballbal.ScanOptions` (its `block`: values of the last axis per continuation block,
+/// `None` for the default). `on_chunk(index, columns)` is called (with the GIL, in this
+/// thread) for every finished chunk as soon as it is done; Ctrl-C cancels the remaining
+/// work, hands over the chunks that still finish, and then raises `KeyboardInterrupt`.
+/// A scene is scanned as a scene even with every effect off (an axis may switch one on).
+#[pyfunction]
+#[pyo3(signature = (model, names, values, patterns, options, chunk, threads, chunks, on_chunk))]
+#[allow(clippy::too_many_arguments)]
+pub fn scan(
+    py: Python<'_>,
+    model: ModelArgs,
+    names: Vec<String>,
+    values: Vec<Vec<f64>>,
+    patterns: Vec<String>,
+    options: Bound<'_, PyAny>,
+    chunk: usize,
+    threads: usize,
+    chunks: Vec<usize>,
+    on_chunk: Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let lens: Vec<usize> = values.iter().map(Vec::len).collect();
+    let args: PeriodicArgs = options.extract()?;
+    let block: Option<usize> = options.getattr("block")?.extract()?;
+    let block = block.unwrap_or_else(|| ballbal_core::scan::default_chunk(&lens));
+    let always_scene = matches!(model, ModelArgs::Scene(_));
+    let m = autonomous(&model, always_scene, "scan")?;
+    let rots = patterns
+        .iter()
+        .map(|s| parse_pattern(s, m.n_balls()))
+        .collect::<Result<Vec<_>, _>>()
+        .py()?;
+    let opts = args.to_core()?;
+    let n_harm = opts.hb.n_harm;
+    let cols = Columns {
+        names: &names,
+        values: &values,
+        patterns: &patterns,
+        n_harm,
+    };
+    dispatch!(&m, base => {
+        let spec = ScanSpec {
+            base,
+            names: names.clone(),
+            values: values.clone(),
+            patterns: rots,
+            max_tail: opts.max_tail,
+            opts,
+            seeds: args.guess.seeds,
+            starts: args.guess.starts,
+            block,
+            chunk,
+            threads,
+        };
+        run_scan(py, &spec, chunks, &cols, &on_chunk)
+    })
+}
+
+/// Runs `spec`'s chunks through [`run_polled`], handing each finished one to `on_chunk`.
+/// The scan cancels between rows with the token's flag (not the thread-local token: a
+/// row stopped half way would look like a row without a solution).
+fn run_scan<D: Family>(
+    py: Python<'_>,
+    spec: &ScanSpec<'_, D>,
+    chunks: Vec<usize>,
+    cols: &Columns<'_>,
+    on_chunk: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    use ballbal_core::scan::scan_chunks;
+    run_polled(
+        py,
+        |tok, tx: &std::sync::mpsc::Sender<(usize, Vec<ScanRow>)>| {
+            scan_chunks(spec, &chunks, tok.flag(), &|c, rows| {
+                let _ = tx.send((c, rows));
+            })
+        },
+        |(c, rows)| scan_columns(py, cols, &rows).and_then(|d| on_chunk.call1((c, d)).map(|_| ())),
+    )
+}
+
+/// Seconds this process has spent in certificate checks (all threads; a benchmark's
+/// measure of what they cost).
+#[pyfunction]
+pub fn certificate_seconds() -> f64 {
+    ballbal_core::hb::certificate_seconds()
+}
+
+/// Default block (and chunk) length, in values of the last parameter, for grid lengths
+/// `lens`: about 1024 points.
+#[pyfunction]
+pub fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
+    if lens.is_empty() || lens.contains(&0) {
+        return Err(Error::param("grid", "every parameter needs values")).py();
+    }
+    Ok(ballbal_core::scan::default_chunk(&lens))
+}

@@ -1,0 +1,173 @@
+"""The options as frozen dataclasses (ballbal.options), read by the native module by
+attribute; the flat keywords of before still work and mean the same; one schema for a
+periodic solution in periodic() and scan(); the first argument is ``model`` everywhere."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import ballbal
+from ballbal import (
+    Execution,
+    Floquet,
+    GuessSearch,
+    HarmonicBalance,
+    PeriodicOptions,
+    ScanOptions,
+)
+from ballbal.exceptions import ParameterError, ParameterTypeError
+
+B = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
+
+
+def test_options_are_frozen_and_check_types_only():
+    o = PeriodicOptions()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        o.max_tail = 1.0  # type: ignore[misc]
+    for make, name in [(lambda: HarmonicBalance(N=2.0), "N"),  # type: ignore[arg-type]
+                       (lambda: HarmonicBalance(tol="1e-3"), "tol"),  # type: ignore[arg-type]
+                       (lambda: Floquet(hill=1), "hill"),  # type: ignore[arg-type]
+                       (lambda: GuessSearch(seeds=1.5), "seeds"),  # type: ignore[arg-type]
+                       (lambda: PeriodicOptions(floquet=None), "floquet"),  # type: ignore
+                       (lambda: Execution(out=3), "out")]:  # type: ignore[arg-type]
+        with pytest.raises(ParameterTypeError) as e:
+            make()
+        assert e.value.parameter == name
+    # Values are the core's to judge: these construct, and the analysis refuses them.
+    bad = PeriodicOptions(floquet=Floquet(rtol=2.0))
+    with pytest.raises(ParameterError) as e:
+        ballbal.periodic(B, options=bad)
+    assert e.value.parameter == "rtol" and e.value.allowed == "(0, 1)"
+
+
+def test_guess_tolerances_reach_the_core():
+    # periodic() used a hidden guess tolerance (1e-9) that no argument could change:
+    # now GuessSearch.rtol is read, and an impossible value is refused by the core.
+    with pytest.raises(ParameterError) as e:
+        ballbal.periodic(B, options=PeriodicOptions(guess=GuessSearch(rtol=1.5)))
+    assert e.value.parameter == "guess_rtol"
+    with pytest.raises(ParameterError) as e:
+        ballbal.periodic(B, guess_rtol=0.0)
+    assert e.value.parameter == "guess_rtol"
+
+
+def test_options_and_flat_keywords_give_the_same_solution():
+    flat = ballbal.periodic(B, "R-R", N=5, rtol=1e-7, atol=1e-9, hill=False, settle=800.0)
+    opts = PeriodicOptions(harmonic_balance=HarmonicBalance(N=5),
+                           floquet=Floquet(rtol=1e-7, atol=1e-9, hill=False),
+                           guess=GuessSearch(settle=800.0))
+    new = ballbal.periodic(B, "R-R", options=opts)
+    assert new.converged and flat.converged
+    assert new.omega == flat.omega
+    assert np.array_equal(new.coeffs, flat.coeffs)
+    assert np.array_equal(new.multipliers, flat.multipliers)
+    # Keywords given with options change those options.
+    both = ballbal.periodic(B, "R-R", options=opts, N=3)
+    assert both.N == 3
+
+
+def test_flat_keyword_errors_name_the_keyword_typed():
+    with pytest.raises(ParameterTypeError) as e:
+        ballbal.periodic(B, floquet=None)
+    assert e.value.parameter == "floquet"
+    with pytest.raises(TypeError, match="unexpected keyword argument 'seeds'"):
+        ballbal.periodic(B, seeds=3)  # a scan's option
+
+
+def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
+    # meta.json's options (the scan directory's fingerprint) as ballbal wrote them before
+    # the option classes, for the defaults: directories written then still resume.
+    from ballbal.scan import _meta_options
+
+    old = {"N": 3, "auto": None, "N_max": 32, "hill": False, "samples": None,
+           "tol": 1e-10, "step_tol": 1e-8, "max_iter": 50, "floquet": True, "rtol": 1e-6,
+           "atol": 1e-9, "margin": 1e-6, "max_steps": 20_000, "settle": 1000.0,
+           "window": 2000.0, "guess_rtol": 1e-5, "seeds": 4, "starts": 4, "max_tail": 0.25,
+           "max_closure": 6.0, "max_trivial": 0.1}
+    got = _meta_options(ScanOptions())
+    assert json.dumps(got) == json.dumps(old)
+    hb = dataclasses.replace(ScanOptions().harmonic_balance, N="auto")
+    auto = _meta_options(ScanOptions(harmonic_balance=hb))
+    assert (auto["N"], auto["auto"]) == (3, 1e-4)  # the scan's default target
+    # A guess atol the flat keywords could not express is recorded.
+    assert _meta_options(ScanOptions(guess=GuessSearch(rtol=1e-5, atol=1e-7)))[
+        "guess_atol"] == 1e-7
+
+
+def test_scan_with_options_equals_scan_with_keywords(tmp_path):
+    grid = {"Omega": [1.2, 1.25], "eta": [1.0]}
+    flat = ballbal.scan(B, threads=1, seeds=2, starts=2, max_steps=10_000, **grid)
+    opts = ScanOptions(floquet=Floquet(rtol=1e-6, atol=1e-9, max_steps=10_000, hill=False),
+                       guess=GuessSearch(settle=1000.0, window=2000.0, rtol=1e-5,
+                                         atol=1e-5 * 1e-3, seeds=2, starts=2))
+    new = ballbal.scan(B, options=opts, execution=Execution(threads=1, out=tmp_path / "s"),
+                       **grid)
+    assert new.drop("seconds").equals(flat.drop("seconds"))
+    meta = json.loads((tmp_path / "s" / "meta.json").read_text())
+    assert meta["options"]["seeds"] == 2 and "guess_atol" not in meta["options"]
+
+
+def test_periodic_and_scan_share_the_solution_schema():
+    grid = {"Omega": [1.2], "eta": [1.0]}
+    df = ballbal.scan(B, threads=1, hill=True, **grid)
+    row = df.row(0, named=True)
+    # The scan's options as periodic() options: the same orbit, the same numbers.
+    o = ScanOptions(floquet=dataclasses.replace(ScanOptions().floquet, hill=True))
+    s = ballbal.periodic(B, "R-R", options=PeriodicOptions(
+        harmonic_balance=o.harmonic_balance, floquet=o.floquet, guess=o.guess))
+    names = {"status", "omega", "stability", "max_modulus", "trivial_error", "residual",
+             "tail", "closure", "separation_error", "pivot_ratio", "iterations",
+             "floquet_steps", "N", "target_met", "hill_stability", "verdicts_disagree"}
+    assert names <= set(df.columns)
+    for n in names:
+        assert hasattr(s, n), n
+    assert row["status"] == s.status == "converged"
+    assert abs(row["omega"] - s.omega) < 1e-9
+    assert abs(row["pivot_ratio"] - s.pivot_ratio) < 1e-6 * s.pivot_ratio
+    # Multipliers: {re, im} structs in the table, complex numbers in the solution.
+    assert s.multipliers is not None
+    tab = np.array([complex(m["re"], m["im"]) for m in row["multipliers"]])
+    assert np.allclose(np.sort_complex(tab), np.sort_complex(s.multipliers), atol=1e-6)
+
+
+def test_condition_is_a_deprecated_alias_of_pivot_ratio():
+    s = ballbal.periodic(B, "R-R", hill=False)
+    with pytest.warns(DeprecationWarning, match="pivot_ratio"):
+        c = s.condition
+    assert c == s.pivot_ratio and c >= 1
+
+
+CALLS = {
+    "equilibria": (ballbal.equilibria, "balancer", {}),
+    "simulate": (ballbal.simulate, "balancer", {"t_eval": [0.0, 1.0]}),
+    "periodic": (ballbal.periodic, "balancer", {"floquet": False, "hill": False}),
+    "run_up": (ballbal.run_up, "scene", {"to": 1.3, "duration": 1.0, "settle": 1.0}),
+}
+
+
+@pytest.mark.parametrize("which", sorted(CALLS))
+def test_first_argument_is_model_and_the_old_name_warns(which):
+    f, old, kw = CALLS[which]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        f(model=B, **kw)
+    with pytest.warns(DeprecationWarning, match="'model'"):
+        f(**{old: B}, **kw)
+    with pytest.raises(TypeError, match="multiple values"):
+        f(B, **{old: B}, **kw)
+
+
+def test_the_flattened_native_arguments_are_gone():
+    for name in ("native_args", "native_effects", "effects_tuple"):
+        assert not hasattr(ballbal.Balancer(), name)
+        assert not hasattr(ballbal.Scene(), name)
+    # The native entry points take the model itself and leave its values to the core.
+    ballbal._native.validate(ballbal.Scene(springs=1e-3))
+    with pytest.raises(ParameterError) as e:
+        ballbal._native.validate(ballbal.Scene(balancer=B.replace(mu=1.5), springs=1e-3))
+    assert (e.value.parameter, e.value.allowed) == ("mu", "(0, 1)")
