@@ -15,7 +15,7 @@ from .scene import Scene
 
 __all__ = [
     "simulate", "validate", "equilibria", "balanced_states", "periodic", "orbit_closure",
-    "scan", "default_chunk", "certificate_seconds", "__version__",
+    "balance_map", "scan", "default_chunk", "certificate_seconds", "__version__",
 ]
 
 __version__: str
@@ -28,6 +28,10 @@ def simulate(
 def validate(model: Balancer | Scene) -> None: ...
 def equilibria(model: Balancer | Scene) -> list[dict[str, Any]]: ...
 def balanced_states(models: Sequence[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
+# (status, equilibrium dict or None) per point: "ok", "no_balance" or "not_converged"
+def balance_map(
+    model: Balancer | Scene, names: list[str], points: list[list[float]],
+) -> list[tuple[str, dict[str, Any] | None]]: ...
 def periodic(
     model: Balancer | Scene, pattern: str, options: PeriodicOptions,
     guess: tuple[float, npt.NDArray[np.float64]] | None = None,

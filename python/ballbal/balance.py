@@ -60,25 +60,21 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
         values.append([float(x) for x in v])
     _check.grid_points([len(v) for v in values], names, streamed=False)
     grid = list(itertools.product(*values))
-    points = [scene.replace(**dict(zip(names, combo, strict=True))) for combo in grid]
-    results = _native.balanced_states(points)
-    # Tell "the balls cannot balance the disk" from "the continuation to this scene failed".
-    missing = [i for i, d in enumerate(results) if d is None]
-    planar_ok = _native.balanced_states([points[i].balancer for i in missing])
-    failed = {i for i, d in zip(missing, planar_ok, strict=True) if d is not None}
+    # The points are built and solved in the core (parameters set by name there), so a
+    # map costs the solves and not one Python scene per point.
+    results = _native.balance_map(scene, names, [list(c) for c in grid])
     cols: dict[str, list[Any]] = {n: [] for n in names}
     for key in ("status", "stability", "index", "whirl", "tilt", "residual"):
         cols[key] = []
-    for i, (combo, d) in enumerate(zip(grid, results, strict=True)):
+    for combo, (status, d) in zip(grid, results, strict=True):
         for n, x in zip(names, combo, strict=True):
             cols[n].append(x)
+        cols["status"].append(status)
         if d is None:
             for key in ("stability", "index", "whirl", "tilt", "residual"):
                 cols[key].append(None)
-            cols["status"].append("not_converged" if i in failed else "no_balance")
             continue
         q = d["q"]
-        cols["status"].append("ok")
         cols["stability"].append(d["stability"])
         cols["index"].append(float(d["index"]))
         cols["whirl"].append(float(np.hypot(q[0], q[1])))

@@ -143,6 +143,67 @@ pub fn balanced_states<'py>(
         .collect()
 }
 
+/// The balanced state over a grid (`balance_map`): each point is the model with the
+/// named parameters set (in the core, by the parameter registry's names), solved on its
+/// own in parallel. Per point `("ok", dict)`, `("no_balance", None)` where the balls
+/// cannot balance the planar disk, or `("not_converged", None)` where they can but the
+/// continuation to the scene failed.
+#[pyfunction]
+pub fn balance_map<'py>(
+    py: Python<'py>,
+    model: ModelArgs,
+    names: Vec<String>,
+    points: Vec<Vec<f64>>,
+) -> PyResult<Vec<(&'static str, Option<Bound<'py, PyDict>>)>> {
+    use ballbal_core::analysis::balanced::balanced_state;
+    use ballbal_core::Scene;
+    use rayon::prelude::*;
+    let Model::Scene(base) = autonomous(&model, true, "balance_map")? else {
+        unreachable!("built as a scene")
+    };
+    let mut scenes = Vec::with_capacity(points.len());
+    for pt in &points {
+        if pt.len() != names.len() {
+            return Err(Error::param("axes", "one value per axis at every point")).py();
+        }
+        let mut s = base.clone();
+        for (n, &v) in names.iter().zip(pt) {
+            s = s.with_param(n, v).py()?;
+        }
+        scenes.push(s);
+    }
+    let found = guarded(py, || {
+        let tok = cancel::current();
+        Ok(scenes
+            .par_iter()
+            .map(|s| {
+                cancel::with(tok.clone(), || {
+                    if cancel::cancelled() {
+                        return ("cancelled", None);
+                    }
+                    match balanced_state(s) {
+                        Some(e) => ("ok", Some(e)),
+                        None => {
+                            // the planar disk of this point, no effects: can it balance?
+                            let plain = Scene::new(s.planar.clone(), 0.0, None, 0.0, None, None)
+                                .ok()
+                                .and_then(|p| balanced_state(&p));
+                            match plain {
+                                Some(_) => ("not_converged", None),
+                                None => ("no_balance", None),
+                            }
+                        }
+                    }
+                })
+            })
+            .collect::<Vec<_>>())
+    })?;
+    found
+        .into_iter()
+        .map(|(st, e)| Ok((st, e.map(|e| equilibrium_dict(py, e)).transpose()?)))
+        .collect()
+}
+
 /// A start for Newton from `(omega, coefficients)`, checked against the model.
 fn start(m: &Model, rotating: &[bool], w: f64, c: &[f64]) -> PyResult<HbSolution> {
     let (d, o) = dispatch!(m, x => (x.ndof(), x.first_ball()));

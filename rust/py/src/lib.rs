@@ -55,6 +55,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::validate, m)?)?;
     m.add_function(wrap_pyfunction!(entries::equilibria, m)?)?;
     m.add_function(wrap_pyfunction!(entries::balanced_states, m)?)?;
+    m.add_function(wrap_pyfunction!(entries::balance_map, m)?)?;
     m.add_function(wrap_pyfunction!(entries::periodic, m)?)?;
     m.add_function(wrap_pyfunction!(entries::orbit_closure, m)?)?;
     m.add_function(wrap_pyfunction!(entries::scan, m)?)?;
