@@ -143,6 +143,9 @@ pub fn balanced_states<'py>(
         .collect()
 }
 
+/// One point of [`balance_map`]: its status and the balanced state, if any.
+type MapPoint<'py> = (&'static str, Option<Bound<'py, PyDict>>);
+
 /// The balanced state over a grid (`balance_map`): each point is the model with the
 /// named parameters set (in the core, by the parameter registry's names), solved on its
 /// own in parallel. Per point `("ok", dict)`, `("no_balance", None)` where the balls
@@ -154,7 +157,7 @@ pub fn balance_map<'py>(
     model: ModelArgs,
     names: Vec<String>,
     points: Vec<Vec<f64>>,
-) -> PyResult<Vec<(&'static str, Option<Bound<'py, PyDict>>)>> {
+) -> PyResult<Vec<MapPoint<'py>>> {
     use ballbal_core::analysis::balanced::balanced_state;
     use ballbal_core::Scene;
     use rayon::prelude::*;
