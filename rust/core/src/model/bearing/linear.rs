@@ -8,7 +8,7 @@
 
 use super::{FilmSolver, JournalState};
 use crate::error::{Error, Result};
-use nalgebra::{Matrix2, Matrix4};
+use nalgebra::Matrix2;
 
 /// Static equilibrium of the journal under a load.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -170,18 +170,20 @@ pub fn linear_coefficients_fd(
 }
 
 impl LinearCoefficients {
-    /// Eigenvalues (units `w`) of `m dq'' + C dq' + K dq = 0`.
-    pub fn eigenvalues(&self, mass: f64) -> Vec<nalgebra::Complex<f64>> {
-        let mut a = Matrix4::zeros();
-        a[(0, 2)] = 1.0;
-        a[(1, 3)] = 1.0;
+    /// Eigenvalues `(re, im)` (units `w`) of `m dq'' + C dq' + K dq = 0`, by decreasing real
+    /// part (faer's QR; nalgebra's Schur can stall on these matrices).
+    pub fn eigenvalues(&self, mass: f64) -> Result<Vec<(f64, f64)>> {
+        let mut a = [0.0; 16];
+        a[2] = 1.0;
+        a[4 + 3] = 1.0;
         for i in 0..2 {
             for j in 0..2 {
-                a[(2 + i, j)] = -self.k[(i, j)] / mass;
-                a[(2 + i, 2 + j)] = -self.c[(i, j)] / mass;
+                a[(2 + i) * 4 + j] = -self.k[(i, j)] / mass;
+                a[(2 + i) * 4 + 2 + j] = -self.c[(i, j)] / mass;
             }
         }
-        a.complex_eigenvalues().iter().cloned().collect()
+        crate::numerics::linalg::eigenvalues(&a, 4)
+            .ok_or_else(|| Error::Eigen("rigid rotor on the film: QR iteration failed".into()))
     }
 }
 
