@@ -177,14 +177,16 @@ impl FiniteSolver {
 
     /// Pressure for a problem; `force_sparse` bypasses the sine-transform fast path.
     pub(crate) fn solve(&mut self, pb: &Problem, force_sparse: bool) -> Result<Vec<f64>> {
+        if self.grooves.is_none() && self.cavitation != Cavitation::Reynolds && !force_sparse {
+            let mut p = self.solve_plain(pb);
+            if self.cavitation == Cavitation::HalfSommerfeld {
+                p.iter_mut().for_each(|v| *v = v.max(0.0));
+            }
+            return Ok(p);
+        }
         let film = self.film(pb);
         let rhs = self.rhs(pb, &film);
-        let mut p =
-            if self.grooves.is_none() && self.cavitation != Cavitation::Reynolds && !force_sparse {
-                self.solve_plain(&film, &rhs)
-            } else {
-                self.solve_sparse(&film, &rhs, None)?
-            };
+        let mut p = self.solve_sparse(&film, &rhs, None)?;
         match self.cavitation {
             Cavitation::None => {}
             Cavitation::HalfSommerfeld => p.iter_mut().for_each(|v| *v = v.max(0.0)),
@@ -440,23 +442,43 @@ impl FiniteSolver {
         (gt, gz)
     }
 
-    /// Fast path for a plain film: one periodic tridiagonal solve per odd sine mode.
-    fn solve_plain(&self, film: &Film, rhs: &[f64]) -> Vec<f64> {
+    /// Fast path for a plain film: one periodic tridiagonal solve per odd sine mode. The
+    /// same face films, conductances and right-hand side as [`Self::film`] and [`Self::rhs`],
+    /// once per theta column since nothing depends on `zeta`.
+    fn solve_plain(&self, pb: &Problem) -> Vec<f64> {
         let (nt, nz) = (self.nt, self.nz);
-        // theta conductances (the same for all j) and zeta conductances per unit T.
-        let kt: Vec<f64> = (0..nt).map(|i| film.kt[i * nz]).collect();
-        let cz: Vec<f64> = (0..nt).map(|i| film.kz[i * (nz + 1) + 1]).collect();
-        let r: Vec<f64> = (0..nt).map(|i| -rhs[i * nz]).collect();
+        let (ctf, czf) = (self.dz / self.dth, self.dth / self.dz);
+        let mut kt = vec![0.0; nt];
+        let mut q = vec![0.0; nt];
+        let mut cz = vec![0.0; nt];
+        for i in 0..nt {
+            let h = 1.0 - pb.x * self.cf[i] - pb.y * self.sf[i];
+            kt[i] = h * h * h * ctf;
+            q[i] = pb.couette * h;
+            let hc = 1.0 - pb.x * (self.sf[i + 1] - self.sf[i]) / self.dth
+                + pb.y * (self.cf[i + 1] - self.cf[i]) / self.dth;
+            cz[i] = hc * hc * hc * czf;
+        }
+        let r: Vec<f64> = (0..nt)
+            .map(|i| {
+                let sq = -12.0
+                    * self.dz
+                    * (pb.vx * (self.sf[i + 1] - self.sf[i])
+                        - pb.vy * (self.cf[i + 1] - self.cf[i]));
+                -(6.0 * self.dz * (q[(i + 1) % nt] - q[i]) + sq)
+            })
+            .collect();
         let half = nz / 2;
         let mut p = vec![0.0; nt * nz];
         let mut diag = vec![0.0; nt];
         let mut sol = vec![0.0; nt];
+        let mut b = vec![0.0; nt];
         let mut work = CyclicWork::new(nt);
         for (mu, beta, v) in &self.modes {
             for i in 0..nt {
                 diag[i] = kt[i] + kt[(i + 1) % nt] + mu * cz[i];
+                b[i] = r[i] * beta;
             }
-            let b: Vec<f64> = r.iter().map(|a| a * beta).collect();
             work.solve(&kt, &diag, &b, &mut sol);
             for i in 0..nt {
                 let row = &mut p[i * nz..i * nz + half];
