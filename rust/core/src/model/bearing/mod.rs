@@ -424,6 +424,15 @@ impl FilmSolver {
         }
     }
 
+    /// Along a trajectory: reuse an old factor as the conjugate-gradient preconditioner of
+    /// the grooved finite film, to relative residual `tol` (`None`: factor every time). No
+    /// effect on the other models.
+    pub fn set_factor_reuse(&mut self, tol: Option<f64>) {
+        if let SolverKind::Finite(s) = &mut self.kind {
+            s.set_factor_reuse(tol);
+        }
+    }
+
     /// Just `(F_x, F_y)`.
     pub fn force_xy(&mut self, state: &JournalState) -> Result<[f64; 2]> {
         let f = self.force(state, false)?;
