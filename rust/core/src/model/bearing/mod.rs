@@ -348,6 +348,9 @@ pub struct FilmForce {
     /// Attitude angle between the force's line of action (reversed) and the line of
     /// centres: `atan2(f_tangential, f_radial)`.
     pub attitude: f64,
+    /// Sommerfeld number of the film force as the load: `S = mu N L D (R/c)^2 / W =
+    /// 1 / (pi |F| / F_S)`.
+    pub sommerfeld: f64,
     /// Peak pressure, units `mu w R^2 / c^2`.
     pub p_max: f64,
     /// Minimum film `h_min / c` over the lands, `1 - eps`.
@@ -374,6 +377,7 @@ impl FilmForce {
             eccentricity: eps,
             position_angle: phi,
             attitude: f_tangential.atan2(f_radial),
+            sommerfeld: 1.0 / (PI * fx.hypot(fy)),
             p_max,
             h_min: 1.0 - eps,
             pressure: None,

@@ -850,3 +850,18 @@ fn bearing_old_factor_preconditioner_matches_direct_solve() {
     );
     assert!(fs.factorisations < 20);
 }
+
+#[test]
+fn bearing_sommerfeld_number_matches_dimensional_definition() {
+    // R = 25 mm, L = 30 mm, c = 40 um, mu = 0.02 Pa s, 300 rad/s.
+    let dims = Dimensions::new(0.025, 0.03, 40e-6, 0.02).unwrap();
+    let omega = 300.0;
+    let mut s = solver(&Bearing::plain(dims.lambda(), FilmModel::Short));
+    let f = s.force(&JournalState::at(0.5, 0.1), false).unwrap();
+    let w = f.fx.hypot(f.fy) * dims.force_scale(omega);
+    // S = mu N L D (R/c)^2 / W with N in rev/s, written out here.
+    let n = omega / (2.0 * PI);
+    let s_def = 0.02 * n * 0.03 * 0.05 * (0.025f64 / 40e-6).powi(2) / w;
+    assert!(rel(f.sommerfeld, s_def) < 1e-12);
+    assert!(rel(dims.sommerfeld(omega, w), s_def) < 1e-12);
+}
