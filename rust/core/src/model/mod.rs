@@ -3,6 +3,7 @@
 //! [`Dynamics`] is the one interface the solvers see. [`Planar`] is the planar
 //! balancer fused for speed; [`Scene`] adds the physical effects a user switches on.
 
+pub mod bearing;
 mod dynamics;
 pub mod planar;
 pub mod scene;
