@@ -13,6 +13,7 @@
 
 pub mod analysis;
 pub mod cancel;
+pub mod continuation;
 pub mod error;
 pub mod model;
 pub mod numerics;

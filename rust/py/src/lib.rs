@@ -402,7 +402,7 @@ fn balanced_states<'py>(
 fn equilibrium_dict(py: Python<'_>, e: Equilibrium) -> PyResult<Bound<'_, PyDict>> {
     {
         let d = PyDict::new(py);
-        d.set_item("kind", e.kind)?;
+        d.set_item("kind", e.kind.as_str())?;
         d.set_item("q", PyArray1::from_vec(py, e.q))?;
         d.set_item("residual", e.residual)?;
         d.set_item(
@@ -976,7 +976,10 @@ fn scan_columns<'py>(
         "seconds",
         rows.iter().map(|r| r.seconds).collect::<Vec<_>>(),
     )?;
-    d.set_item("origin", rows.iter().map(|r| r.origin).collect::<Vec<_>>())?;
+    d.set_item(
+        "origin",
+        rows.iter().map(|r| r.origin.as_str()).collect::<Vec<_>>(),
+    )?;
     d.set_item(
         "pb_exists",
         rows.iter().map(|r| r.pb_exists).collect::<Vec<_>>(),

@@ -9,8 +9,10 @@
 //! free time shift: `b_r(0) = 0` for the first rotating ball `r`, otherwise the
 //! `sin tau` coefficient of `x` is zero (spec section 4).
 
+use crate::continuation::Secant;
 use crate::linalg::lu_solve;
 use crate::model::Dynamics;
+use crate::numerics::problem::{At, ModelAt, Problem};
 use std::f64::consts::PI;
 
 /// Coefficient layout per coordinate: `[a_0, a_1, b_1, ..., a_N, b_N]`.
@@ -403,6 +405,19 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
 
     /// Residual `r` (length `size()`), and the Jacobian (row-major) when `jac` is given.
     pub fn assemble(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut [f64]>) {
+        let model = self.model;
+        self.assemble_with(model, x, r, jac);
+    }
+
+    /// [`Self::assemble`] for another model of the same coordinates (the same model at
+    /// another parameter value).
+    pub fn assemble_with<M: Dynamics + ?Sized>(
+        &mut self,
+        model: &M,
+        x: &[f64],
+        r: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) {
         let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         let om = x[d * l];
         self.sample(x);
@@ -416,15 +431,14 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             }
             let t = self.basis.tau[i] / om;
             let q = &self.q[i * d..(i + 1) * d];
-            self.model
-                .residual(t, q, &v, &a, &mut self.f[i * d..(i + 1) * d]);
+            model.residual(t, q, &v, &a, &mut self.f[i * d..(i + 1) * d]);
             if want_jac {
                 let (kk, cc, mm) = (
                     &mut self.k[i * d * d..(i + 1) * d * d],
                     &mut self.c[i * d * d..(i + 1) * d * d],
                     &mut self.m[i * d * d..(i + 1) * d * d],
                 );
-                self.model.jacobians(t, q, &v, &a, kk, cc, mm);
+                model.jacobians(t, q, &v, &a, kk, cc, mm);
             }
         }
         // Galerkin projection.
@@ -525,6 +539,75 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
     }
 }
 
+/// The harmonic-balance problem as a [`Problem`]: unknowns the coefficients and
+/// `omega` (`x = (c, omega)`), equations the Galerkin residual and the phase condition;
+/// the parameter is one of the model's (see [`ModelAt`]).
+pub struct HbProblem<'a, D: Dynamics + ?Sized> {
+    sys: HbSystem<'a, D>,
+    models: ModelAt<'a, D>,
+}
+
+impl<'a, D: Dynamics + ?Sized> HbProblem<'a, D> {
+    pub fn new(models: ModelAt<'a, D>, winding: &[f64], n_harm: usize, samples: usize) -> Self {
+        HbProblem {
+            sys: HbSystem::new(models.base(), winding, n_harm, samples),
+            models,
+        }
+    }
+
+    /// The unknowns of a solution: its coefficients, then omega.
+    pub fn unknowns(sol: &HbSolution) -> Vec<f64> {
+        let mut x = sol.coeffs.clone();
+        x.push(sol.omega);
+        x
+    }
+
+    fn assemble(
+        &mut self,
+        x: &[f64],
+        p: f64,
+        r: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) -> crate::Result<()> {
+        match self.models.at(p)? {
+            At::Base(m) => self.sys.assemble_with(m, x, r, jac),
+            At::Varied(m) => self.sys.assemble_with(m, x, r, jac),
+        }
+        Ok(())
+    }
+}
+
+impl<D: Dynamics + ?Sized> Problem for HbProblem<'_, D> {
+    fn size(&self) -> usize {
+        self.sys.size()
+    }
+    fn param(&self) -> f64 {
+        self.models.value()
+    }
+    fn residual(&mut self, x: &[f64], p: f64, r: &mut [f64]) -> crate::Result<()> {
+        self.assemble(x, p, r, None)
+    }
+    fn jac_x(&mut self, x: &[f64], p: f64, r: &mut [f64], jac: &mut [f64]) -> crate::Result<()> {
+        self.assemble(x, p, r, Some(jac))
+    }
+}
+
+/// The secant predictor `2 a - b` in coefficients and frequency (a frequency that
+/// would not be positive keeps `a`'s).
+impl Secant for HbSolution {
+    fn secant(&self, previous: &Self) -> Self {
+        let mut g = self.clone();
+        for (x, y) in g.coeffs.iter_mut().zip(&previous.coeffs) {
+            *x = 2.0 * *x - y;
+        }
+        g.omega = 2.0 * self.omega - previous.omega;
+        if !(g.omega > 0.0) {
+            g.omega = self.omega;
+        }
+        g
+    }
+}
+
 fn l2(v: &[f64]) -> f64 {
     v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
@@ -545,10 +628,11 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         guess.resized(opts.n_harm)
     };
     let samples = opts.samples.unwrap_or_else(|| default_samples(opts.n_harm));
-    let mut sys = HbSystem::new(model, &g.winding, opts.n_harm, samples);
-    let n = sys.size();
-    let mut x = g.coeffs.clone();
-    x.push(g.omega);
+    let mut prob = HbProblem::new(ModelAt::fixed(model), &g.winding, opts.n_harm, samples);
+    // The model as given: the problem's own parameter value, where it never fails.
+    let p = prob.param();
+    let n = prob.size();
+    let mut x = HbProblem::<D>::unknowns(&g);
     let mut r = vec![0.0; n];
     let mut rt = vec![0.0; n];
     let mut jac = vec![0.0; n * n];
@@ -584,7 +668,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         );
         return out;
     }
-    sys.assemble(&x, &mut r, Some(&mut jac));
+    let _ = prob.jac_x(&x, p, &mut r, &mut jac);
     let mut rn = max_abs(&r);
     let scale0 = max_abs(&x).max(1.0);
     for it in 1..=opts.max_iter {
@@ -623,7 +707,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
                 xt[i] = x[i] + lam * dx[i];
             }
             if xt[n - 1] > 0.0 {
-                sys.assemble(&xt, &mut rt, None);
+                let _ = prob.residual(&xt, p, &mut rt);
                 rtn = max_abs(&rt);
                 let mt = l2(&rt);
                 if mt.is_finite() && mt < (1.0 - 1e-4 * lam) * merit.max(1e-300) {
@@ -653,7 +737,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
             finish(&x, &mut out, Status::Converged, rn, step, it);
             return out;
         }
-        sys.assemble(&x, &mut r, Some(&mut jac));
+        let _ = prob.jac_x(&x, p, &mut r, &mut jac);
         rn = max_abs(&r);
         if it == opts.max_iter {
             finish(&x, &mut out, Status::MaxIterations, rn, step, it);
