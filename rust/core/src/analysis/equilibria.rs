@@ -809,6 +809,56 @@ mod tests {
     }
 
     #[test]
+    fn equilibrium_problem_jacobians_and_the_balance_angles_slope() {
+        use crate::numerics::problem::tangent;
+        // dF/dq against central differences, at an arbitrary point of three unequal balls.
+        let p3 = Planar::new(0.2, 0.05, &[0.1], 50.0, 1.4, &[0.4, 0.6, 0.5]).unwrap();
+        let mut prob = EquilibriumProblem::new(ModelAt::family(&p3, "Omega", 1.4));
+        let q = [0.01, -0.02, 0.3, 2.0, -2.5];
+        let n = prob.size();
+        let (mut r, mut jac) = (vec![0.0; n], vec![0.0; n * n]);
+        prob.jac_x(&q, 1.4, &mut r, &mut jac).unwrap();
+        let h = 1e-6;
+        let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
+        for col in 0..n {
+            let mut qp = q.to_vec();
+            qp[col] += h;
+            prob.residual(&qp, 1.4, &mut rp).unwrap();
+            qp[col] -= 2.0 * h;
+            prob.residual(&qp, 1.4, &mut rm).unwrap();
+            for row in 0..n {
+                let fd = (rp[row] - rm[row]) / (2.0 * h);
+                assert!((fd - jac[row * n + col]).abs() < 1e-6, "({row},{col})");
+            }
+        }
+        // The perfect balance of two equal balls, b = arccos(-1 / (2 eta)): its slope in
+        // eta from the implicit-function theorem (dF/deta by the default difference)
+        // against the closed form's derivative.
+        let eta = 0.8;
+        let p2 = two(1.3, eta);
+        let pb = equilibria(&p2)
+            .into_iter()
+            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+            .unwrap();
+        let mut prob = EquilibriumProblem::new(ModelAt::family(&p2, "eta", eta));
+        let t = tangent(&mut prob, &pb.q, eta)
+            .unwrap()
+            .expect("isolated equilibrium");
+        let db = -(1.0 / (2.0 * eta * eta)) / (1.0 - 1.0 / (4.0 * eta * eta)).sqrt();
+        assert!(t[0].abs() < 1e-7 && t[1].abs() < 1e-7, "{t:?}");
+        assert!(
+            (t[2] - db).abs() < 1e-6 && (t[3] + db).abs() < 1e-6,
+            "{t:?} vs {db}"
+        );
+        // newton_static goes through the problem: it lands on the closed form.
+        let q = newton_static(&p2, &[0.01, 0.0, pb.q[2] + 0.1, pb.q[3] - 0.1]).unwrap();
+        assert!(
+            q.iter().zip(&pb.q).all(|(a, b)| (a - b).abs() < 1e-10),
+            "{q:?}"
+        );
+    }
+
+    #[test]
     fn perfect_balance_needs_eta_half() {
         assert!(equilibria(&two(1.5, 0.49))
             .iter()
