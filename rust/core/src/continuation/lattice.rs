@@ -163,3 +163,129 @@ pub fn waves<W: Waves, L: Lattice>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::continuation::Secant;
+
+    /// Points `0..n` on a line at parameters `p_i = 2 + 0.1 i`; the branch solves
+    /// x^3 + x = p (closed form checked below), by three Newton steps from the guess so
+    /// that a poor guess fails.
+    struct Line(usize);
+    impl Lattice for Line {
+        fn size(&self) -> usize {
+            self.0
+        }
+        fn neighbours(&self, p: usize) -> Vec<(usize, Option<usize>)> {
+            let mut out = vec![];
+            if p > 0 {
+                out.push((p - 1, (p + 1 < self.0).then_some(p + 1)));
+            }
+            if p + 1 < self.0 {
+                out.push((p + 1, p.checked_sub(1)));
+            }
+            out
+        }
+    }
+    #[derive(Clone, Debug)]
+    struct X(f64);
+    impl Secant for X {
+        fn secant(&self, previous: &Self) -> Self {
+            X(2.0 * self.0 - previous.0)
+        }
+    }
+    struct Cubic;
+    impl Corrector for Cubic {
+        type At = usize;
+        type Point = X;
+        fn correct(&self, at: &usize, guess: &X, _from: &X) -> Option<X> {
+            let p = 2.0 + 0.1 * *at as f64;
+            let mut x = guess.0;
+            for _ in 0..3 {
+                x -= (x * x * x + x - p) / (3.0 * x * x + 1.0);
+            }
+            ((x * x * x + x - p).abs() < 1e-12).then_some(X(x))
+        }
+    }
+    struct F {
+        x: X,
+        parent: Option<(usize, usize)>,
+    }
+    impl Waves for Cubic {
+        type Found = F;
+        type Key = f64;
+        fn point(f: &F) -> &X {
+            &f.x
+        }
+        fn class(_: &F) -> usize {
+            0
+        }
+        fn parent(f: &F) -> Option<(usize, usize)> {
+            f.parent
+        }
+        fn key(&self, p: &X) -> f64 {
+            p.0
+        }
+        fn found_key(f: &F) -> &f64 {
+            &f.x.0
+        }
+        fn admit(&self, have: &[F], _: usize, key: &f64) -> bool {
+            have.iter().all(|h| (h.x.0 - key).abs() > 1e-9)
+        }
+        fn complete(
+            &self,
+            _: usize,
+            x: X,
+            _: usize,
+            _: f64,
+            parent: (usize, usize),
+            _: Instant,
+        ) -> Option<F> {
+            Some(F {
+                x,
+                parent: Some(parent),
+            })
+        }
+    }
+
+    #[test]
+    fn waves_reach_every_point_of_the_branch_once() {
+        let n = 12;
+        let mut sols: Vec<Vec<F>> = (0..n).map(|_| vec![]).collect();
+        // One seed in the middle: x^3 + x = 2.5.
+        let x5 = Cubic.correct(&5, &X(1.115), &X(1.115)).unwrap();
+        sols[5].push(F {
+            x: x5,
+            parent: None,
+        });
+        let mut tally = Tally::new(n, 1);
+        waves(
+            &Cubic,
+            &Line(n),
+            &mut sols,
+            vec![(5, 0)],
+            &mut tally,
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        for (i, s) in sols.iter().enumerate() {
+            assert_eq!(s.len(), 1, "point {i}");
+            let (x, p) = (s[0].x.0, 2.0 + 0.1 * i as f64);
+            assert!((x * x * x + x - p).abs() < 1e-12);
+        }
+        // Each point solved once, from its one neighbour nearer the seed, with the
+        // first guess (the secant where the source has a parent) converging.
+        assert!(tally.attempts.iter().all(|a| a[0] <= 1));
+        assert_eq!(tally.attempts.iter().map(|a| a[0]).sum::<usize>(), n - 1);
+        assert!(waves(
+            &Cubic,
+            &Line(n),
+            &mut sols,
+            vec![(5, 0)],
+            &mut tally,
+            &AtomicBool::new(true)
+        )
+        .is_err());
+    }
+}
