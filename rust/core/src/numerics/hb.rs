@@ -1005,6 +1005,8 @@ mod tests {
         // A problem without a parameter refuses another value instead of ignoring it.
         let mut fixed = HbProblem::new(ModelAt::fixed(&base), &[0.0, 0.0, -1.0, 0.0], 3, 32);
         assert!(fixed.residual(&x, 1.3, &mut rp).is_err());
+        let nan = fixed.param();
+        assert!(fixed.jac_p(&x, nan, &mut fp).is_err());
     }
 
     #[test]

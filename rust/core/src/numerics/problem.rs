@@ -33,6 +33,9 @@ pub trait Problem {
     /// `dF/dp` into `out`. By default a central difference with step
     /// `1e-6 (1 + |p|)`, for problems without an analytic derivative.
     fn jac_p(&mut self, x: &[f64], p: f64, out: &mut [f64]) -> Result<()> {
+        if !p.is_finite() {
+            return Err(Error::param("p", format!("no derivative at p = {p}")));
+        }
         let h = 1e-6 * (1.0 + p.abs());
         let mut rm = vec![0.0; self.size()];
         self.residual(x, p + h, out)?;
