@@ -4,7 +4,10 @@
 //!
 //! * [`model`]: the equations of motion ([`Dynamics`]), the planar balancer and scenes;
 //! * [`numerics`]: integrator, linear algebra, harmonic balance, Floquet multipliers;
-//! * [`analysis`]: simulation, equilibria, periodic solutions and their certificates;
+//! * [`analysis`]: simulation, attractors, equilibria, periodic solutions and their
+//!   certificates;
+//! * [`continuation`]: following solutions through parameter space, generic over a
+//!   corrector (the problems of [`numerics::problem`]);
 //! * [`scan`]: parallel parameter scans;
 //! * [`error`] and [`cancel`]: what every layer shares.
 
@@ -13,6 +16,7 @@
 
 pub mod analysis;
 pub mod cancel;
+pub mod continuation;
 pub mod error;
 pub mod model;
 pub mod numerics;

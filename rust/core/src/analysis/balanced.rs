@@ -4,7 +4,7 @@
 
 use crate::equilibria::{
     analyse_all, analyse_model, equal_balls, equilibria, equilibria_in_track_order, equilibria_of,
-    newton_static, Equilibrium,
+    newton_static, Equilibrium, EquilibriumKind,
 };
 use crate::model::{Dynamics, Scene};
 use std::f64::consts::PI;
@@ -18,9 +18,9 @@ use std::f64::consts::PI;
 pub fn balanced_state(sc: &Scene) -> Option<Equilibrium> {
     let q = balanced_q(sc)?;
     let kind = if sc.springs > 0.0 {
-        "balanced"
+        EquilibriumKind::Balanced
     } else {
-        "perfect_balance"
+        EquilibriumKind::PerfectBalance
     };
     Some(analyse_model(sc, &q, kind, sc.springs == 0.0))
 }
@@ -85,7 +85,7 @@ pub fn scene_equilibria(sc: &Scene) -> Vec<Equilibrium> {
             .iter_mut()
             .find(|(q, _)| q.iter().zip(b).all(|(u, v)| (u - v).abs() < 1e-6))
         {
-            f.1 = "balanced".into();
+            f.1 = EquilibriumKind::Balanced;
         }
     }
     analyse_all(sc, found, false)

@@ -10,6 +10,7 @@
 
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::{Dynamics, Planar};
+use crate::numerics::problem::{At, ModelAt, Problem};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 
@@ -31,11 +32,52 @@ impl Verdict {
     }
 }
 
+/// What an equilibrium is, by the balls' and the disk's configuration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EquilibriumKind {
+    /// The disk centre at rest on the axis, the balls cancelling the unbalance.
+    PerfectBalance,
+    /// With ball springs: the state that continues the perfect balance.
+    Balanced,
+    /// Every ball at one angle.
+    Together,
+    /// Two balls half a turn apart.
+    Opposite,
+    Unbalanced,
+}
+
+impl EquilibriumKind {
+    /// The name tables and the Python API use.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            EquilibriumKind::PerfectBalance => "perfect_balance",
+            EquilibriumKind::Balanced => "balanced",
+            EquilibriumKind::Together => "together",
+            EquilibriumKind::Opposite => "opposite",
+            EquilibriumKind::Unbalanced => "unbalanced",
+        }
+    }
+
+    /// Order of the equilibrium lists: the balanced states first.
+    fn rank(&self) -> u8 {
+        match self {
+            EquilibriumKind::PerfectBalance | EquilibriumKind::Balanced => 0,
+            EquilibriumKind::Together => 1,
+            EquilibriumKind::Opposite => 2,
+            EquilibriumKind::Unbalanced => 3,
+        }
+    }
+}
+
+impl std::fmt::Display for EquilibriumKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Equilibrium {
-    /// "perfect_balance", "together", "opposite" or "unbalanced"; with ball springs
-    /// "balanced" for the state that continues the perfect balance.
-    pub kind: String,
+    pub kind: EquilibriumKind,
     /// `(x, y, b_1, ..., b_n)`, angles wrapped to `(-pi, pi]`.
     pub q: Vec<f64>,
     /// Max-norm of `F(q, 0, 0)`.
@@ -74,8 +116,59 @@ fn static_residual<D: Dynamics + ?Sized>(p: &D, q: &[f64], out: &mut [f64]) {
     p.residual(0.0, q, &z, &z, out);
 }
 
+/// The equilibrium problem as a [`Problem`]: `F(0, q, 0, 0) = 0` in `q`, with
+/// `dF/dq = K`. For a family of equilibria (three or more free balls) `K` is singular
+/// along the family; [`newton_static`] solves it in the least-squares sense, without
+/// a gauge equation.
+pub struct EquilibriumProblem<'a, D: Dynamics + ?Sized> {
+    models: ModelAt<'a, D>,
+    z: Vec<f64>,
+    c: Vec<f64>,
+    m: Vec<f64>,
+}
+
+impl<'a, D: Dynamics + ?Sized> EquilibriumProblem<'a, D> {
+    pub fn new(models: ModelAt<'a, D>) -> Self {
+        let d = models.base().ndof();
+        EquilibriumProblem {
+            models,
+            z: vec![0.0; d],
+            c: vec![0.0; d * d],
+            m: vec![0.0; d * d],
+        }
+    }
+}
+
+impl<D: Dynamics + ?Sized> Problem for EquilibriumProblem<'_, D> {
+    fn size(&self) -> usize {
+        self.z.len()
+    }
+    fn param(&self) -> f64 {
+        self.models.value()
+    }
+    fn residual(&mut self, x: &[f64], p: f64, r: &mut [f64]) -> crate::Result<()> {
+        match self.models.at(p)? {
+            At::Base(m) => static_residual(m, x, r),
+            At::Varied(m) => static_residual(m, x, r),
+        }
+        Ok(())
+    }
+    fn jacobian(&mut self, x: &[f64], p: f64, jac: &mut [f64]) -> crate::Result<()> {
+        let (z, c, m) = (&self.z, &mut self.c, &mut self.m);
+        match self.models.at(p)? {
+            At::Base(model) => model.jacobians(0.0, x, z, z, jac, c, m),
+            At::Varied(model) => model.jacobians(0.0, x, z, z, jac, c, m),
+        }
+        Ok(())
+    }
+    fn jac_x(&mut self, x: &[f64], p: f64, r: &mut [f64], jac: &mut [f64]) -> crate::Result<()> {
+        self.residual(x, p, r)?;
+        self.jacobian(x, p, jac)
+    }
+}
+
 /// Analyse a point known (or claimed) to be an equilibrium of the planar balancer.
-pub fn analyse(p: &Planar, q: &[f64], kind: &str) -> Equilibrium {
+pub fn analyse(p: &Planar, q: &[f64], kind: EquilibriumKind) -> Equilibrium {
     analyse_model(p, q, kind, true)
 }
 
@@ -84,7 +177,7 @@ pub fn analyse(p: &Planar, q: &[f64], kind: &str) -> Equilibrium {
 pub fn analyse_model<D: Dynamics + ?Sized>(
     p: &D,
     q: &[f64],
-    kind: &str,
+    kind: EquilibriumKind,
     family: bool,
 ) -> Equilibrium {
     let d = p.ndof();
@@ -102,7 +195,7 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
     // directions have zero eigenvalues and say nothing about attraction.
     let o = p.first_ball();
     let n_balls = d - o;
-    let neutral = if family && kind == "perfect_balance" && n_balls >= 3 {
+    let neutral = if family && kind == EquilibriumKind::PerfectBalance && n_balls >= 3 {
         n_balls - 2
     } else {
         0
@@ -133,7 +226,7 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
         None
     };
     Equilibrium {
-        kind: kind.to_string(),
+        kind,
         q: q.iter()
             .enumerate()
             .map(|(i, &v)| {
@@ -160,31 +253,31 @@ pub fn equal_balls(p: &Planar) -> bool {
     p.eta.windows(2).all(|w| w[0] == w[1])
 }
 
-fn classify(q: &[f64], o: usize) -> &'static str {
+fn classify(q: &[f64], o: usize) -> EquilibriumKind {
     // Newton's points (as opposed to closed forms) carry its tolerance.
     if q[..o].iter().all(|v| v.abs() < 1e-6) {
-        return "perfect_balance";
+        return EquilibriumKind::PerfectBalance;
     }
     if q.len() > o + 1 && q[o + 1..].iter().all(|&b| wrap(b - q[o]).abs() < 1e-7) {
-        return "together";
+        return EquilibriumKind::Together;
     }
     if q.len() == o + 2 {
         let diff = wrap(q[o] - q[o + 1]);
         if (diff.abs() - PI).abs() < 1e-7 {
-            return "opposite";
+            return EquilibriumKind::Opposite;
         }
     }
-    "unbalanced"
+    EquilibriumKind::Unbalanced
 }
 
 /// Closed-form equilibria of two equal balls.
-fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, &'static str)> {
+fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, EquilibriumKind)> {
     let eta = p.eta[0];
     let (om, z, mu) = (p.omega_s, p.zeta, p.mu);
     let mut out = vec![];
     if eta >= 0.5 {
         let b = (-1.0 / (2.0 * eta)).acos();
-        out.push((vec![0.0, 0.0, b, -b], "perfect_balance"));
+        out.push((vec![0.0, 0.0, b, -b], EquilibriumKind::PerfectBalance));
     }
     if om == 0.0 {
         return out;
@@ -212,30 +305,35 @@ fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, &'static str)> {
             }
             for b in roots {
                 let (x, y) = place(b);
-                out.push((vec![x, y, b, b], "together"));
+                out.push((vec![x, y, b, b], EquilibriumKind::Together));
             }
         }
         // opposite: amp sin(b + phi) = 0; b and b + pi are the same configuration.
         let b = -phi;
         let (x, y) = place(b);
-        out.push((vec![x, y, b, b + PI], "opposite"));
+        out.push((vec![x, y, b, b + PI], EquilibriumKind::Opposite));
     }
     out
 }
 
 /// Newton (least squares, so that families of equilibria do not stall it) on `F(q,0,0) = 0`.
 pub fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>> {
-    let d = p.ndof();
-    let z = vec![0.0; d];
+    newton_least_squares(&mut EquilibriumProblem::new(ModelAt::fixed(p)), q0)
+}
+
+/// The least-squares Newton of [`newton_static`] on any problem, at its own parameter.
+pub fn newton_least_squares<P: Problem + ?Sized>(prob: &mut P, q0: &[f64]) -> Option<Vec<f64>> {
+    let d = prob.size();
+    let p = prob.param();
     let mut q = q0.to_vec();
     let mut r = vec![0.0; d];
-    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    let mut k = vec![0.0; d * d];
     // Residuals of the last iterations: a Newton that has stopped improving (a nearly
     // neutral direction cut off by the least-squares threshold) goes to the final test
     // now instead of after all 60 iterations (most of a many-ball spring search's time).
     let mut history: Vec<f64> = Vec::with_capacity(60);
     for _ in 0..60 {
-        static_residual(p, &q, &mut r);
+        prob.residual(&q, p, &mut r).ok()?;
         let rn = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if !rn.is_finite() {
             return None;
@@ -245,7 +343,7 @@ pub fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>
         if it > 16 && rn < 1e-9 && history[it - 9] <= 2.0 * rn {
             break;
         }
-        p.jacobians(0.0, &q, &z, &z, &mut k, &mut c, &mut m);
+        prob.jacobian(&q, p, &mut k).ok()?;
         let j = DMatrix::from_row_slice(d, d, &k);
         let svd = j.svd(true, true);
         let rhs = DVector::from_column_slice(&r);
@@ -258,7 +356,7 @@ pub fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>
             return Some(q);
         }
     }
-    static_residual(p, &q, &mut r);
+    prob.residual(&q, p, &mut r).ok()?;
     let rn = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     (rn < 1e-10).then_some(q)
 }
@@ -290,11 +388,7 @@ fn same_equilibrium(equal: bool, o: usize, a: &[f64], b: &[f64]) -> bool {
 pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
     let n = p.n_balls();
     if n == 2 && equal_balls(p) && p.zeta > 0.0 {
-        let found = closed_form_two_equal(p)
-            .into_iter()
-            .map(|(q, kind)| (q, kind.to_string()))
-            .collect();
-        return sorted_analysed(p, found, true);
+        return sorted_analysed(p, closed_form_two_equal(p), true);
     }
     equilibria_of(p, equal_balls(p), true)
 }
@@ -305,7 +399,7 @@ pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
 /// or more balls are one `(n - 2)`-parameter family: every start would land on another
 /// point of it, so it is reported once, by the first point found (`neutral > 0`).
 pub fn equilibria_of<D: Dynamics + ?Sized>(p: &D, equal: bool, family: bool) -> Vec<Equilibrium> {
-    let mut found: Vec<(Vec<f64>, String)> = vec![];
+    let mut found: Vec<(Vec<f64>, EquilibriumKind)> = vec![];
     let o = p.first_ball();
     let n = p.ndof() - o;
     let one_family = family && n >= 3;
@@ -316,14 +410,17 @@ pub fn equilibria_of<D: Dynamics + ?Sized>(p: &D, equal: bool, family: bool) -> 
         }
         if let Some(q) = newton_static(p, &q0) {
             let kind = classify(&q, o);
-            if one_family && kind == "perfect_balance" {
-                if found.iter().any(|(_, k)| k == "perfect_balance") {
+            if one_family && kind == EquilibriumKind::PerfectBalance {
+                if found
+                    .iter()
+                    .any(|(_, k)| *k == EquilibriumKind::PerfectBalance)
+                {
                     continue;
                 }
             } else if found.iter().any(|(f, _)| same_equilibrium(equal, o, f, &q)) {
                 continue;
             }
-            found.push((q, kind.to_string()));
+            found.push((q, kind));
         }
     }
     let mut out = sorted_analysed(p, found, family);
@@ -343,10 +440,10 @@ pub fn equilibria_in_track_order<D: Dynamics + ?Sized>(
     p: &D,
     equal: bool,
     extra: &[Vec<f64>],
-) -> Vec<(Vec<f64>, String)> {
+) -> Vec<(Vec<f64>, EquilibriumKind)> {
     let o = p.first_ball();
     let n = p.ndof() - o;
-    let mut found: Vec<(Vec<f64>, String)> = vec![];
+    let mut found: Vec<(Vec<f64>, EquilibriumKind)> = vec![];
     for q0 in extra.iter().cloned().chain(ordered_starts(n, o)) {
         if crate::cancel::cancelled() {
             break;
@@ -376,7 +473,7 @@ pub fn equilibria_in_track_order<D: Dynamics + ?Sized>(
         let turn = q[o] - wrap(q[o]);
         q[o..].iter_mut().for_each(|b| *b -= turn);
         if !found.iter().any(|(f, _)| same_in_order(equal, o, f, &q)) {
-            let kind = classify(&q, o).to_string();
+            let kind = classify(&q, o);
             found.push((q, kind));
         }
     }
@@ -466,7 +563,7 @@ fn same_in_order(equal: bool, o: usize, a: &[f64], b: &[f64]) -> bool {
 /// Analyses found equilibria and orders them by kind and `x`.
 pub fn analyse_all<D: Dynamics + ?Sized>(
     p: &D,
-    found: Vec<(Vec<f64>, String)>,
+    found: Vec<(Vec<f64>, EquilibriumKind)>,
     family: bool,
 ) -> Vec<Equilibrium> {
     sorted_analysed(p, found, family)
@@ -474,23 +571,13 @@ pub fn analyse_all<D: Dynamics + ?Sized>(
 
 fn sorted_analysed<D: Dynamics + ?Sized>(
     p: &D,
-    mut found: Vec<(Vec<f64>, String)>,
+    mut found: Vec<(Vec<f64>, EquilibriumKind)>,
     family: bool,
 ) -> Vec<Equilibrium> {
-    let order = |k: &str| match k {
-        "perfect_balance" | "balanced" => 0,
-        "together" => 1,
-        "opposite" => 2,
-        _ => 3,
-    };
-    found.sort_by(|a, b| {
-        order(&a.1)
-            .cmp(&order(&b.1))
-            .then(a.0[0].total_cmp(&b.0[0]))
-    });
+    found.sort_by(|a, b| a.1.rank().cmp(&b.1.rank()).then(a.0[0].total_cmp(&b.0[0])));
     found
         .iter()
-        .map(|(q, k)| analyse_model(p, q, k, family))
+        .map(|(q, k)| analyse_model(p, q, *k, family))
         .collect()
 }
 
@@ -706,7 +793,7 @@ mod tests {
     fn closed_forms_are_equilibria_and_numeric_path_finds_them() {
         let p = two(1.3, 0.8);
         let eqs = equilibria(&p);
-        assert_eq!(eqs[0].kind, "perfect_balance");
+        assert_eq!(eqs[0].kind, EquilibriumKind::PerfectBalance);
         for e in &eqs {
             assert!(e.residual < 1e-13, "{} residual {}", e.kind, e.residual);
         }
@@ -722,13 +809,63 @@ mod tests {
     }
 
     #[test]
+    fn equilibrium_problem_jacobians_and_the_balance_angles_slope() {
+        use crate::numerics::problem::tangent;
+        // dF/dq against central differences, at an arbitrary point of three unequal balls.
+        let p3 = Planar::new(0.2, 0.05, &[0.1], 50.0, 1.4, &[0.4, 0.6, 0.5]).unwrap();
+        let mut prob = EquilibriumProblem::new(ModelAt::family(&p3, "Omega", 1.4));
+        let q = [0.01, -0.02, 0.3, 2.0, -2.5];
+        let n = prob.size();
+        let (mut r, mut jac) = (vec![0.0; n], vec![0.0; n * n]);
+        prob.jac_x(&q, 1.4, &mut r, &mut jac).unwrap();
+        let h = 1e-6;
+        let (mut rp, mut rm) = (vec![0.0; n], vec![0.0; n]);
+        for col in 0..n {
+            let mut qp = q.to_vec();
+            qp[col] += h;
+            prob.residual(&qp, 1.4, &mut rp).unwrap();
+            qp[col] -= 2.0 * h;
+            prob.residual(&qp, 1.4, &mut rm).unwrap();
+            for row in 0..n {
+                let fd = (rp[row] - rm[row]) / (2.0 * h);
+                assert!((fd - jac[row * n + col]).abs() < 1e-6, "({row},{col})");
+            }
+        }
+        // The perfect balance of two equal balls, b = arccos(-1 / (2 eta)): its slope in
+        // eta from the implicit-function theorem (dF/deta by the default difference)
+        // against the closed form's derivative.
+        let eta = 0.8;
+        let p2 = two(1.3, eta);
+        let pb = equilibria(&p2)
+            .into_iter()
+            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+            .unwrap();
+        let mut prob = EquilibriumProblem::new(ModelAt::family(&p2, "eta", eta));
+        let t = tangent(&mut prob, &pb.q, eta)
+            .unwrap()
+            .expect("isolated equilibrium");
+        let db = -(1.0 / (2.0 * eta * eta)) / (1.0 - 1.0 / (4.0 * eta * eta)).sqrt();
+        assert!(t[0].abs() < 1e-7 && t[1].abs() < 1e-7, "{t:?}");
+        assert!(
+            (t[2] - db).abs() < 1e-6 && (t[3] + db).abs() < 1e-6,
+            "{t:?} vs {db}"
+        );
+        // newton_static goes through the problem: it lands on the closed form.
+        let q = newton_static(&p2, &[0.01, 0.0, pb.q[2] + 0.1, pb.q[3] - 0.1]).unwrap();
+        assert!(
+            q.iter().zip(&pb.q).all(|(a, b)| (a - b).abs() < 1e-10),
+            "{q:?}"
+        );
+    }
+
+    #[test]
     fn perfect_balance_needs_eta_half() {
         assert!(equilibria(&two(1.5, 0.49))
             .iter()
-            .all(|e| e.kind != "perfect_balance"));
+            .all(|e| e.kind != EquilibriumKind::PerfectBalance));
         assert!(equilibria(&two(1.5, 0.51))
             .iter()
-            .any(|e| e.kind == "perfect_balance"));
+            .any(|e| e.kind == EquilibriumKind::PerfectBalance));
     }
 
     #[test]
@@ -769,7 +906,7 @@ mod tests {
         let eqs = equilibria(&p);
         let pb = eqs
             .iter()
-            .find(|e| e.kind == "perfect_balance")
+            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
             .expect("perfect balance");
         assert!(pb.residual < 1e-10);
         assert_eq!(pb.neutral, 1);
@@ -807,7 +944,7 @@ mod tests {
             let eqs = equilibria(&p);
             let pb = eqs
                 .iter()
-                .find(|e| e.kind == "perfect_balance")
+                .find(|e| e.kind == EquilibriumKind::PerfectBalance)
                 .expect("perfect balance");
             // Closed form of the family: x = y = 0 and the balls' unbalance cancels the
             // disk's, sum eta e^(i b) = -1.

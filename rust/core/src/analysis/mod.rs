@@ -1,7 +1,9 @@
 //! Analyses a user asks for, built on the numerics: time simulation, equilibria and
 //! their stability, periodic solutions with their certificates.
 
+pub mod attractors;
 pub mod balanced;
 pub mod equilibria;
+pub mod family;
 pub mod periodic;
 pub mod simulate;

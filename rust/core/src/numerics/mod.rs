@@ -6,3 +6,4 @@ pub mod floquet;
 pub mod hb;
 pub mod linalg;
 pub mod ode;
+pub mod problem;

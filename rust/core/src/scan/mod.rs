@@ -20,194 +20,31 @@
 //! Each wave reads only what earlier waves produced and runs its points in parallel,
 //! so the table does not depend on the thread count. Solutions that are the same orbit
 //! (shifted phase, swapped identical balls) are merged by a phase-free key.
+//!
+//! Files: [`spec`] (what is asked, chunks and blocks), `grid` (a block's points and
+//! neighbours), `seeding`, `waves` (the harmonic balance as the corrector of
+//! [`crate::continuation`]'s neighbour waves) and [`rows`]. The scan sees models only
+//! through [`Family`].
 
-use crate::equilibria::{equilibria, Equilibrium, Verdict};
+mod grid;
+pub mod rows;
+mod seeding;
+pub mod spec;
+mod waves;
+
+pub use crate::analysis::family::Family;
+pub use rows::{Origin, ScanRow};
+pub use spec::{default_chunk, ScanSpec};
+
+use crate::continuation::{self, Lattice, Tally};
+use crate::equilibria::Verdict;
 use crate::error::{Error, Result};
 use crate::floquet::FloquetOptions;
-use crate::hb::{solve, HbSolution, Status};
-use crate::periodic::{
-    finish, guess_from_state, initial_states, require_autonomous, Periodic, PeriodicOptions,
-};
-use crate::{Dynamics, Planar, Scene};
+use crate::periodic::Periodic;
+use grid::Local;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
-
-/// Most solutions of one type kept at one point: a guard against a duplicate test
-/// that a pathological orbit family might slip through.
-const MAX_PER_TYPE: usize = 4;
-
-/// A model whose parameters a scan varies: the planar balancer, or a scene.
-pub trait Family: Dynamics + Clone {
-    /// A copy with one named parameter changed, validated.
-    fn with_param(&self, name: &str, value: f64) -> Result<Self>;
-    /// The equilibrium reported beside every point (`pb_exists`, `pb_stable`): the
-    /// perfect balance, or with ball springs the balanced state that continues it.
-    fn balance(&self) -> Option<Equilibrium>;
-}
-
-impl Family for Planar {
-    fn with_param(&self, name: &str, value: f64) -> Result<Self> {
-        Planar::with_param(self, name, value)
-    }
-    fn balance(&self) -> Option<Equilibrium> {
-        equilibria(self)
-            .into_iter()
-            .find(|e| e.kind == "perfect_balance")
-    }
-}
-
-impl Family for Scene {
-    fn with_param(&self, name: &str, value: f64) -> Result<Self> {
-        Scene::with_param(self, name, value)
-    }
-    fn balance(&self) -> Option<Equilibrium> {
-        crate::analysis::balanced::balanced_state(self)
-    }
-}
-
-#[derive(Debug, Clone)]
-pub struct ScanRow {
-    /// Grid index along each parameter.
-    pub index: Vec<usize>,
-    pub pattern: usize,
-    /// Number of this solution among those of its type at this point (0, 1, ...);
-    /// `None` when none was found.
-    pub solution: Option<usize>,
-    pub result: Option<Periodic>,
-    /// How the solution was reached: "seed" (simulated start), "continuation"; "none".
-    pub origin: &'static str,
-    /// Harmonic-balance attempts made at this point for this type.
-    pub attempts: usize,
-    /// Time of the successful solve and its Floquet analysis, or of all failed attempts.
-    pub seconds: f64,
-    pub pb_exists: bool,
-    pub pb_stable: bool,
-}
-
-#[derive(Debug, Clone)]
-pub struct ScanSpec<'a, D: Family> {
-    pub base: &'a D,
-    pub names: Vec<String>,
-    pub values: Vec<Vec<f64>>,
-    /// Rotation pattern per requested solution type.
-    pub patterns: Vec<Vec<bool>>,
-    pub opts: PeriodicOptions,
-    /// Seed points per parameter over the whole grid (their spacing in grid steps is
-    /// `ceil(len / seeds)`); every chunk gets at least one seed line.
-    pub seeds: usize,
-    /// Simulated initial states per seed point.
-    pub starts: usize,
-    /// Values of the last parameter per continuation block (seeding and continuation
-    /// stay inside a block, so this is a numerical option; see [`default_chunk`]).
-    pub block: usize,
-    /// Values of the last parameter per chunk, rounded up to whole blocks: the unit of
-    /// progress and resumption only; the rows do not depend on it.
-    pub chunk: usize,
-    pub threads: usize,
-    /// Largest accepted [`HbSolution::tail_ratio`]; a solution above it is not resolved
-    /// by `N` harmonics and is neither reported nor continued.
-    pub max_tail: f64,
-}
-
-impl<D: Family> ScanSpec<'_, D> {
-    /// Checks every value and option before any work starts.
-    pub fn validate(&self) -> Result<()> {
-        require_autonomous(self.base)?;
-        if self.names.is_empty() || self.names.len() != self.values.len() {
-            return Err(Error::param(
-                "grid",
-                "give at least one parameter with its values",
-            ));
-        }
-        for (k, vals) in self.values.iter().enumerate() {
-            let name = &self.names[k];
-            if self.names[..k].contains(name) {
-                return Err(Error::param(name.as_str(), "is scanned twice"));
-            }
-            if vals.is_empty() {
-                return Err(Error::param(name.as_str(), "the grid is empty"));
-            }
-            for &v in vals {
-                self.base.with_param(name, v)?;
-            }
-        }
-        // Every combination must be valid, not just every value (e.g. ball masses).
-        for k in 0..self.values.len() {
-            let mut p = self.base.clone();
-            for (j, vals) in self.values.iter().enumerate() {
-                if j != k {
-                    p = p.with_param(&self.names[j], vals[0])?;
-                }
-            }
-            for &v in &self.values[k] {
-                p.with_param(&self.names[k], v)?;
-            }
-        }
-        if self.patterns.is_empty() {
-            return Err(Error::param("patterns", "give at least one solution type"));
-        }
-        for (name, v, lo) in [
-            ("threads", self.threads, 1),
-            ("seeds", self.seeds, 1),
-            ("starts", self.starts, 1),
-            ("chunk", self.chunk, 1),
-            ("block", self.block, 1),
-        ] {
-            if v < lo {
-                return Err(Error::param(name, format!("must be >= {lo}, got {v}")));
-            }
-        }
-        if !(self.max_tail > 0.0) {
-            return Err(Error::param(
-                "max_tail",
-                format!("must be a number > 0, got {}", self.max_tail),
-            ));
-        }
-        let available = initial_states(self.base).len();
-        if self.starts > available {
-            return Err(Error::param(
-                "starts",
-                format!("must be in [1, {available}], got {}", self.starts),
-            ));
-        }
-        Ok(())
-    }
-
-    /// Chunk length actually used: `chunk` rounded up to whole blocks, so that no block
-    /// is ever split between chunks (a split block would continue less).
-    pub fn chunk_len(&self) -> usize {
-        let b = self.block.max(1);
-        self.chunk.max(1).div_ceil(b) * b
-    }
-
-    /// Chunk bounds along the last parameter.
-    pub fn chunks(&self) -> Vec<Range<usize>> {
-        let n = self.values.last().map_or(0, |v| v.len());
-        let len = self.chunk_len();
-        (0..n).step_by(len).map(|a| a..(a + len).min(n)).collect()
-    }
-
-    /// Block bounds inside a chunk (chunks start on block edges).
-    fn blocks(&self, chunk: &Range<usize>) -> Vec<Range<usize>> {
-        let b = self.block.max(1);
-        chunk
-            .clone()
-            .step_by(b)
-            .map(|a| a..(a + b).min(chunk.end))
-            .collect()
-    }
-}
-
-/// Default block (and chunk) length: about 1024 grid points, so that a block is long
-/// enough for continuation and seeds to pay off and short enough to report progress and
-/// lose little on interruption. It depends on the grid's shape only.
-pub fn default_chunk(lens: &[usize]) -> usize {
-    let inner: usize = lens[..lens.len().saturating_sub(1)].iter().product();
-    let outer = lens.last().copied().unwrap_or(1);
-    1024usize.div_ceil(inner.max(1)).clamp(1, outer.max(1))
-}
 
 /// Runs the chunks `which` (indices into `spec.chunks()`) and hands each finished
 /// chunk's rows to `on_chunk` (from a worker thread, in completion order). Stops early,
@@ -260,96 +97,16 @@ pub fn scan<D: Family>(spec: &ScanSpec<'_, D>) -> Result<Vec<ScanRow>> {
         .collect())
 }
 
-/// A solution found at one point of a chunk.
+/// A solution found at one point of a block.
 #[derive(Clone)]
-struct Found {
+pub(crate) struct Found {
     pattern: usize,
     res: Periodic,
-    origin: &'static str,
+    origin: Origin,
     /// (point, solution) it was continued from.
     parent: Option<(usize, usize)>,
     key: Vec<f64>,
     seconds: f64,
-}
-
-/// Phase-free description of an orbit: omega, the sorted windings, and the amplitude
-/// of every harmonic of the support motion (a time shift changes only phases, and
-/// swapping identical balls does not change x, y).
-fn orbit_key(s: &HbSolution) -> Vec<f64> {
-    let mut key = vec![s.omega];
-    let mut w: Vec<f64> = s.winding.clone();
-    w.sort_by(f64::total_cmp);
-    key.extend(w);
-    let (cx, cy) = (s.coord(0), s.coord(1));
-    key.push(cx[0].hypot(cy[0]));
-    for m in 1..=s.n_harm {
-        let (i, j) = (2 * m - 1, 2 * m);
-        key.push((cx[i].powi(2) + cx[j].powi(2) + cy[i].powi(2) + cy[j].powi(2)).sqrt());
-    }
-    key
-}
-
-fn same_orbit(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len()
-        && a.iter()
-            .zip(b)
-            .all(|(x, y)| (x - y).abs() <= 1e-5 * (1.0 + x.abs().max(y.abs())))
-}
-
-/// Chunk-local grid geometry: sizes, strides, neighbours.
-struct Local {
-    lens: Vec<usize>,
-    strides: Vec<usize>,
-    outer0: usize,
-}
-
-impl Local {
-    fn new<D: Family>(spec: &ScanSpec<'_, D>, range: &Range<usize>) -> Self {
-        let mut lens: Vec<usize> = spec.values.iter().map(|v| v.len()).collect();
-        *lens.last_mut().unwrap() = range.len();
-        let mut strides = vec![1; lens.len()];
-        for k in 1..lens.len() {
-            strides[k] = strides[k - 1] * lens[k - 1];
-        }
-        Local {
-            lens,
-            strides,
-            outer0: range.start,
-        }
-    }
-    fn size(&self) -> usize {
-        self.lens.iter().product()
-    }
-    fn index(&self, p: usize) -> Vec<usize> {
-        let mut idx: Vec<usize> = (0..self.lens.len())
-            .map(|k| (p / self.strides[k]) % self.lens[k])
-            .collect();
-        *idx.last_mut().unwrap() += self.outer0;
-        idx
-    }
-    /// Neighbours of `p` as (neighbour, the point on the far side of `p` from it).
-    fn neighbours(&self, p: usize) -> Vec<(usize, Option<usize>)> {
-        let mut out = vec![];
-        for k in 0..self.lens.len() {
-            let i = (p / self.strides[k]) % self.lens[k];
-            let s = self.strides[k];
-            if i > 0 {
-                out.push((p - s, (i + 1 < self.lens[k]).then(|| p + s)));
-            }
-            if i + 1 < self.lens[k] {
-                out.push((p + s, (i > 0).then(|| p - s)));
-            }
-        }
-        out.sort_unstable();
-        out
-    }
-}
-
-/// Seed positions along one parameter of length `len`: spacing `ceil(len / seeds)`,
-/// offset to the middle of the first interval.
-fn seed_positions(len: usize, seeds: usize) -> Vec<usize> {
-    let s = len.div_ceil(seeds.max(1)).max(1);
-    (s / 2..len).step_by(s).collect()
 }
 
 fn scan_chunk<D: Family>(
@@ -359,7 +116,6 @@ fn scan_chunk<D: Family>(
 ) -> Result<Vec<ScanRow>> {
     let geo = Local::new(spec, &range);
     let npts = geo.size();
-    let dims = spec.names.len();
     let np = spec.patterns.len();
     let params: Vec<D> = (0..npts)
         .map(|p| {
@@ -387,285 +143,25 @@ fn scan_chunk<D: Family>(
     };
     check()?;
 
-    // Seed points: the lattice, every chunk's middle line if the lattice misses the
-    // chunk, and (when an oscillating type is wanted) the points on either side of the
-    // perfect balance's stability boundary, where O motions are born in a Hopf
-    // bifurcation; these get half the starts, since there are many of them.
-    let mut per_dim: Vec<Vec<usize>> = spec
-        .values
-        .iter()
-        .map(|v| seed_positions(v.len(), spec.seeds))
-        .collect();
-    let last = per_dim.last_mut().unwrap();
-    last.retain(|j| range.contains(j));
-    if last.is_empty() {
-        last.push(range.start + range.len() / 2);
-    }
-    let seeds: Vec<usize> = (0..npts)
-        .filter(|&p| {
-            let idx = geo.index(p);
-            (0..dims).all(|k| per_dim[k].contains(&idx[k]))
-        })
-        .collect();
-    let mut boundary: Vec<usize> = vec![];
-    if spec.patterns.iter().any(|r| r.iter().any(|&b| !b)) {
-        boundary = (0..npts)
-            .filter(|&p| {
-                !seeds.contains(&p) && geo.neighbours(p).iter().any(|&(q, _)| pb[q] != pb[p])
-            })
-            .collect();
-    }
-
-    let mut sols: Vec<Vec<Found>> = vec![vec![]; npts];
-    let mut attempts = vec![vec![0usize; np]; npts];
-    let mut fail_secs = vec![vec![0.0f64; np]; npts];
-    let n_harm = spec.opts.hb.n_harm;
-    let starts = spread(initial_states(spec.base).len(), spec.starts);
-    let half = starts.len().div_ceil(2);
-    let mut tasks: Vec<(usize, usize)> = seeds
-        .iter()
-        .flat_map(|&p| (0..starts.len()).map(move |s| (p, s)))
-        .chain(
-            boundary
-                .iter()
-                .flat_map(|&p| (0..half).map(move |s| (p, s))),
-        )
-        .collect();
-    tasks.sort_unstable();
-    let seeded: Vec<Option<(usize, Found)>> = tasks
-        .par_iter()
-        .map(|&(p, s)| {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            let t = Instant::now();
-            let model = &params[p];
-            // This point's own states: "at rest in the ground frame" depends on its spin.
-            let y0 = &initial_states(model)[starts[s]];
-            let g = guess_from_state(model, y0, None, n_harm, &spec.opts.guess)?;
-            let rot: Vec<bool> = g.winding[model.first_ball()..]
-                .iter()
-                .map(|w| *w != 0.0)
-                .collect();
-            let k = spec.patterns.iter().position(|r| *r == rot)?;
-            let sol = solve(model, &g, &spec.opts.hb);
-            if !accept(model, &sol, &g, spec) {
-                return None;
-            }
-            let key = orbit_key(&sol);
-            let res = finish(model, sol, &spec.opts);
-            if res.sol.status != Status::Converged {
-                return None;
-            }
-            Some((
-                p,
-                Found {
-                    pattern: k,
-                    res,
-                    origin: "seed",
-                    parent: None,
-                    key,
-                    seconds: t.elapsed().as_secs_f64(),
-                },
-            ))
-        })
-        .collect();
+    let (tasks, starts) = seeding::seed_tasks(spec, &geo, &range, &pb);
+    let seeded = seeding::run_seeds(spec, &params, &tasks, &starts, cancel);
     check()?;
+    let mut sols: Vec<Vec<Found>> = vec![vec![]; npts];
     let mut frontier: Vec<(usize, usize)> = vec![];
     for (p, f) in seeded.into_iter().flatten() {
-        if admit(&sols[p], f.pattern, &f.key) {
+        if waves::admit(&sols[p], f.pattern, &f.key) {
             sols[p].push(f);
             frontier.push((p, sols[p].len() - 1));
         }
     }
 
-    // Continuation waves.
-    while !frontier.is_empty() {
-        let mut fresh_at: Vec<Vec<usize>> = vec![vec![]; npts];
-        for &(p, s) in &frontier {
-            fresh_at[p].push(s);
-        }
-        let targets: Vec<usize> = (0..npts)
-            .filter(|&q| {
-                geo.neighbours(q)
-                    .iter()
-                    .any(|(p, _)| !fresh_at[*p].is_empty())
-            })
-            .collect();
-        let results: Vec<(Vec<Found>, Vec<usize>, Vec<f64>)> = targets
-            .par_iter()
-            .map(|&q| {
-                let mut new: Vec<Found> = vec![];
-                let mut tries = vec![0usize; np];
-                let mut secs = vec![0.0f64; np];
-                for (p, far) in geo.neighbours(q) {
-                    for &s in &fresh_at[p] {
-                        if cancel.load(Ordering::Relaxed) {
-                            return (new, tries, secs);
-                        }
-                        let src = &sols[p][s];
-                        // Continuing back to where a solution came from, or again from a
-                        // solution already continued here, gives nothing new.
-                        if src.parent.is_some_and(|(pp, _)| pp == q)
-                            || sols[q].iter().any(|f| f.parent == Some((p, s)))
-                        {
-                            continue;
-                        }
-                        let k = src.pattern;
-                        let t = Instant::now();
-                        let secant = match (far, src.parent) {
-                            (Some(f), Some((pp, ps))) if pp == f => {
-                                Some(extrapolate(&src.res.sol, &sols[pp][ps].res.sol))
-                            }
-                            _ => None,
-                        };
-                        let mut sol = None;
-                        for g in secant.iter().chain(std::iter::once(&src.res.sol)) {
-                            tries[k] += 1;
-                            let r = solve(&params[q], g, &spec.opts.hb);
-                            if accept(&params[q], &r, &src.res.sol, spec) {
-                                sol = Some(r);
-                                break;
-                            }
-                        }
-                        let Some(sol) = sol else {
-                            secs[k] += t.elapsed().as_secs_f64();
-                            continue;
-                        };
-                        let key = orbit_key(&sol);
-                        // Before the Floquet analysis, which a known orbit does not need.
-                        if !admit(&sols[q], k, &key) || !admit(&new, k, &key) {
-                            secs[k] += t.elapsed().as_secs_f64();
-                            continue;
-                        }
-                        let res = finish(&params[q], sol, &spec.opts);
-                        // Refined with N = "auto" and certified: a series that fails
-                        // is neither reported nor continued, like a failed solve.
-                        if res.sol.status != Status::Converged {
-                            secs[k] += t.elapsed().as_secs_f64();
-                            continue;
-                        }
-                        new.push(Found {
-                            pattern: k,
-                            res,
-                            origin: "continuation",
-                            parent: Some((p, s)),
-                            key,
-                            seconds: t.elapsed().as_secs_f64(),
-                        });
-                    }
-                }
-                (new, tries, secs)
-            })
-            .collect();
-        check()?;
-        frontier.clear();
-        for (&q, (new, tries, secs)) in targets.iter().zip(results) {
-            for k in 0..np {
-                attempts[q][k] += tries[k];
-                fail_secs[q][k] += secs[k];
-            }
-            for f in new {
-                if admit(&sols[q], f.pattern, &f.key) {
-                    sols[q].push(f);
-                    frontier.push((q, sols[q].len() - 1));
-                }
-            }
-        }
-    }
-
-    let mut seed_runs = vec![0usize; npts];
-    for &(p, _) in &tasks {
-        seed_runs[p] += 1;
-    }
-    let mut rows = vec![];
-    for p in 0..npts {
-        let index = geo.index(p);
-        for k in 0..np {
-            let mut mine: Vec<&Found> = sols[p].iter().filter(|f| f.pattern == k).collect();
-            mine.sort_by(|a, b| a.res.sol.omega.total_cmp(&b.res.sol.omega));
-            let base = ScanRow {
-                index: index.clone(),
-                pattern: k,
-                solution: None,
-                result: None,
-                origin: "none",
-                attempts: attempts[p][k] + seed_runs[p],
-                seconds: fail_secs[p][k],
-                pb_exists: pb[p].0,
-                pb_stable: pb[p].1,
-            };
-            if mine.is_empty() {
-                rows.push(base.clone());
-            }
-            for (m, f) in mine.into_iter().enumerate() {
-                rows.push(ScanRow {
-                    solution: Some(m),
-                    result: Some(f.res.clone()),
-                    origin: f.origin,
-                    seconds: f.seconds,
-                    ..base.clone()
-                });
-            }
-        }
-    }
-    Ok(rows)
-}
-
-/// A converged, resolved solution of the same rotation pattern as its guess, whose
-/// series passes the orbit-closure certificate (checked here already, before the
-/// duplicate test and the Floquet analysis, so that a refused series can fall back to
-/// the next guess; with N = "auto" only after refinement, in `finish`).
-fn accept<D: Family>(
-    model: &D,
-    s: &HbSolution,
-    guess: &HbSolution,
-    spec: &ScanSpec<'_, D>,
-) -> bool {
-    if !(s.status == Status::Converged
-        && s.winding == guess.winding
-        && s.tail_ratio() <= spec.max_tail)
-    {
-        return false;
-    }
-    spec.opts.auto.is_some() || {
-        let mut c = s.clone();
-        crate::periodic::certify(model, &mut c, &spec.opts);
-        c.status == Status::Converged
-    }
-}
-
-/// Whether an orbit of type `pattern` with `key` is new among `have`, and its type
-/// still has room there.
-fn admit(have: &[Found], pattern: usize, key: &[f64]) -> bool {
-    let mut n = 0;
-    for h in have.iter().filter(|h| h.pattern == pattern) {
-        if same_orbit(&h.key, key) {
-            return false;
-        }
-        n += 1;
-    }
-    n < MAX_PER_TYPE
-}
-
-/// Secant predictor `2 a - b` in coefficients and frequency.
-fn extrapolate(a: &HbSolution, b: &HbSolution) -> HbSolution {
-    let mut g = a.clone();
-    for (x, y) in g.coeffs.iter_mut().zip(&b.coeffs) {
-        *x = 2.0 * *x - y;
-    }
-    g.omega = 2.0 * a.omega - b.omega;
-    if !(g.omega > 0.0) {
-        g.omega = a.omega;
-    }
-    g
-}
-
-/// Indices of `k` of the `n` initial states, spread over the list (which alternates
-/// configurations and starts at rest in the ground frame, then relative to the disk).
-fn spread(n: usize, k: usize) -> Vec<usize> {
-    let k = k.min(n);
-    (0..k).map(|i| (i * n / k + i / 2) % n).collect()
+    let mut tally = Tally::new(npts, np);
+    let block = waves::BlockWaves {
+        spec,
+        params: &params,
+    };
+    continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
+    Ok(rows::rows(&geo, np, &sols, &tally, &tasks, &pb))
 }
 
 /// Floquet tolerances suited to many points (see the periodic benchmark).
@@ -681,9 +177,12 @@ pub fn scan_floquet_default() -> FloquetOptions {
 
 #[cfg(test)]
 mod tests {
+    use super::waves::{orbit_key, same_orbit};
     use super::*;
     use crate::hb::HbOptions;
-    use crate::periodic::GuessOptions;
+    use crate::numerics::problem::Parametric;
+    use crate::periodic::{GuessOptions, PeriodicOptions};
+    use crate::{Planar, Scene};
 
     fn spec<'a, D: Family>(
         base: &'a D,
@@ -857,13 +356,13 @@ mod tests {
     fn scene_parameters_are_scanned_by_name_and_time_dependent_scenes_refused() {
         let base = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
         let sc = Scene::new(base.clone(), 1e-5, None, 0.0, None, None).unwrap();
-        let s2 = Family::with_param(&sc, "springs", 2e-5).unwrap();
+        let s2 = Parametric::with_param(&sc, "springs", 2e-5).unwrap();
         assert_eq!(s2.springs, 2e-5);
-        let e = Family::with_param(&sc, "j_t", 0.1).err().unwrap();
+        let e = Parametric::with_param(&sc, "j_t", 0.1).err().unwrap();
         assert!(e.to_string().starts_with("j_t: is a tilt parameter"), "{e}");
-        let e = Family::with_param(&sc, "spring", 0.1).err().unwrap();
+        let e = Parametric::with_param(&sc, "spring", 0.1).err().unwrap();
         assert!(e.to_string().contains("parameter of the scene"), "{e}");
-        let e = Family::with_param(&sc, "springs", -1.0).err().unwrap();
+        let e = Parametric::with_param(&sc, "springs", -1.0).err().unwrap();
         assert!(e.to_string().starts_with("springs"), "{e}");
         let ramp = crate::model::scene::Ramp {
             to: 2.0,

@@ -1,0 +1,394 @@
+//! Attractors of simulated starts: where a motion started from a given state settles,
+//! classified as rest (an equilibrium), a periodic motion with its rotation pattern and
+//! period (and a Fourier series fitted over one period, a harmonic-balance starting
+//! guess), or no clear period within the observation window. The periodic solve takes
+//! its guesses from here; basins of attraction classify a grid of starts with it.
+
+use crate::equilibria::wrap;
+use crate::error::check_range;
+use crate::hb::{fit_coefficients, HbSolution, Status};
+use crate::model::{first_order_rhs, Dynamics};
+use crate::ode::{solve_at, Dopri5, Options};
+use std::f64::consts::PI;
+
+#[derive(Debug, Clone)]
+pub struct GuessOptions {
+    /// Time allowed for transients to die out before measuring.
+    pub settle: f64,
+    /// Longest observation window after settling.
+    pub window: f64,
+    pub rtol: f64,
+    pub atol: f64,
+}
+
+impl GuessOptions {
+    /// Longest `settle` and `window` accepted: each simulated start integrates for
+    /// `settle + window` time units (about a second per 1e5 on one core), from up to 16
+    /// starts, so anything longer is a typo rather than a wish.
+    pub const MAX_TIME: f64 = 1e5;
+
+    pub fn validate(&self) -> crate::Result<()> {
+        check_range("settle", self.settle, 0.0, true, Self::MAX_TIME, false)?;
+        check_range("window", self.window, 0.0, true, Self::MAX_TIME, false)?;
+        check_range("guess_rtol", self.rtol, 0.0, true, 1.0, true)?;
+        check_range("guess_atol", self.atol, 0.0, false, 1.0, true)?;
+        Ok(())
+    }
+}
+
+impl Default for GuessOptions {
+    fn default() -> Self {
+        GuessOptions {
+            settle: 1500.0,
+            window: 2500.0,
+            rtol: 1e-9,
+            atol: 1e-11,
+        }
+    }
+}
+
+/// Deterministic initial states: at rest in the ground frame (`b_i' = -Omega`, the
+/// thesis' basin set-up) from merged, opposed and spread ball positions.
+pub fn initial_states<D: Dynamics + ?Sized>(p: &D) -> Vec<Vec<f64>> {
+    let o = p.first_ball();
+    let n = p.ndof() - o;
+    let d = n + o;
+    let mut configs: Vec<Vec<f64>> = vec![
+        vec![0.0; n],
+        vec![PI / 2.0; n],
+        (0..n)
+            .map(|i| 2.0 * PI * i as f64 / n as f64 + 0.3)
+            .collect(),
+        (0..n)
+            .map(|i| if i % 2 == 0 { 2.0 } else { -2.0 })
+            .collect(),
+        (0..n)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect(),
+        (0..n).map(|i| 0.7 + 1.9 * i as f64).collect(),
+        (0..n)
+            .map(|i| if i % 2 == 0 { 2.8 } else { -2.8 })
+            .collect(),
+        (0..n).map(|i| -1.2 + 2.9 * i as f64).collect(),
+    ];
+    configs.dedup();
+    let mut out = vec![];
+    for rate in [-p.base_spin(), 0.0] {
+        for b in &configs {
+            let mut y = vec![0.0; 2 * d];
+            for i in 0..n {
+                y[o + i] = b[i];
+                y[d + o + i] = rate;
+            }
+            out.push(y);
+        }
+    }
+    out
+}
+
+/// Where the motion from one initial state settles.
+#[derive(Debug, Clone)]
+pub enum Attractor {
+    /// At rest relative to the disk: an equilibrium (a periodic motion cannot appear
+    /// from rest in an autonomous system).
+    Rest,
+    /// A periodic motion.
+    Periodic {
+        /// Which balls rotate (made at least 1.5 net turns during the observation).
+        rotating: Vec<bool>,
+        /// Period measured from the last whole-turn (rotating) or mean-level
+        /// (oscillating) crossings.
+        period: f64,
+        /// The series fitted to one simulated period: a harmonic-balance start.
+        series: HbSolution,
+    },
+    /// Still moving, but without a clear period within the observation window
+    /// (quasi-periodic, chaotic, or a transient longer than the settling time).
+    NotSettled,
+    /// A motion of a rotation pattern other than the one asked for (only when
+    /// classifying with a pattern filter, which stops as soon as the pattern is known).
+    OtherPattern { rotating: Vec<bool> },
+    /// The integration failed (step size underflow, non-finite state).
+    Failed,
+}
+
+impl Attractor {
+    /// The name tables use.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Attractor::Rest => "rest",
+            Attractor::Periodic { .. } => "periodic",
+            Attractor::NotSettled => "not_settled",
+            Attractor::OtherPattern { .. } => "other_pattern",
+            Attractor::Failed => "failed",
+        }
+    }
+
+    /// The fitted series of a periodic attractor.
+    pub fn into_series(self) -> Option<HbSolution> {
+        match self {
+            Attractor::Periodic { series, .. } => Some(series),
+            _ => None,
+        }
+    }
+}
+
+/// Simulates from `y0` (settle, then observe) and classifies where the motion goes; a
+/// periodic motion comes with its series of `n_harm` harmonics.
+pub fn classify<D: Dynamics + ?Sized>(
+    model: &D,
+    y0: &[f64],
+    n_harm: usize,
+    g: &GuessOptions,
+) -> Attractor {
+    classify_as(model, y0, None, n_harm, g)
+}
+
+/// Tries to turn one simulated attractor into a harmonic-balance starting guess.
+/// With `rotating = Some(pattern)` only that rotation pattern is accepted; with `None`
+/// the pattern is read off the attractor (balls that make at least 1.5 net turns during
+/// the observation rotate) and is carried by the guess's `winding`. `None` if the motion
+/// settles to rest, is of another type, or shows no clear period.
+pub fn guess_from_state<D: Dynamics + ?Sized>(
+    model: &D,
+    y0: &[f64],
+    rotating: Option<&[bool]>,
+    n_harm: usize,
+    g: &GuessOptions,
+) -> Option<HbSolution> {
+    classify_as(model, y0, rotating, n_harm, g).into_series()
+}
+
+/// [`classify`], stopping early (as `OtherPattern`) when `want` is given and the
+/// rotation pattern differs.
+fn classify_as<D: Dynamics + ?Sized>(
+    model: &D,
+    y0: &[f64],
+    want: Option<&[bool]>,
+    n_harm: usize,
+    g: &GuessOptions,
+) -> Attractor {
+    use Attractor::{Failed, NotSettled, Rest};
+    let d = model.ndof();
+    let o = model.first_ball();
+    let n = d - o;
+    let opts = Options::new(g.rtol, g.atol);
+    let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
+    let mut solver = Dopri5::new(2 * d);
+    // A start that comes to rest relative to the disk has fallen into an equilibrium (a
+    // periodic motion cannot appear from rest in an autonomous system): stop there
+    // rather than settle for the whole time.
+    let mut at_rest = false;
+    let Ok((_, ys, _)) = solver.integrate(rhs, 0.0, y0, g.settle, &opts, |_, tb, dense| {
+        at_rest = tb > 50.0 && dense.end()[d..].iter().all(|v| v.abs() < 1e-7);
+        !at_rest
+    }) else {
+        return Failed;
+    };
+    if at_rest || ys[d..].iter().all(|v| v.abs() < 1e-9) {
+        return Rest;
+    }
+    // Observe: record every ball's crossings of whole turns, and x for oscillations.
+    let dt = 0.05;
+    let mut t_prev = g.settle;
+    let mut y_prev = ys.clone();
+    let mut crossings: Vec<Vec<f64>> = vec![vec![]; n];
+    let start_b: Vec<f64> = ys[o..d].to_vec();
+    let mut end_b = start_b.clone();
+    let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
+    let mut tmp = vec![0.0; 2 * d];
+    let need = 6;
+    let mut solver = Dopri5::new(2 * d);
+    let res = solver.integrate(
+        |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
+        g.settle,
+        &ys,
+        g.settle + g.window,
+        &opts,
+        |_, tb, dense| {
+            let mut t = t_prev + dt;
+            while t <= tb {
+                dense.eval(t, &mut tmp);
+                for (i, c) in crossings.iter_mut().enumerate() {
+                    let (a, b) = (
+                        (y_prev[o + i] / (2.0 * PI)).floor(),
+                        (tmp[o + i] / (2.0 * PI)).floor(),
+                    );
+                    if a != b {
+                        // Linear interpolation of the level crossing.
+                        let level = 2.0 * PI * a.max(b);
+                        let f = (level - y_prev[o + i]) / (tmp[o + i] - y_prev[o + i]);
+                        c.push(t - dt + f * dt);
+                    }
+                }
+                xs.push((t, tmp[0], tmp[d]));
+                y_prev.copy_from_slice(&tmp);
+                t_prev = t;
+                t += dt;
+            }
+            end_b.copy_from_slice(&y_prev[o..d]);
+            // Enough turns of some ball to measure a period: a rotating motion.
+            crossings.iter().all(|c| c.len() < need)
+        },
+    );
+    if res.is_err() {
+        return Failed;
+    }
+    let span = t_prev - g.settle;
+    if span <= 0.0 {
+        return NotSettled;
+    }
+    let detected: Vec<bool> = (0..n)
+        .map(|i| (end_b[i] - start_b[i]).abs() >= 1.5 * 2.0 * PI)
+        .collect();
+    if let Some(want) = want {
+        if want != detected.as_slice() {
+            return Attractor::OtherPattern { rotating: detected };
+        }
+    }
+    let r = detected.iter().position(|&b| b);
+    let (t_c, period) = if let Some(r) = r {
+        let crossings = &crossings[r];
+        if crossings.len() < 3 {
+            return NotSettled;
+        }
+        let k = crossings.len();
+        let t1 = crossings[k - 1] - crossings[k - 2];
+        let t2 = crossings[k - 2] - crossings[k - 3];
+        if (t1 - t2).abs() > 0.02 * t1 {
+            return NotSettled; // not periodic (quasi-periodic or chaotic)
+        }
+        (crossings[k - 1], t1)
+    } else {
+        // Upward crossings of x through its mean.
+        let half = xs.len() / 2;
+        let mean = xs[half..].iter().map(|p| p.1).sum::<f64>() / (xs.len() - half) as f64;
+        let amp = xs[half..]
+            .iter()
+            .map(|p| (p.1 - mean).abs())
+            .fold(0.0, f64::max);
+        if amp < 1e-6 {
+            return Rest; // at rest: an equilibrium, not a periodic motion
+        }
+        let mut ups = vec![];
+        for w in xs[half..].windows(2) {
+            if w[0].1 < mean && w[1].1 >= mean {
+                let f = (mean - w[0].1) / (w[1].1 - w[0].1);
+                ups.push(w[0].0 + f * (w[1].0 - w[0].0));
+            }
+        }
+        if ups.len() < 4 {
+            return NotSettled;
+        }
+        let k = ups.len();
+        // Smallest multiple of the crossing spacing after which the motion repeats.
+        let mut found = None;
+        for m in 1..=3.min(k - 1) {
+            let t1 = ups[k - 1] - ups[k - 1 - m];
+            if k > 2 * m {
+                let t2 = ups[k - 1 - m] - ups[k - 1 - 2 * m];
+                if (t1 - t2).abs() < 0.01 * t1 {
+                    found = Some((ups[k - 1], t1));
+                    break;
+                }
+            }
+        }
+        match found {
+            Some(f) => f,
+            None => return NotSettled,
+        }
+    };
+    // Re-simulate one period at collocation times for the fit.
+    let s = crate::hb::default_samples(n_harm) * 2;
+    let t0 = t_c - period;
+    let times: Vec<f64> = (0..=s).map(|i| t0 + period * i as f64 / s as f64).collect();
+    let mut all_t = vec![g.settle];
+    all_t.extend(times.iter().copied());
+    let Ok((traj, _)) = solve_at(
+        |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
+        0.0,
+        y0,
+        &all_t,
+        &opts,
+    ) else {
+        return Failed;
+    };
+    let first = &traj[1];
+    let last = &traj[s + 1];
+    let mut winding = vec![0.0; d];
+    for i in 0..n {
+        winding[o + i] = ((last[o + i] - first[o + i]) / (2.0 * PI)).round();
+    }
+    if r.is_some() && winding[o + r.unwrap()] == 0.0 {
+        return NotSettled;
+    }
+    // Shift angles by whole turns: the phase ball to 0, others into (-pi, pi].
+    let mut shift = vec![0.0; d];
+    for i in 0..n {
+        let b0 = first[o + i];
+        shift[o + i] = b0 - wrap(b0);
+        if Some(i) == r {
+            shift[o + i] = 2.0 * PI * (b0 / (2.0 * PI)).round();
+        }
+    }
+    let mut samples = vec![0.0; s * d];
+    for i in 0..s {
+        for j in 0..d {
+            samples[i * d + j] = traj[1 + i][j] - shift[j];
+        }
+    }
+    let coeffs = fit_coefficients(&samples, d, &winding, n_harm);
+    Attractor::Periodic {
+        rotating: detected,
+        period,
+        series: HbSolution::start(2.0 * PI / period, coeffs, winding, n_harm, Status::NoGuess),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::equilibria::{equilibria, EquilibriumKind, Verdict};
+    use crate::Planar;
+
+    #[test]
+    fn standard_case_settles_on_the_rr_orbit_with_its_period() {
+        // The thesis' standard case: the R-R orbit of omega 0.25141 (independent
+        // shooting value in the spec), reached from rest in the ground frame.
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let y0 = &initial_states(&p)[0];
+        match classify(&p, y0, 3, &GuessOptions::default()) {
+            Attractor::Periodic {
+                rotating, period, ..
+            } => {
+                assert_eq!(rotating, vec![true, true]);
+                let exact = 2.0 * PI / 0.25141;
+                assert!((period - exact).abs() < 1e-3 * exact, "period {period}");
+            }
+            other => panic!("{}", other.as_str()),
+        }
+        // With a filter for another pattern the search stops at the pattern.
+        let filtered = classify_as(&p, y0, Some(&[false, false]), 3, &GuessOptions::default());
+        assert!(
+            matches!(filtered, Attractor::OtherPattern { ref rotating } if rotating == &[true, true])
+        );
+    }
+
+    #[test]
+    fn a_start_near_a_stable_perfect_balance_comes_to_rest() {
+        // Supercritical, heavy balls: the perfect balance is stable (its eigenvalues
+        // say so); a start next to it must settle there.
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 3.0, &[1.0, 1.0]).unwrap();
+        let pb = equilibria(&p)
+            .into_iter()
+            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+            .unwrap();
+        assert_eq!(pb.verdict, Verdict::Stable);
+        let mut y0 = vec![0.0; 8];
+        y0[..4].copy_from_slice(&pb.q);
+        y0[2] += 0.05;
+        y0[3] -= 0.05;
+        let a = classify(&p, &y0, 3, &GuessOptions::default());
+        assert!(matches!(a, Attractor::Rest), "{}", a.as_str());
+    }
+}

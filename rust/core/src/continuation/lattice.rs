@@ -1,0 +1,291 @@
+//! Natural-parameter continuation on a grid: every solution found is continued to its
+//! grid neighbours in all directions (with the secant predictor where the solution
+//! itself came from the neighbour on the opposite side), wave after wave, until no new
+//! solution appears. Each wave reads only what earlier waves produced and runs its
+//! points in parallel, so the result does not depend on the thread count.
+
+use super::{natural_step, Corrector};
+use crate::error::{Error, Result};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// A grid of parameter points numbered `0..size()`.
+pub trait Lattice: Sync {
+    fn size(&self) -> usize;
+    /// Neighbours of `p` as (neighbour, the point on the far side of `p` from it),
+    /// in increasing order.
+    fn neighbours(&self, p: usize) -> Vec<(usize, Option<usize>)>;
+}
+
+/// What the waves need beyond the corrector: stored solutions and how to tell a new
+/// one from those known.
+pub trait Waves: Corrector<At = usize> {
+    /// A solution stored at a grid point (the corrected point and what else was
+    /// computed for it).
+    type Found: Send + Sync;
+    /// A description by which the same solution is recognised.
+    type Key: Send + Sync;
+    fn point(f: &Self::Found) -> &Self::Point;
+    /// Solutions are counted per class (e.g. a rotation pattern).
+    fn class(f: &Self::Found) -> usize;
+    /// The (grid point, solution) it was continued from.
+    fn parent(f: &Self::Found) -> Option<(usize, usize)>;
+    fn key(&self, p: &Self::Point) -> Self::Key;
+    /// The key a stored solution was admitted with.
+    fn found_key(f: &Self::Found) -> &Self::Key;
+    /// Whether a solution of `class` with `key` is new among `have` (and its class
+    /// still has room there).
+    fn admit(&self, have: &[Self::Found], class: usize, key: &Self::Key) -> bool;
+    /// Completes a corrected, admitted point into a stored solution (e.g. with its
+    /// stability), or refuses it; `started`: when this step began.
+    fn complete(
+        &self,
+        at: usize,
+        point: Self::Point,
+        class: usize,
+        key: Self::Key,
+        parent: (usize, usize),
+        started: Instant,
+    ) -> Option<Self::Found>;
+}
+
+/// Corrector calls and the time of failed steps, per grid point and class.
+#[derive(Debug, Clone)]
+pub struct Tally {
+    pub attempts: Vec<Vec<usize>>,
+    pub fail_secs: Vec<Vec<f64>>,
+}
+
+impl Tally {
+    pub fn new(points: usize, classes: usize) -> Self {
+        Tally {
+            attempts: vec![vec![0; classes]; points],
+            fail_secs: vec![vec![0.0; classes]; points],
+        }
+    }
+}
+
+/// One target point's share of a wave: its new solutions, and the attempts and time
+/// of failures per class.
+type PointWave<F> = (Vec<F>, Vec<usize>, Vec<f64>);
+
+/// Runs continuation waves from `frontier` (indices `(point, solution)` into `sols`)
+/// until no new solution appears; new solutions are appended to `sols`. Stops with
+/// `Error::Cancelled` after the wave during which `cancel` was set.
+pub fn waves<W: Waves, L: Lattice>(
+    w: &W,
+    lattice: &L,
+    sols: &mut [Vec<W::Found>],
+    mut frontier: Vec<(usize, usize)>,
+    tally: &mut Tally,
+    cancel: &AtomicBool,
+) -> Result<()> {
+    let npts = lattice.size();
+    let classes = tally.attempts.first().map_or(0, |a| a.len());
+    while !frontier.is_empty() {
+        let mut fresh_at: Vec<Vec<usize>> = vec![vec![]; npts];
+        for &(p, s) in &frontier {
+            fresh_at[p].push(s);
+        }
+        let targets: Vec<usize> = (0..npts)
+            .filter(|&q| {
+                lattice
+                    .neighbours(q)
+                    .iter()
+                    .any(|(p, _)| !fresh_at[*p].is_empty())
+            })
+            .collect();
+        let known: &[Vec<W::Found>] = sols;
+        let results: Vec<PointWave<W::Found>> = targets
+            .par_iter()
+            .map(|&q| {
+                let mut new: Vec<W::Found> = vec![];
+                let mut tries = vec![0usize; classes];
+                let mut secs = vec![0.0f64; classes];
+                for (p, far) in lattice.neighbours(q) {
+                    for &s in &fresh_at[p] {
+                        if cancel.load(Ordering::Relaxed) {
+                            return (new, tries, secs);
+                        }
+                        let src = &known[p][s];
+                        // Continuing back to where a solution came from, or again from a
+                        // solution already continued here, gives nothing new.
+                        if W::parent(src).is_some_and(|(pp, _)| pp == q)
+                            || known[q].iter().any(|f| W::parent(f) == Some((p, s)))
+                        {
+                            continue;
+                        }
+                        let k = W::class(src);
+                        let t = Instant::now();
+                        let previous = match (far, W::parent(src)) {
+                            (Some(f), Some((pp, ps))) if pp == f => Some(W::point(&known[pp][ps])),
+                            _ => None,
+                        };
+                        let step = natural_step(w, &q, W::point(src), previous);
+                        tries[k] += step.attempts;
+                        let Some(sol) = step.point else {
+                            secs[k] += t.elapsed().as_secs_f64();
+                            continue;
+                        };
+                        let key = w.key(&sol);
+                        // Before completing (e.g. a Floquet analysis), which a known
+                        // solution does not need.
+                        if !w.admit(&known[q], k, &key) || !w.admit(&new, k, &key) {
+                            secs[k] += t.elapsed().as_secs_f64();
+                            continue;
+                        }
+                        match w.complete(q, sol, k, key, (p, s), t) {
+                            Some(f) => new.push(f),
+                            None => secs[k] += t.elapsed().as_secs_f64(),
+                        }
+                    }
+                }
+                (new, tries, secs)
+            })
+            .collect();
+        if cancel.load(Ordering::Relaxed) {
+            return Err(Error::Cancelled);
+        }
+        frontier.clear();
+        for (&q, (new, tries, secs)) in targets.iter().zip(results) {
+            for k in 0..classes {
+                tally.attempts[q][k] += tries[k];
+                tally.fail_secs[q][k] += secs[k];
+            }
+            for f in new {
+                if w.admit(&sols[q], W::class(&f), W::found_key(&f)) {
+                    sols[q].push(f);
+                    frontier.push((q, sols[q].len() - 1));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::continuation::Secant;
+
+    /// Points `0..n` on a line at parameters `p_i = 2 + 0.1 i`; the branch solves
+    /// x^3 + x = p (closed form checked below), by three Newton steps from the guess so
+    /// that a poor guess fails.
+    struct Line(usize);
+    impl Lattice for Line {
+        fn size(&self) -> usize {
+            self.0
+        }
+        fn neighbours(&self, p: usize) -> Vec<(usize, Option<usize>)> {
+            let mut out = vec![];
+            if p > 0 {
+                out.push((p - 1, (p + 1 < self.0).then_some(p + 1)));
+            }
+            if p + 1 < self.0 {
+                out.push((p + 1, p.checked_sub(1)));
+            }
+            out
+        }
+    }
+    #[derive(Clone, Debug)]
+    struct X(f64);
+    impl Secant for X {
+        fn secant(&self, previous: &Self) -> Self {
+            X(2.0 * self.0 - previous.0)
+        }
+    }
+    struct Cubic;
+    impl Corrector for Cubic {
+        type At = usize;
+        type Point = X;
+        fn correct(&self, at: &usize, guess: &X, _from: &X) -> Option<X> {
+            let p = 2.0 + 0.1 * *at as f64;
+            let mut x = guess.0;
+            for _ in 0..3 {
+                x -= (x * x * x + x - p) / (3.0 * x * x + 1.0);
+            }
+            ((x * x * x + x - p).abs() < 1e-12).then_some(X(x))
+        }
+    }
+    struct F {
+        x: X,
+        parent: Option<(usize, usize)>,
+    }
+    impl Waves for Cubic {
+        type Found = F;
+        type Key = f64;
+        fn point(f: &F) -> &X {
+            &f.x
+        }
+        fn class(_: &F) -> usize {
+            0
+        }
+        fn parent(f: &F) -> Option<(usize, usize)> {
+            f.parent
+        }
+        fn key(&self, p: &X) -> f64 {
+            p.0
+        }
+        fn found_key(f: &F) -> &f64 {
+            &f.x.0
+        }
+        fn admit(&self, have: &[F], _: usize, key: &f64) -> bool {
+            have.iter().all(|h| (h.x.0 - key).abs() > 1e-9)
+        }
+        fn complete(
+            &self,
+            _: usize,
+            x: X,
+            _: usize,
+            _: f64,
+            parent: (usize, usize),
+            _: Instant,
+        ) -> Option<F> {
+            Some(F {
+                x,
+                parent: Some(parent),
+            })
+        }
+    }
+
+    #[test]
+    fn waves_reach_every_point_of_the_branch_once() {
+        let n = 12;
+        let mut sols: Vec<Vec<F>> = (0..n).map(|_| vec![]).collect();
+        // One seed in the middle: x^3 + x = 2.5.
+        let x5 = Cubic.correct(&5, &X(1.115), &X(1.115)).unwrap();
+        sols[5].push(F {
+            x: x5,
+            parent: None,
+        });
+        let mut tally = Tally::new(n, 1);
+        waves(
+            &Cubic,
+            &Line(n),
+            &mut sols,
+            vec![(5, 0)],
+            &mut tally,
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        for (i, s) in sols.iter().enumerate() {
+            assert_eq!(s.len(), 1, "point {i}");
+            let (x, p) = (s[0].x.0, 2.0 + 0.1 * i as f64);
+            assert!((x * x * x + x - p).abs() < 1e-12);
+        }
+        // Each point solved once, from its one neighbour nearer the seed, with the
+        // first guess (the secant where the source has a parent) converging.
+        assert!(tally.attempts.iter().all(|a| a[0] <= 1));
+        assert_eq!(tally.attempts.iter().map(|a| a[0]).sum::<usize>(), n - 1);
+        assert!(waves(
+            &Cubic,
+            &Line(n),
+            &mut sols,
+            vec![(5, 0)],
+            &mut tally,
+            &AtomicBool::new(true)
+        )
+        .is_err());
+    }
+}

@@ -1,0 +1,129 @@
+//! Seeds of a block: the points simulated from a few initial states, each attractor's
+//! rotation pattern read off the simulation and the harmonic balance solved from it.
+
+use super::grid::Local;
+use super::waves::{accept, orbit_key};
+use super::{Family, Found, Origin, ScanSpec};
+use crate::continuation::Lattice;
+use crate::hb::{solve, Status};
+use crate::periodic::{finish, guess_from_state, initial_states};
+use rayon::prelude::*;
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Seed points: the lattice, every chunk's middle line if the lattice misses the
+/// chunk, and (when an oscillating type is wanted) the points on either side of the
+/// perfect balance's stability boundary, where O motions are born in a Hopf
+/// bifurcation; these get half the starts, since there are many of them. Returns the
+/// (point, start) tasks, sorted, and the starts' indices into [`initial_states`].
+pub(super) fn seed_tasks<D: Family>(
+    spec: &ScanSpec<'_, D>,
+    geo: &Local,
+    range: &Range<usize>,
+    pb: &[(bool, bool)],
+) -> (Vec<(usize, usize)>, Vec<usize>) {
+    let npts = geo.size();
+    let dims = spec.names.len();
+    let mut per_dim: Vec<Vec<usize>> = spec
+        .values
+        .iter()
+        .map(|v| seed_positions(v.len(), spec.seeds))
+        .collect();
+    let last = per_dim.last_mut().unwrap();
+    last.retain(|j| range.contains(j));
+    if last.is_empty() {
+        last.push(range.start + range.len() / 2);
+    }
+    let seeds: Vec<usize> = (0..npts)
+        .filter(|&p| {
+            let idx = geo.index(p);
+            (0..dims).all(|k| per_dim[k].contains(&idx[k]))
+        })
+        .collect();
+    let mut boundary: Vec<usize> = vec![];
+    if spec.patterns.iter().any(|r| r.iter().any(|&b| !b)) {
+        boundary = (0..npts)
+            .filter(|&p| {
+                !seeds.contains(&p) && geo.neighbours(p).iter().any(|&(q, _)| pb[q] != pb[p])
+            })
+            .collect();
+    }
+    let starts = spread(initial_states(spec.base).len(), spec.starts);
+    let half = starts.len().div_ceil(2);
+    let mut tasks: Vec<(usize, usize)> = seeds
+        .iter()
+        .flat_map(|&p| (0..starts.len()).map(move |s| (p, s)))
+        .chain(
+            boundary
+                .iter()
+                .flat_map(|&p| (0..half).map(move |s| (p, s))),
+        )
+        .collect();
+    tasks.sort_unstable();
+    (tasks, starts)
+}
+
+/// Runs the seed tasks in parallel: each simulated start that settles on a periodic
+/// motion of a requested type, solved, resolved and certified, is a found solution.
+pub(super) fn run_seeds<D: Family>(
+    spec: &ScanSpec<'_, D>,
+    params: &[D],
+    tasks: &[(usize, usize)],
+    starts: &[usize],
+    cancel: &AtomicBool,
+) -> Vec<Option<(usize, Found)>> {
+    let n_harm = spec.opts.hb.n_harm;
+    tasks
+        .par_iter()
+        .map(|&(p, s)| {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let t = Instant::now();
+            let model = &params[p];
+            // This point's own states: "at rest in the ground frame" depends on its spin.
+            let y0 = &initial_states(model)[starts[s]];
+            let g = guess_from_state(model, y0, None, n_harm, &spec.opts.guess)?;
+            let rot: Vec<bool> = g.winding[model.first_ball()..]
+                .iter()
+                .map(|w| *w != 0.0)
+                .collect();
+            let k = spec.patterns.iter().position(|r| *r == rot)?;
+            let sol = solve(model, &g, &spec.opts.hb);
+            if !accept(model, &sol, &g, spec) {
+                return None;
+            }
+            let key = orbit_key(&sol);
+            let res = finish(model, sol, &spec.opts);
+            if res.sol.status != Status::Converged {
+                return None;
+            }
+            Some((
+                p,
+                Found {
+                    pattern: k,
+                    res,
+                    origin: Origin::Seed,
+                    parent: None,
+                    key,
+                    seconds: t.elapsed().as_secs_f64(),
+                },
+            ))
+        })
+        .collect()
+}
+
+/// Seed positions along one parameter of length `len`: spacing `ceil(len / seeds)`,
+/// offset to the middle of the first interval.
+fn seed_positions(len: usize, seeds: usize) -> Vec<usize> {
+    let s = len.div_ceil(seeds.max(1)).max(1);
+    (s / 2..len).step_by(s).collect()
+}
+
+/// Indices of `k` of the `n` initial states, spread over the list (which alternates
+/// configurations and starts at rest in the ground frame, then relative to the disk).
+fn spread(n: usize, k: usize) -> Vec<usize> {
+    let k = k.min(n);
+    (0..k).map(|i| (i * n / k + i / 2) % n).collect()
+}
