@@ -1,115 +1,33 @@
 //! Results as Python values: an equilibrium's dict, a periodic solution's dict and a
-//! scan chunk's columns. A periodic solution's schema (names, types, the multipliers
-//! as real and imaginary parts) is defined once, by [`SOLUTION_FIELDS`] and
-//! [`solution_cells`]: `periodic()`'s dict and the scan's columns both use it.
+//! scan chunk's columns. A periodic solution's schema is the core's
+//! (`ballbal_core::analysis::record`): `periodic()`'s dict and the scan's columns both
+//! use it; here its cells only become Python values.
 
+use ballbal_core::analysis::record::{missing_cells, solution_cells, Cell, SOLUTION_FIELDS};
 use ballbal_core::equilibria::Equilibrium;
-use ballbal_core::hb::Status;
 use ballbal_core::periodic::{pattern_string, Periodic};
 use ballbal_core::scan::ScanRow;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-/// One value of a solution's schema; `None` where it does not apply (no Floquet
-/// analysis, no Hill estimate, no solution).
-pub enum Cell {
-    F(Option<f64>),
-    U(Option<usize>),
-    B(Option<bool>),
-    S(Option<&'static str>),
-    Text(Option<String>),
-    /// One part of the multipliers (`mult_re`, `mult_im`).
-    V(Option<Vec<f64>>),
-}
-
-impl Cell {
-    /// As a Python value; a vector as a NumPy array if `arrays`, else as a list (a
-    /// scan column of lists becomes a polars list column).
-    fn into_py(self, py: Python<'_>, arrays: bool) -> PyResult<Bound<'_, PyAny>> {
-        Ok(match self {
-            Cell::F(v) => v.into_pyobject(py)?.into_any(),
-            Cell::U(v) => v.into_pyobject(py)?.into_any(),
-            Cell::B(v) => v.into_pyobject(py)?.to_owned().into_any(),
-            Cell::S(v) => v.into_pyobject(py)?.into_any(),
-            Cell::Text(v) => v.into_pyobject(py)?.into_any(),
-            Cell::V(Some(v)) if arrays => PyArray1::from_vec(py, v).into_any(),
-            Cell::V(v) => v.into_pyobject(py)?.into_any(),
-        })
-    }
-}
-
-/// The schema's names, in the order of [`solution_cells`]. `pivot_ratio` is the last
-/// Newton matrix's largest over smallest LU pivot, a lower bound of its condition
-/// number (`PeriodicSolution.condition` before; stored scan tables use this name).
-pub const SOLUTION_FIELDS: [&str; 19] = [
-    "status",
-    "omega",
-    "stability",
-    "max_modulus",
-    "trivial_error",
-    "mult_re",
-    "mult_im",
-    "residual",
-    "tail",
-    "closure",
-    "separation_error",
-    "pivot_ratio",
-    "iterations",
-    "floquet_steps",
-    "floquet_error",
-    "N",
-    "target_met",
-    "hill_stability",
-    "verdicts_disagree",
-];
-
-/// A solution's values in the order of [`SOLUTION_FIELDS`]. A series that converged
-/// but failed a certificate (`not_closed`, `truncated`) keeps its `omega` for
-/// inspection; its status says why it is not a result.
-pub fn solution_cells(r: &Periodic) -> [Cell; 19] {
-    let s = &r.sol;
-    let fl = r.floquet.as_ref();
-    let ok = matches!(
-        s.status,
-        Status::Converged | Status::NotClosed | Status::Truncated
-    );
-    let part = |k: fn(&(f64, f64)) -> f64| fl.map(|f| f.multipliers.iter().map(k).collect());
-    [
-        Cell::S(Some(s.status.as_str())),
-        Cell::F(ok.then_some(s.omega)),
-        Cell::S(Some(fl.map_or("undetermined", |f| f.stability.as_str()))),
-        Cell::F(fl.map(|f| f.max_modulus)),
-        Cell::F(fl.map(|f| f.trivial_error)),
-        Cell::V(part(|z| z.0)),
-        Cell::V(part(|z| z.1)),
-        Cell::F(Some(s.residual)),
-        Cell::F(Some(s.tail_ratio())),
-        Cell::F(r.closure),
-        Cell::F(fl.and_then(|f| f.separation_error)),
-        Cell::F(Some(s.pivot_ratio)),
-        Cell::U(Some(s.iterations)),
-        Cell::U(fl.map(|f| f.steps)),
-        Cell::Text(r.floquet_error.clone()),
-        Cell::U(Some(s.n_harm)),
-        Cell::B(r.target_met),
-        Cell::S(r.hill.as_ref().map(|h| h.1.as_str())),
-        Cell::B(r.verdicts_disagree()),
-    ]
-}
-
-/// The schema's values where no solution was found (a scan row `not_found`, with the
-/// harmonics it was asked for).
-fn missing_cells(n_harm: usize) -> [Cell; 19] {
-    let mut c: [Cell; 19] = std::array::from_fn(|_| Cell::F(None));
-    c[0] = Cell::S(Some("not_found"));
-    c[15] = Cell::U(Some(n_harm));
-    c
+/// As a Python value; a vector as a NumPy array if `arrays`, else as a list (a
+/// scan column of lists becomes a polars list column).
+pub fn cell_to_py(cell: Cell, py: Python<'_>, arrays: bool) -> PyResult<Bound<'_, PyAny>> {
+    Ok(match cell {
+        Cell::F(v) => v.into_pyobject(py)?.into_any(),
+        Cell::U(v) => v.into_pyobject(py)?.into_any(),
+        Cell::B(v) => v.into_pyobject(py)?.to_owned().into_any(),
+        Cell::S(v) => v.into_pyobject(py)?.into_any(),
+        Cell::Text(v) => v.into_pyobject(py)?.into_any(),
+        Cell::V(Some(v)) if arrays => PyArray1::from_vec(py, v).into_any(),
+        Cell::V(v) => v.into_pyobject(py)?.into_any(),
+    })
 }
 
 pub fn equilibrium_dict(py: Python<'_>, e: Equilibrium) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("kind", e.kind)?;
+    d.set_item("kind", e.kind.as_str())?;
     d.set_item("q", PyArray1::from_vec(py, e.q))?;
     d.set_item("residual", e.residual)?;
     d.set_item(
@@ -135,7 +53,7 @@ pub fn equilibrium_dict(py: Python<'_>, e: Equilibrium) -> PyResult<Bound<'_, Py
 pub fn solution_dict(py: Python<'_>, r: Periodic, n_balls: usize) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
     for (name, cell) in SOLUTION_FIELDS.iter().zip(solution_cells(&r)) {
-        d.set_item(name, cell.into_py(py, true)?)?;
+        d.set_item(name, cell_to_py(cell, py, true)?)?;
     }
     if let Some((m, _)) = &r.hill {
         d.set_item(
@@ -206,7 +124,7 @@ pub fn scan_columns<'py>(
             None => missing_cells(cols.n_harm),
         };
         for (list, cell) in lists.iter_mut().zip(cells) {
-            list.push(cell.into_py(py, false)?);
+            list.push(cell_to_py(cell, py, false)?);
         }
     }
     for (name, list) in SOLUTION_FIELDS.iter().zip(lists) {
@@ -220,7 +138,10 @@ pub fn scan_columns<'py>(
         "seconds",
         rows.iter().map(|r| r.seconds).collect::<Vec<_>>(),
     )?;
-    d.set_item("origin", rows.iter().map(|r| r.origin).collect::<Vec<_>>())?;
+    d.set_item(
+        "origin",
+        rows.iter().map(|r| r.origin.as_str()).collect::<Vec<_>>(),
+    )?;
     d.set_item(
         "pb_exists",
         rows.iter().map(|r| r.pb_exists).collect::<Vec<_>>(),

@@ -6,4 +6,5 @@ pub mod balanced;
 pub mod equilibria;
 pub mod family;
 pub mod periodic;
+pub mod record;
 pub mod simulate;
