@@ -256,6 +256,7 @@ impl PeriodicArgs {
                 n_max: h.n_max,
             }),
             hill: f.hill,
+            hill_judging: Some((f.margin, f.max_trivial)),
             hb: HbOptions {
                 n_harm: h.start,
                 samples: h.samples,

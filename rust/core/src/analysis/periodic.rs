@@ -102,6 +102,9 @@ pub struct PeriodicOptions {
     pub auto: Option<AutoHarmonics>,
     /// Also estimate the multipliers by Hill's method and compare the verdicts.
     pub hill: bool,
+    /// `(margin, max_trivial)` for Hill's verdict when `floquet` is `None` (with a
+    /// monodromy both verdicts use the Floquet options'); `None`: the defaults.
+    pub hill_judging: Option<(f64, f64)>,
     /// Largest integrated ODE defect ([`defect_closure`]) of a converged series; above
     /// it the result is `NotClosed`.
     pub max_closure: f64,
@@ -118,6 +121,7 @@ impl Default for PeriodicOptions {
             guess: GuessOptions::default(),
             auto: None,
             hill: false,
+            hill_judging: None,
             max_closure: MAX_CLOSURE,
             max_tail: MAX_TAIL,
         }
@@ -306,12 +310,12 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
         }
     }
     let hill = if opts.hill && sol.status == Status::Converged {
-        let (margin, max_trivial) = opts
-            .floquet
-            .as_ref()
-            .map_or((1e-6, crate::floquet::MAX_TRIVIAL), |f| {
-                (f.margin, f.max_trivial)
-            });
+        let defaults = FloquetOptions::default();
+        let (margin, max_trivial) = match (&opts.floquet, opts.hill_judging) {
+            (Some(f), _) => (f.margin, f.max_trivial),
+            (None, Some(j)) => j,
+            (None, None) => (defaults.margin, defaults.max_trivial),
+        };
         // The Hill matrix grows as (16 H)^2 and its eigenvectors as its cube: past 24
         // harmonics the estimate costs seconds for no gain in the leading multipliers.
         hill_multipliers(p, &sol, (sol.n_harm + 4).clamp(8, 24))
