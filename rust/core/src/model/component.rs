@@ -72,6 +72,13 @@ pub trait Component: Send + Sync + Debug {
     }
     /// Adds its terms of `F(t, q, v, a)` to `out`.
     fn add_residual(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]);
+    /// Writes its terms into `out` (the first component of an assembly writes, the
+    /// others add). Override when writing costs less than zeroing and adding.
+    #[inline]
+    fn set_residual(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        self.add_residual(cx, q, v, a, out);
+    }
     /// Adds its terms of `K, C, M` (row-major `d x d`). Default: central differences of
     /// [`Self::add_residual`].
     #[allow(clippy::too_many_arguments)]
@@ -94,6 +101,24 @@ pub trait Component: Send + Sync + Debug {
             c,
             m,
         );
+    }
+    /// Writes its terms of `K, C, M` (see [`Self::set_residual`]).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn set_jacobians(
+        &self,
+        cx: &Ctx,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        k.fill(0.0);
+        c.fill(0.0);
+        m.fill(0.0);
+        self.add_jacobians(cx, q, v, a, k, c, m);
     }
     /// Adds its terms of `M` alone (it must depend on `q` only). Default: from
     /// [`Self::add_jacobians`] at `v = a = 0`.
@@ -334,8 +359,11 @@ impl Dynamics for Composed {
     #[inline]
     fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
         let cx = self.ctx(t);
-        out.fill(0.0);
-        for p in &self.parts {
+        let Some((first, rest)) = self.parts.split_first() else {
+            return out.fill(0.0);
+        };
+        first.set_residual(&cx, q, v, a, out);
+        for p in rest {
             p.add_residual(&cx, q, v, a, out);
         }
     }
@@ -351,10 +379,13 @@ impl Dynamics for Composed {
         m: &mut [f64],
     ) {
         let cx = self.ctx(t);
-        k.fill(0.0);
-        c.fill(0.0);
-        m.fill(0.0);
-        for p in &self.parts {
+        let Some((first, rest)) = self.parts.split_first() else {
+            k.fill(0.0);
+            c.fill(0.0);
+            return m.fill(0.0);
+        };
+        first.set_jacobians(&cx, q, v, a, k, c, m);
+        for p in rest {
             p.add_jacobians(&cx, q, v, a, k, c, m);
         }
     }
@@ -409,5 +440,254 @@ impl Dynamics for Composed {
 
     fn angles_modulo_turns(&self) -> bool {
         self.modulo_turns
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::components::{FreeBalls, FusedPlanar, IsotropicSupport, PlanarDisk};
+    use crate::model::scene::{Impulse, Ramp, Tilt};
+    use crate::model::Scene;
+
+    /// A model that only has a residual: its Jacobians are [`Dynamics`]'s default.
+    struct ResidualOnly<'a, D: Dynamics>(&'a D);
+
+    impl<D: Dynamics> Dynamics for ResidualOnly<'_, D> {
+        fn ndof(&self) -> usize {
+            self.0.ndof()
+        }
+        fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+            self.0.residual(t, q, v, a, out)
+        }
+        fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]) {
+            self.0.solve_mass(t, q, rhs)
+        }
+        fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+            self.0.accel(t, q, v, out)
+        }
+    }
+
+    fn jacs<D: Dynamics + ?Sized>(
+        model: &D,
+        t: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+    ) -> [Vec<f64>; 3] {
+        let d = model.ndof();
+        let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        // stale values must not leak into the result
+        k.fill(7.0);
+        c.fill(7.0);
+        m.fill(7.0);
+        model.jacobians(t, q, v, a, &mut k, &mut c, &mut m);
+        [k, c, m]
+    }
+
+    /// Largest error of `b` against `a`, relative to the largest entry of `a`.
+    fn rel_err(a: &[f64], b: &[f64]) -> f64 {
+        let scale = a.iter().fold(0.0f64, |s, x| s.max(x.abs())).max(1e-300);
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |e, (x, y)| e.max((x - y).abs()))
+            / scale
+    }
+
+    fn planar() -> Planar {
+        Planar::new(0.2, 0.05, &[0.07, 0.05, 0.06], 50.0, 1.3, &[0.9, 1.1, 0.8]).unwrap()
+    }
+
+    fn tilting_scene() -> Scene {
+        Scene::new(
+            planar(),
+            0.3,
+            Some(Ramp {
+                to: 2.0,
+                start: -1.0,
+                duration: 4.0,
+            }),
+            0.7,
+            Some(Impulse {
+                amplitude: 2.0,
+                t0: 0.5,
+                sharpness: 2.0,
+                angle: 0.3,
+            }),
+            Some(Tilt {
+                a: 1.5,
+                b: 2.5,
+                j_t: 0.3,
+                j_z: 0.5,
+                zeta_r: 0.05,
+            }),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn finite_difference_default_matches_analytic_jacobians() {
+        let p = planar();
+        let (q, v, a) = (
+            [0.3, -0.2, 0.7, -1.9, 2.4],
+            [0.1, 0.4, -1.2, 0.3, 0.2],
+            [0.05, -0.3, 0.2, 0.6, -0.1],
+        );
+        let (exact, fd) = (
+            jacs(&p, 0.0, &q, &v, &a),
+            jacs(&ResidualOnly(&p), 0.0, &q, &v, &a),
+        );
+        for (e, f) in exact.iter().zip(&fd) {
+            assert!(rel_err(e, f) < 1e-8, "planar: {}", rel_err(e, f));
+        }
+        let s = tilting_scene();
+        let q = [0.3, -0.2, 0.8, -0.6, 0.7, -1.9, 2.4];
+        let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
+        let a = [0.05, -0.3, 0.2, -0.1, 0.2, 0.6, -0.1];
+        let (exact, fd) = (
+            jacs(&s, 0.8, &q, &v, &a),
+            jacs(&ResidualOnly(&s), 0.8, &q, &v, &a),
+        );
+        for (e, f) in exact.iter().zip(&fd) {
+            assert!(rel_err(e, f) < 1e-6, "tilting scene: {}", rel_err(e, f));
+        }
+    }
+
+    /// The planar disk, the isotropic support and free balls as three components.
+    fn three_components(p: &Planar, drive: Drive) -> Composed {
+        let n = p.n_balls();
+        let parts: Vec<Arc<dyn Component>> = vec![
+            Arc::new(PlanarDisk { mu: p.mu }),
+            Arc::new(IsotropicSupport { zeta: p.zeta }),
+            Arc::new(FreeBalls {
+                zeta_b: p.zeta_b.clone(),
+                delta: p.delta,
+            }),
+        ];
+        Composed::new(
+            Layout::planar(n),
+            drive,
+            (0..n).map(|i| p.m(i)).collect(),
+            parts,
+        )
+    }
+
+    #[test]
+    fn composed_planar_scene_is_the_planar_balancer() {
+        let p = planar();
+        let composed = three_components(&p, Drive::Constant(p.omega_s));
+        let (q, v, a) = (
+            [0.3, -0.2, 0.7, -1.9, 2.4],
+            [0.1, 0.4, -1.2, 0.3, 0.2],
+            [0.05, -0.3, 0.2, 0.6, -0.1],
+        );
+        let (mut r1, mut r2) = ([0.0; 5], [0.0; 5]);
+        p.residual(0.3, &q, &v, &a, &mut r1);
+        composed.residual(0.3, &q, &v, &a, &mut r2);
+        assert!(rel_err(&r1, &r2) < 1e-13, "{r1:?} {r2:?}");
+        for (e, f) in jacs(&p, 0.3, &q, &v, &a)
+            .iter()
+            .zip(&jacs(&composed, 0.3, &q, &v, &a))
+        {
+            assert!(rel_err(e, f) < 1e-13, "{e:?} {f:?}");
+        }
+        // the dense mass solve of the components is the planar arrow elimination
+        let (mut z1, mut z2) = ([0.4, -1.0, 2.0, 0.25, 0.5], [0.4, -1.0, 2.0, 0.25, 0.5]);
+        p.solve_mass(0.0, &q, &mut z1);
+        composed.solve_mass(0.0, &q, &mut z2);
+        assert!(rel_err(&z1, &z2) < 1e-13, "{z1:?} {z2:?}");
+        assert_eq!(composed.time_dependence(), None);
+        assert_eq!(composed.base_spin(), p.omega_s);
+    }
+
+    #[test]
+    fn fused_planar_is_its_three_components() {
+        // with a spin ramp, so that the Omega' terms of both are compared too
+        let p = planar();
+        let drive = Drive::Ramp {
+            from: p.omega_s,
+            to: 2.0,
+            start: -1.0,
+            duration: 4.0,
+        };
+        let n = p.n_balls();
+        let fused = Composed::new(
+            Layout::planar(n),
+            drive.clone(),
+            (0..n).map(|i| p.m(i)).collect(),
+            vec![Arc::new(FusedPlanar { planar: p.clone() })],
+        );
+        let split = three_components(&p, drive);
+        let (q, v, a) = (
+            [0.3, -0.2, 0.7, -1.9, 2.4],
+            [0.1, 0.4, -1.2, 0.3, 0.2],
+            [0.05, -0.3, 0.2, 0.6, -0.1],
+        );
+        let t = 0.8;
+        assert!(fused.drive().spin(t).dom != 0.0);
+        let (mut r1, mut r2) = ([0.0; 5], [0.0; 5]);
+        fused.residual(t, &q, &v, &a, &mut r1);
+        split.residual(t, &q, &v, &a, &mut r2);
+        assert!(rel_err(&r1, &r2) < 1e-13, "{r1:?} {r2:?}");
+        for (e, f) in jacs(&fused, t, &q, &v, &a)
+            .iter()
+            .zip(&jacs(&split, t, &q, &v, &a))
+        {
+            assert!(rel_err(e, f) < 1e-13, "{e:?} {f:?}");
+        }
+        // and the split components' analytic Jacobians are their residual's derivatives
+        for (e, f) in
+            jacs(&split, t, &q, &v, &a)
+                .iter()
+                .zip(&jacs(&ResidualOnly(&split), t, &q, &v, &a))
+        {
+            assert!(rel_err(e, f) < 1e-8, "{}", rel_err(e, f));
+        }
+        assert_eq!(split.time_dependence().as_deref(), Some("ramp"));
+    }
+
+    #[test]
+    fn component_without_jacobians_gets_finite_differences() {
+        // a cubic support spring written as a residual only
+        #[derive(Debug)]
+        struct Cubic;
+        impl Component for Cubic {
+            fn name(&self) -> &'static str {
+                "support"
+            }
+            fn has_inertia(&self) -> bool {
+                false
+            }
+            fn add_residual(&self, cx: &Ctx, q: &[f64], v: &[f64], _: &[f64], out: &mut [f64]) {
+                let (x, y) = (q[cx.layout.x], q[cx.layout.y]);
+                out[cx.layout.x] += x * x * x + 0.1 * v[cx.layout.x];
+                out[cx.layout.y] += y * y * y;
+            }
+        }
+        let l = Layout::planar(0);
+        let cx = Ctx {
+            t: 0.0,
+            layout: l,
+            spin: Spin {
+                om: 1.0,
+                dom: 0.0,
+                th: 0.0,
+            },
+            m: &[],
+        };
+        let (mut k, mut c, mut m) = ([0.0; 4], [0.0; 4], [0.0; 4]);
+        Cubic.add_jacobians(
+            &cx,
+            &[0.5, -2.0],
+            &[0.0; 2],
+            &[0.0; 2],
+            &mut k,
+            &mut c,
+            &mut m,
+        );
+        let want_k = [3.0 * 0.25, 0.0, 0.0, 3.0 * 4.0];
+        assert!(rel_err(&want_k, &k) < 1e-9, "{k:?}");
+        assert!(rel_err(&[0.1, 0.0, 0.0, 0.0], &c) < 1e-9, "{c:?}");
+        assert_eq!(m, [0.0; 4]);
     }
 }

@@ -94,27 +94,132 @@ use ParamId as P;
 
 /// The registry, in the order `with_param`'s error lists the names.
 pub const REGISTRY: &[ParamSpec] = &[
-    spec(P::Mu, "mu", Some("mu"), "rotor", iv(0.0, true, 1.0, true), false),
-    spec(P::Zeta, "zeta", Some("zeta"), "support", NON_NEGATIVE, false),
-    spec(P::ZetaB, "zeta_b", Some("zeta_b"), "balls", NON_NEGATIVE, true),
+    spec(
+        P::Mu,
+        "mu",
+        Some("mu"),
+        "rotor",
+        iv(0.0, true, 1.0, true),
+        false,
+    ),
+    spec(
+        P::Zeta,
+        "zeta",
+        Some("zeta"),
+        "support",
+        NON_NEGATIVE,
+        false,
+    ),
+    spec(
+        P::ZetaB,
+        "zeta_b",
+        Some("zeta_b"),
+        "balls",
+        NON_NEGATIVE,
+        true,
+    ),
     spec(P::Delta, "delta", Some("delta"), "balls", POSITIVE, false),
-    spec(P::Omega, "Omega", Some("Omega"), "drive", NON_NEGATIVE, false),
+    spec(
+        P::Omega,
+        "Omega",
+        Some("Omega"),
+        "drive",
+        NON_NEGATIVE,
+        false,
+    ),
     spec(P::Eta, "eta", Some("eta"), "balls", POSITIVE, true),
-    spec(P::Springs, "springs", Some("springs"), "ball_springs", NON_NEGATIVE, false),
-    spec(P::Gravity, "gravity", Some("gravity"), "gravity", NON_NEGATIVE, false),
-    spec(P::TiltA, "tilt.a", Some("a"), "tilting_disk", POSITIVE, false),
-    spec(P::TiltB, "tilt.b", Some("b"), "tilting_disk", POSITIVE, false),
-    spec(P::TiltJt, "tilt.j_t", Some("j_t"), "tilting_disk", POSITIVE, false),
+    spec(
+        P::Springs,
+        "springs",
+        Some("springs"),
+        "ball_springs",
+        NON_NEGATIVE,
+        false,
+    ),
+    spec(
+        P::Gravity,
+        "gravity",
+        Some("gravity"),
+        "gravity",
+        NON_NEGATIVE,
+        false,
+    ),
+    spec(
+        P::TiltA,
+        "tilt.a",
+        Some("a"),
+        "tilting_disk",
+        POSITIVE,
+        false,
+    ),
+    spec(
+        P::TiltB,
+        "tilt.b",
+        Some("b"),
+        "tilting_disk",
+        POSITIVE,
+        false,
+    ),
+    spec(
+        P::TiltJt,
+        "tilt.j_t",
+        Some("j_t"),
+        "tilting_disk",
+        POSITIVE,
+        false,
+    ),
     // also at most 2 j_t: checked with the tilt (a range that depends on another value)
-    spec(P::TiltJz, "tilt.j_z", Some("j_z"), "tilting_disk", NON_NEGATIVE, false),
-    spec(P::TiltZetaR, "tilt.zeta_r", Some("zeta_r"), "tilting_disk", NON_NEGATIVE, false),
+    spec(
+        P::TiltJz,
+        "tilt.j_z",
+        Some("j_z"),
+        "tilting_disk",
+        NON_NEGATIVE,
+        false,
+    ),
+    spec(
+        P::TiltZetaR,
+        "tilt.zeta_r",
+        Some("zeta_r"),
+        "tilting_disk",
+        NON_NEGATIVE,
+        false,
+    ),
     spec(P::RampTo, "ramp.to", None, "drive", POSITIVE, false),
     spec(P::RampStart, "ramp.start", None, "drive", FINITE, false),
-    spec(P::RampDuration, "ramp.duration", None, "drive", POSITIVE, false),
-    spec(P::ImpulseAmplitude, "impulse.amplitude", None, "impulse", FINITE, false),
+    spec(
+        P::RampDuration,
+        "ramp.duration",
+        None,
+        "drive",
+        POSITIVE,
+        false,
+    ),
+    spec(
+        P::ImpulseAmplitude,
+        "impulse.amplitude",
+        None,
+        "impulse",
+        FINITE,
+        false,
+    ),
     spec(P::ImpulseT0, "impulse.t0", None, "impulse", FINITE, false),
-    spec(P::ImpulseSharpness, "impulse.sharpness", None, "impulse", POSITIVE, false),
-    spec(P::ImpulseAngle, "impulse.angle", None, "impulse", FINITE, false),
+    spec(
+        P::ImpulseSharpness,
+        "impulse.sharpness",
+        None,
+        "impulse",
+        POSITIVE,
+        false,
+    ),
+    spec(
+        P::ImpulseAngle,
+        "impulse.angle",
+        None,
+        "impulse",
+        FINITE,
+        false,
+    ),
 ];
 
 impl ParamId {
@@ -215,7 +320,10 @@ pub fn key_list(owners: &[&str]) -> String {
 
 /// The error for a name that is not in the registry (or not of this model).
 pub fn unknown(name: &str, model: &str, owners: &str) -> Error {
-    Error::param(name, format!("is not a parameter of the {model} ({owners})"))
+    Error::param(
+        name,
+        format!("is not a parameter of the {model} ({owners})"),
+    )
 }
 
 fn indexed(name: &str, base: &str) -> Option<usize> {

@@ -147,11 +147,19 @@ impl Planar {
     /// have or a ball it does not have.
     pub fn set(&mut self, p: ParamRef, value: f64) -> Result<()> {
         let n = self.n_balls();
+        let one = match p.id {
+            ParamId::Mu => &mut self.mu,
+            ParamId::Zeta => &mut self.zeta,
+            ParamId::Delta => &mut self.delta,
+            ParamId::Omega => &mut self.omega_s,
+            _ => return self.set_balls(p, value, n),
+        };
+        *one = value;
+        Ok(())
+    }
+
+    fn set_balls(&mut self, p: ParamRef, value: f64, n: usize) -> Result<()> {
         let balls = match p.id {
-            ParamId::Mu => return Ok(self.mu = value),
-            ParamId::Zeta => return Ok(self.zeta = value),
-            ParamId::Delta => return Ok(self.delta = value),
-            ParamId::Omega => return Ok(self.omega_s = value),
             ParamId::Eta => &mut self.eta,
             ParamId::ZetaB => &mut self.zeta_b,
             _ => {
@@ -297,7 +305,12 @@ impl Planar {
             put::<ADD>(&mut c[r + j], 2.0 * self.zeta_b[i] * dl);
             put::<ADD>(&mut k[r], om * om * s);
             put::<ADD>(&mut k[r + 1], -om * om * cs);
-            put::<ADD>(&mut k[r + j], -cs * a[0] - s * a[1] + 2.0 * om * (-s * v[0] + cs * v[1]) + om * om * (q[0] * cs + q[1] * s));
+            put::<ADD>(
+                &mut k[r + j],
+                -cs * a[0] - s * a[1]
+                    + 2.0 * om * (-s * v[0] + cs * v[1])
+                    + om * om * (q[0] * cs + q[1] * s),
+            );
         }
     }
 }

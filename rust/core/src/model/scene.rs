@@ -241,8 +241,7 @@ impl Scene {
         if let Some(f) = &self.impulse {
             parts.push(Arc::new(f.clone()));
         }
-        let model =
-            Composed::new(layout, drive, m, parts).with_modulo_turns(self.springs == 0.0);
+        let model = Composed::new(layout, drive, m, parts).with_modulo_turns(self.springs == 0.0);
         self.model = if self.tilt.is_none() {
             model.with_planar_mass(p)
         } else {
@@ -319,7 +318,11 @@ impl Scene {
     /// The value of one parameter (see [`Planar::get`]); `None` when the scene has none.
     pub fn get(&self, p: ParamRef) -> Option<f64> {
         use ParamId as P;
-        let (t, r, f) = (self.tilt.as_ref(), self.ramp.as_ref(), self.impulse.as_ref());
+        let (t, r, f) = (
+            self.tilt.as_ref(),
+            self.ramp.as_ref(),
+            self.impulse.as_ref(),
+        );
         match p.id {
             P::Springs => Some(self.springs),
             P::Gravity => Some(self.gravity),

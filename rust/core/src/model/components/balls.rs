@@ -146,7 +146,11 @@ impl Component for TiltingBalls {
         let spin = cx.spin.tuple();
         let mut r = [0.0; 5];
         for (i, &mi) in cx.m.iter().enumerate() {
-            let (qb, vb, ab) = (Self::view(l, q, i), Self::view(l, v, i), Self::view(l, a, i));
+            let (qb, vb, ab) = (
+                Self::view(l, q, i),
+                Self::view(l, v, i),
+                Self::view(l, a, i),
+            );
             ball_residual(&self.consts, self.zeta_b[i], spin, &qb, &vb, &ab, &mut r);
             for (o, ri) in out[..4].iter_mut().zip(&r[..4]) {
                 *o += mi * ri;
@@ -169,9 +173,23 @@ impl Component for TiltingBalls {
         let spin = cx.spin.tuple();
         let (mut bk, mut bc, mut bm) = ([0.0; 25], [0.0; 25], [0.0; 25]);
         for (i, &mi) in cx.m.iter().enumerate() {
-            let (qb, vb, ab) = (Self::view(l, q, i), Self::view(l, v, i), Self::view(l, a, i));
+            let (qb, vb, ab) = (
+                Self::view(l, q, i),
+                Self::view(l, v, i),
+                Self::view(l, a, i),
+            );
             let zb = self.zeta_b[i];
-            ball_jacobians(&self.consts, zb, spin, &qb, &vb, &ab, &mut bk, &mut bc, &mut bm);
+            ball_jacobians(
+                &self.consts,
+                zb,
+                spin,
+                &qb,
+                &vb,
+                &ab,
+                &mut bk,
+                &mut bc,
+                &mut bm,
+            );
             for (big, block) in [(&mut *k, &bk), (&mut *c, &bc), (&mut *m, &bm)] {
                 Self::add_block(l, i, mi, block, big);
             }

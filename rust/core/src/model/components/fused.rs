@@ -29,8 +29,49 @@ impl Component for FusedPlanar {
     }
     #[inline]
     fn add_residual(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+        self.planar.add_forces_at(cx.spin.om, q, v, out);
+        self.inertia_and_ramp(cx, q, a, out);
+    }
+    #[inline]
+    fn set_residual(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+        self.planar.forces_at(cx.spin.om, q, v, out);
+        self.inertia_and_ramp(cx, q, a, out);
+    }
+    #[inline]
+    fn add_jacobians(
+        &self,
+        cx: &Ctx,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        self.planar.add_jacobians_at(cx.spin.om, q, v, a, k, c, m);
+        self.ramp_jacobian(cx, q, k);
+    }
+    #[inline]
+    fn set_jacobians(
+        &self,
+        cx: &Ctx,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        self.planar.jacobians_at(cx.spin.om, q, v, a, k, c, m);
+        self.ramp_jacobian(cx, q, k);
+    }
+}
+
+impl FusedPlanar {
+    /// The inertia terms, and the `Omega'` terms of a varying spin.
+    #[inline(always)]
+    fn inertia_and_ramp(&self, cx: &Ctx, q: &[f64], a: &[f64], out: &mut [f64]) {
         let p = &self.planar;
-        p.add_forces_at(cx.spin.om, q, v, out);
         p.add_inertia(q, a, out);
         let dom = cx.spin.dom;
         if dom != 0.0 {
@@ -46,19 +87,10 @@ impl Component for FusedPlanar {
             }
         }
     }
-    #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+
+    #[inline(always)]
+    fn ramp_jacobian(&self, cx: &Ctx, q: &[f64], k: &mut [f64]) {
         let p = &self.planar;
-        p.add_jacobians_at(cx.spin.om, q, v, a, k, c, m);
         let dom = cx.spin.dom;
         if dom != 0.0 {
             let d = p.n_balls() + 2;

@@ -111,7 +111,16 @@ impl Component for TiltingDisk {
     ) {
         let d = cx.ndof();
         let (mut rk, mut rc, mut rm) = ([0.0; 16], [0.0; 16], [0.0; 16]);
-        rotor_jacobians(&self.consts, cx.spin.tuple(), q, v, a, &mut rk, &mut rc, &mut rm);
+        rotor_jacobians(
+            &self.consts,
+            cx.spin.tuple(),
+            q,
+            v,
+            a,
+            &mut rk,
+            &mut rc,
+            &mut rm,
+        );
         for (big, block) in [(&mut *k, &rk), (&mut *c, &rc), (&mut *m, &rm)] {
             add_rotor_block(d, block, big);
         }
@@ -127,7 +136,10 @@ impl Component for TiltingDisk {
 #[inline]
 fn add_rotor_block(d: usize, block: &[f64; 16], big: &mut [f64]) {
     for i in 0..4 {
-        for (b, x) in big[i * d..i * d + 4].iter_mut().zip(&block[i * 4..i * 4 + 4]) {
+        for (b, x) in big[i * d..i * d + 4]
+            .iter_mut()
+            .zip(&block[i * 4..i * 4 + 4])
+        {
             *b += x;
         }
     }
