@@ -6,6 +6,7 @@
 //! parameters. [`Planar`] is the planar balancer fused for speed (every analysis of a
 //! scene without effects runs it); [`Scene`] assembles the components a user switches on.
 
+pub mod assembly;
 pub mod component;
 pub mod components;
 mod dynamics;

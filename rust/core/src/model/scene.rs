@@ -41,6 +41,7 @@
 //! the coupling vanishes and a disk started flat stays flat: the planar equations.
 
 use crate::error::{Error, Result};
+use crate::model::assembly::{Assembly, PlanarAssembly};
 use crate::model::component::{Component, Composed, Drive};
 use crate::model::components::{
     BallSprings, FusedPlanar, Gravity, IsotropicSupport, TiltingBalls, TiltingDisk,
@@ -125,7 +126,7 @@ pub struct Scene {
     pub gravity: f64,
     pub impulse: Option<Impulse>,
     pub tilt: Option<Tilt>,
-    model: Composed,
+    model: Assembly,
 }
 
 impl PartialEq for Scene {
@@ -183,7 +184,12 @@ impl Scene {
             tl.validate()?;
         }
         let mut s = Scene {
-            model: Composed::new(Layout::planar(0), Drive::Constant(0.0), vec![], vec![]),
+            model: Assembly::Composed(Composed::new(
+                Layout::planar(0),
+                Drive::Constant(0.0),
+                vec![],
+                vec![],
+            )),
             planar,
             springs,
             spring_layout: SpringLayout::Ring,
@@ -212,45 +218,45 @@ impl Scene {
                 duration: r.duration,
             },
         };
-        let mut parts: Vec<Arc<dyn Component>> = vec![];
-        let layout = match self.rotor_consts() {
-            None => {
-                parts.push(Arc::new(FusedPlanar { planar: p.clone() }));
-                Layout::planar(n)
-            }
-            Some(consts) => {
-                parts.push(Arc::new(TiltingDisk { consts }));
-                parts.push(Arc::new(IsotropicSupport { zeta: p.zeta }));
-                parts.push(Arc::new(TiltingBalls {
-                    consts,
-                    zeta_b: p.zeta_b.clone(),
-                }));
-                Layout::tilting(n)
-            }
+        let springs = (self.springs > 0.0).then_some(BallSprings {
+            kd: self.springs * p.delta * p.delta,
+            layout: self.spring_layout,
+        });
+        let Some(consts) = self.rotor_consts() else {
+            // the planar balancer's fused code, the effects dispatched statically, summed
+            // in the order springs, load, gravity
+            self.model = Assembly::Planar(PlanarAssembly::new(
+                FusedPlanar { planar: p.clone() },
+                drive,
+                springs,
+                self.impulse.clone(),
+                (self.gravity != 0.0).then_some(Gravity { g: self.gravity }),
+            ));
+            return;
         };
-        if self.springs > 0.0 {
-            parts.push(Arc::new(BallSprings {
-                kd: self.springs * p.delta * p.delta,
-                layout: self.spring_layout,
-            }));
-        }
         // a tilting disk's gravity is in its generated terms (it depends on the tilt)
-        if self.gravity != 0.0 && self.tilt.is_none() {
-            parts.push(Arc::new(Gravity { g: self.gravity }));
+        let mut parts: Vec<Arc<dyn Component>> = vec![
+            Arc::new(TiltingDisk { consts }),
+            Arc::new(IsotropicSupport { zeta: p.zeta }),
+            Arc::new(TiltingBalls {
+                consts,
+                zeta_b: p.zeta_b.clone(),
+            }),
+        ];
+        if let Some(s) = springs {
+            parts.push(Arc::new(s));
         }
         if let Some(f) = &self.impulse {
             parts.push(Arc::new(f.clone()));
         }
-        let model = Composed::new(layout, drive, m, parts).with_modulo_turns(self.springs == 0.0);
-        self.model = if self.tilt.is_none() {
-            model.with_planar_mass(p)
-        } else {
-            model
-        };
+        self.model = Assembly::Composed(
+            Composed::new(Layout::tilting(n), drive, m, parts)
+                .with_modulo_turns(self.springs == 0.0),
+        );
     }
 
     /// The assembled model.
-    pub fn model(&self) -> &Composed {
+    pub fn model(&self) -> &Assembly {
         &self.model
     }
 
@@ -627,7 +633,10 @@ mod tests {
         let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
         let (mut k, mut c, mut m) = (vec![0.0; 49], vec![0.0; 49], vec![0.0; 49]);
         s.jacobians(0.8, &q, &v, &v, &mut k, &mut c, &mut m);
-        let alone = s.model.mass_matrix(0.8, &q);
+        let Assembly::Composed(model) = &s.model else {
+            panic!("a tilting scene is a composed model")
+        };
+        let alone = model.mass_matrix(0.8, &q);
         for i in 0..7 {
             for j in 0..7 {
                 assert!((alone[(i, j)] - m[i * 7 + j]).abs() < 1e-14, "[{i}][{j}]");
