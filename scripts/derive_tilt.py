@@ -145,12 +145,15 @@ def code(e):
     return _Printer().doprint(e)
 
 
-def rust_fn(name, doc, args, unpack, outputs):
+def rust_fn(name, doc, args, unpack, outputs, inline=False):
     """One Rust function writing each (slice, expressions) output after common
-    subexpression elimination over all of them."""
+    subexpression elimination over all of them. ``inline``: always inlined, so that a
+    caller looping over the balls hoists the trigonometry of the tilts out of the loop."""
     flat = [e for _, exprs in outputs for e in exprs]
     reps, reduced = sp.cse(flat, symbols=sp.numbered_symbols("t"), optimizations="basic")
     lines = [f"/// {doc}", "#[allow(clippy::all, unused_variables, non_snake_case)]"]
+    if inline:
+        lines.append("#[inline(always)]")
     lines.append(f"pub fn {name}({args}) {{")
     lines += [f"    {u}" for u in unpack]
     for sym, e in reps:
@@ -237,6 +240,7 @@ pub struct RotorConsts {
             "p: &RotorConsts, q: &[f64], m: &mut [f64; 16]",
             p_unpack[:1] + ["let (x, y, A, B) = (q[0], q[1], q[2], q[3]);"],
             [("m", rm)],
+            inline=True,
         ),
         rust_fn(
             "ball_residual",
@@ -260,6 +264,7 @@ pub struct RotorConsts {
             ["let (dl, idl) = (p.dl, p.idl);",
              "let (x, y, A, B, phi) = (q[0], q[1], q[2], q[3], q[4]);"],
             [("m", bm)],
+            inline=True,
         ),
     ]
     text = "\n\n".join(parts) + "\n"

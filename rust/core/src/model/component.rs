@@ -267,6 +267,46 @@ impl Component for Drive {
     }
 }
 
+/// Largest `d` whose mass matrix is factored on the stack.
+const SMALL: usize = 16;
+
+/// Solves `M Z = B` in place by Gaussian elimination with partial pivoting: `m` the
+/// row-major `d x d` matrix (overwritten), `cols` the columns of `B`, each of length `d`.
+fn gauss_solve(m: &mut [f64], d: usize, cols: &mut [f64]) {
+    for k in 0..d {
+        let p = (k..d)
+            .max_by(|&i, &j| m[i * d + k].abs().total_cmp(&m[j * d + k].abs()))
+            .unwrap_or(k);
+        if p != k {
+            for j in 0..d {
+                m.swap(k * d + j, p * d + j);
+            }
+            for c in cols.chunks_mut(d) {
+                c.swap(k, p);
+            }
+        }
+        let piv = m[k * d + k];
+        for i in k + 1..d {
+            let f = m[i * d + k] / piv;
+            if f == 0.0 {
+                continue;
+            }
+            for j in k + 1..d {
+                m[i * d + j] -= f * m[k * d + j];
+            }
+            for c in cols.chunks_mut(d) {
+                c[i] -= f * c[k];
+            }
+        }
+    }
+    for c in cols.chunks_mut(d) {
+        for k in (0..d).rev() {
+            let s: f64 = (k + 1..d).map(|j| m[k * d + j] * c[j]).sum();
+            c[k] = (c[k] - s) / m[k * d + k];
+        }
+    }
+}
+
 /// How a composed model solves `M z = rhs`: chosen once, at assembly.
 #[derive(Debug, Clone)]
 enum MassSolve {
@@ -403,6 +443,16 @@ impl Dynamics for Composed {
             MassSolve::Dense => {
                 let d = self.ndof();
                 // M is the kinetic-energy Hessian with rows scaled: never singular.
+                if d <= SMALL {
+                    // on the stack: a right-hand side evaluation allocates nothing
+                    let mut buf = [0.0; SMALL * SMALL];
+                    let m = &mut buf[..d * d];
+                    let cx = self.ctx(t);
+                    for p in &self.parts {
+                        p.add_mass(&cx, q, m);
+                    }
+                    return gauss_solve(m, d, cols);
+                }
                 let lu = self.mass_matrix(t, q).lu();
                 let mut b = DMatrix::from_column_slice(d, cols.len() / d, cols);
                 lu.solve_mut(&mut b);

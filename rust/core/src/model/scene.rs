@@ -44,7 +44,7 @@ use crate::error::{Error, Result};
 use crate::model::assembly::{Assembly, PlanarAssembly};
 use crate::model::component::{Component, Composed, Drive};
 use crate::model::components::{
-    BallSprings, FusedPlanar, Gravity, IsotropicSupport, TiltingBalls, TiltingDisk,
+    BallSprings, FusedPlanar, FusedTilting, Gravity, IsotropicSupport, TiltingBalls, TiltingDisk,
 };
 use crate::model::params::{key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
 use crate::model::tilt_terms::RotorConsts;
@@ -236,12 +236,14 @@ impl Scene {
         };
         // a tilting disk's gravity is in its generated terms (it depends on the tilt)
         let mut parts: Vec<Arc<dyn Component>> = vec![
-            Arc::new(TiltingDisk { consts }),
-            Arc::new(IsotropicSupport { zeta: p.zeta }),
-            Arc::new(TiltingBalls {
-                consts,
-                zeta_b: p.zeta_b.clone(),
+            Arc::new(FusedTilting {
+                disk: TiltingDisk { consts },
+                balls: TiltingBalls {
+                    consts,
+                    zeta_b: p.zeta_b.clone(),
+                },
             }),
+            Arc::new(IsotropicSupport { zeta: p.zeta }),
         ];
         if let Some(s) = springs {
             parts.push(Arc::new(s));

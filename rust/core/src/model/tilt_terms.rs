@@ -326,6 +326,7 @@ pub fn rotor_jacobians(p: &RotorConsts, spin: (f64, f64, f64), q: &[f64], v: &[f
 
 /// The `m` of [`rotor_jacobians`] alone (it depends on `q` only): what a right-hand side evaluation needs.
 #[allow(clippy::all, unused_variables, non_snake_case)]
+#[inline(always)]
 pub fn rotor_mass(p: &RotorConsts, q: &[f64], m: &mut [f64; 16]) {
     let RotorConsts { mh, mu, dl, idl, jt, jz, kc, kt, cr, g } = *p;
     let (x, y, A, B) = (q[0], q[1], q[2], q[3]);
@@ -824,6 +825,7 @@ pub fn ball_jacobians(p: &RotorConsts, zb: f64, spin: (f64, f64, f64), q: &[f64;
 
 /// The `m` of [`ball_jacobians`] alone (it depends on `q` only).
 #[allow(clippy::all, unused_variables, non_snake_case)]
+#[inline(always)]
 pub fn ball_mass(p: &RotorConsts, q: &[f64; 5], m: &mut [f64; 25]) {
     let (dl, idl) = (p.dl, p.idl);
     let (x, y, A, B, phi) = (q[0], q[1], q[2], q[3], q[4]);

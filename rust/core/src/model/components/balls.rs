@@ -112,13 +112,13 @@ pub struct TiltingBalls {
 impl TiltingBalls {
     /// One ball's `(x, y, A, B, b_i)` slice of a tilting state.
     #[inline(always)]
-    fn view(l: &Layout, z: &[f64], i: usize) -> [f64; 5] {
+    pub(super) fn view(l: &Layout, z: &[f64], i: usize) -> [f64; 5] {
         [z[0], z[1], z[2], z[3], z[l.ball(i)]]
     }
 
     /// Adds ball `i`'s 5 x 5 block to a `d x d` matrix, its rotor rows scaled by `mi`.
-    #[inline]
-    fn add_block(l: &Layout, i: usize, mi: f64, block: &[f64; 25], big: &mut [f64]) {
+    #[inline(always)]
+    pub(super) fn add_block(l: &Layout, i: usize, mi: f64, block: &[f64; 25], big: &mut [f64]) {
         let d = l.ndof();
         let idx = [0, 1, 2, 3, l.ball(i)];
         for (r, &row) in idx.iter().enumerate() {

@@ -109,3 +109,71 @@ impl FusedPlanar {
         }
     }
 }
+
+/// [`super::TiltingDisk`] + [`super::TiltingBalls`] in one component, so that the
+/// generated rotor and ball terms are compiled together (their trigonometry of the
+/// tilts is shared): what a scene with a tilting disk uses.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FusedTilting {
+    pub disk: super::TiltingDisk,
+    pub balls: super::TiltingBalls,
+}
+
+impl Component for FusedTilting {
+    fn name(&self) -> &'static str {
+        "tilting_disk"
+    }
+    fn params(&self) -> &'static [ParamId] {
+        &[
+            ParamId::Mu,
+            ParamId::TiltA,
+            ParamId::TiltB,
+            ParamId::TiltJt,
+            ParamId::TiltJz,
+            ParamId::TiltZetaR,
+            ParamId::ZetaB,
+            ParamId::Delta,
+            ParamId::Eta,
+        ]
+    }
+    fn time_dependence(&self) -> Option<&'static str> {
+        self.disk.time_dependence()
+    }
+    fn coords(&self, l: &Layout) -> Vec<usize> {
+        (0..l.ndof()).collect()
+    }
+    #[inline]
+    fn add_residual(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
+        self.disk.add_residual(cx, q, v, a, out);
+        self.balls.add_residual(cx, q, v, a, out);
+    }
+    #[inline]
+    fn add_jacobians(
+        &self,
+        cx: &Ctx,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        self.disk.add_jacobians(cx, q, v, a, k, c, m);
+        self.balls.add_jacobians(cx, q, v, a, k, c, m);
+    }
+    /// The rotor's and the balls' generated mass terms in one body, so that the
+    /// trigonometry of the tilts is computed once for all of them.
+    #[inline]
+    fn add_mass(&self, cx: &Ctx, q: &[f64], m: &mut [f64]) {
+        use crate::model::tilt_terms::{ball_mass, rotor_mass};
+        let (c, l) = (&self.disk.consts, &cx.layout);
+        let mut rm = [0.0; 16];
+        rotor_mass(c, q, &mut rm);
+        super::rotor::add_rotor_block(cx.ndof(), &rm, m);
+        let mut bm = [0.0; 25];
+        for (i, &mi) in cx.m.iter().enumerate() {
+            ball_mass(c, &super::TiltingBalls::view(l, q, i), &mut bm);
+            super::TiltingBalls::add_block(l, i, mi, &bm, m);
+        }
+    }
+}

@@ -19,7 +19,7 @@ mod rotor;
 mod support;
 
 pub use balls::{BallSprings, FreeBalls, SpringLayout, TiltingBalls};
-pub use fused::FusedPlanar;
+pub use fused::{FusedPlanar, FusedTilting};
 pub use loads::{Gravity, Impulse};
 pub use rotor::{PlanarDisk, TiltingDisk};
 pub use support::IsotropicSupport;

@@ -133,8 +133,8 @@ impl Component for TiltingDisk {
 }
 
 /// Adds a 4 x 4 block to the top left of a `d x d` matrix.
-#[inline]
-fn add_rotor_block(d: usize, block: &[f64; 16], big: &mut [f64]) {
+#[inline(always)]
+pub(super) fn add_rotor_block(d: usize, block: &[f64; 16], big: &mut [f64]) {
     for i in 0..4 {
         for (b, x) in big[i * d..i * d + 4]
             .iter_mut()
