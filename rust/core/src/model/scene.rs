@@ -32,8 +32,8 @@
 //! where `A, B` are the disk's Euler tilts scaled by `delta` (the rim's axial
 //! displacement over `e`). The rotor and ball terms, including spin ramp and gravity,
 //! come from `scripts/derive_tilt.py`, which derives them from the Lagrangian and
-//! writes [`crate::model::tilt_terms`]; springs and the impulsive load are added here as for
-//! the planar disk. The shaft is massless, simply supported, the disk at distances
+//! writes [`crate::model::tilt_terms`]; the support's spring and damper, springs and the
+//! impulsive load are their own components, as for the planar disk. The shaft is massless, simply supported, the disk at distances
 //! `a`, `b` (over `r_t`) from the bearings: beam theory gives the translational
 //! stiffness `k = 3 E I (1/a^3 + 1/b^3)` (the `k` of `w_n`), the coupling
 //! `kappa_c = a b (a - b) / (a^2 - a b + b^2)` and tilt stiffness
