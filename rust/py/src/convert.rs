@@ -75,6 +75,8 @@ pub enum ModelArgs {
 }
 
 /// A built, validated core model: the planar code when no effect is on.
+// Built once per call and matched by reference: the size difference costs nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum Model {
     Planar(Planar),
     Scene(Scene),

@@ -99,6 +99,7 @@ fn spring_homotopy(sc: &Scene, mut q: Vec<f64>) -> Option<Vec<f64>> {
         let next = (at + step).min(1.0);
         let mut partial = sc.clone();
         partial.springs = sc.springs * next;
+        partial.reassemble();
         match newton_static(&partial, &q) {
             // a continuation step must not jump to another winding of the springs
             Some(qn) if qn.iter().zip(&q).all(|(a, b)| (a - b).abs() < 1.0) => {

@@ -170,7 +170,7 @@ pub fn certify<D: Dynamics + ?Sized>(
         return None;
     }
     let closure = crate::hb::timed_certificate(|| defect_closure(p, sol, defect_points(sol)));
-    if !(sol.tail_ratio() <= opts.max_tail) {
+    if !(sol.tail_ratio_on(p.layout().support()) <= opts.max_tail) {
         sol.status = Status::Truncated;
     } else if !(closure <= opts.max_closure) {
         sol.status = Status::NotClosed;

@@ -6,9 +6,13 @@
 //! never needs `M^-1`; simulation solves `F(t, q, v, a) = 0` for `a`. A model that adds
 //! physical effects only has to supply this residual and its Jacobians.
 //!
-//! Coordinates: `q = (x, y, b_1, ..., b_n)`; see `shared/spec/model.md` section 2.
+//! Coordinates: `q = (x, y, b_1, ..., b_n)` (see `shared/spec/model.md` section 2),
+//! or another [`Layout`] a model declares; solvers ask the layout, never assume it.
 //! Ball rows are divided by `m_i = mu eta_i` so that light balls do not make the
 //! harmonic-balance Jacobian badly scaled.
+
+use super::component::fd_add_jacobians;
+use super::Layout;
 
 /// The dynamics interface shared by every analysis.
 pub trait Dynamics: Send + Sync {
@@ -17,6 +21,8 @@ pub trait Dynamics: Send + Sync {
     /// Residual `F(t, q, v, a)` into `out` (length `d`).
     fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]);
     /// Row-major `d x d` Jacobians `K = dF/dq`, `C = dF/dv`, `M = dF/da` at `(t, q, v, a)`.
+    /// Default: central differences of [`Self::residual`] (steps scaled to each
+    /// variable), for a model without analytic derivatives; `6 d` residuals per call.
     #[allow(clippy::too_many_arguments)]
     fn jacobians(
         &self,
@@ -27,7 +33,24 @@ pub trait Dynamics: Send + Sync {
         k: &mut [f64],
         c: &mut [f64],
         m: &mut [f64],
-    );
+    ) {
+        k.fill(0.0);
+        c.fill(0.0);
+        m.fill(0.0);
+        let mut full = vec![0.0; q.len()];
+        fd_add_jacobians(
+            |q, v, a, out| {
+                self.residual(t, q, v, a, &mut full);
+                out.iter_mut().zip(&full).for_each(|(o, f)| *o += f);
+            },
+            q,
+            v,
+            a,
+            k,
+            c,
+            m,
+        );
+    }
     /// Solves `M(q) z = rhs` in place (`M = dF/da`).
     fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]);
     /// Solves `M(q) Z = B` in place for `B` stored as consecutive columns of length `d`.
@@ -49,9 +72,13 @@ pub trait Dynamics: Send + Sync {
     fn base_spin(&self) -> f64 {
         0.0
     }
+    /// Where each coordinate lives in `q`. Default: the planar `(x, y, b_1, ..., b_n)`.
+    fn layout(&self) -> Layout {
+        Layout::planar(self.ndof().saturating_sub(2))
+    }
     /// Index of the first ball angle in `q` (the coordinates before it are the rotor's).
     fn first_ball(&self) -> usize {
-        2
+        self.layout().first_ball
     }
     /// Whether ball angles that differ by whole turns are the same state (not so when
     /// springs count the turns).

@@ -1,8 +1,9 @@
 //! The planar n-ball balancer on an isotropic spring–damper support, fused into one
 //! residual for speed: every scene without effects runs this code.
 
+use super::params::{key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
 use super::Dynamics;
-use crate::error::{check_range, Error, Result};
+use crate::error::{Error, Result};
 
 /// Planar n-ball automatic balancer on an isotropic spring–damper support.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,19 +32,17 @@ impl Planar {
         omega_s: f64,
         eta: &[f64],
     ) -> Result<Self> {
-        check_range("mu", mu, 0.0, true, 1.0, true)?;
-        check_range("zeta", zeta, 0.0, false, f64::INFINITY, true)?;
-        check_range("delta", delta, 0.0, true, f64::INFINITY, true)?;
-        check_range("Omega", omega_s, 0.0, false, f64::INFINITY, true)?;
+        ParamId::Mu.check(mu)?;
+        ParamId::Zeta.check(zeta)?;
+        ParamId::Delta.check(delta)?;
+        ParamId::Omega.check(omega_s)?;
         if eta.is_empty() {
             return Err(Error::param(
                 "eta",
                 "needs one value per ball and at least one ball (n >= 1), got n = 0",
             ));
         }
-        for (i, &e) in eta.iter().enumerate() {
-            check_range(&format!("eta[{i}]"), e, 0.0, true, f64::INFINITY, true)?;
-        }
+        ParamId::Eta.check_balls(eta, false)?;
         let zb: Vec<f64> = match zeta_b.len() {
             1 => vec![zeta_b[0]; eta.len()],
             n if n == eta.len() => zeta_b.to_vec(),
@@ -54,14 +53,7 @@ impl Planar {
                 ))
             }
         };
-        for (i, &z) in zb.iter().enumerate() {
-            let name = if zeta_b.len() == 1 {
-                "zeta_b".to_string()
-            } else {
-                format!("zeta_b[{i}]")
-            };
-            check_range(&name, z, 0.0, false, f64::INFINITY, true)?;
-        }
+        ParamId::ZetaB.check_balls(&zb, zeta_b.len() == 1)?;
         // Disk and balls are part of the total mass M: m_d + sum m_b <= M.
         let share = mu * (1.0 + eta.iter().sum::<f64>() / delta);
         if share > 1.0 {
@@ -101,6 +93,17 @@ impl Planar {
     /// [`Self::forces`] at spin `om` (a scene's spin may vary in time).
     #[inline(always)]
     pub fn forces_at(&self, om: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        self.forces_impl::<false>(om, q, v, out);
+    }
+
+    /// Adds [`Self::forces_at`] to `out` (the fused planar component of a scene).
+    #[inline(always)]
+    pub fn add_forces_at(&self, om: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        self.forces_impl::<true>(om, q, v, out);
+    }
+
+    #[inline(always)]
+    fn forces_impl<const ADD: bool>(&self, om: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
         let (z, dl) = (self.zeta, self.delta);
         let (x, y, vx, vy) = (q[0], q[1], v[0], v[1]);
         let k = 1.0 - om * om;
@@ -112,47 +115,92 @@ impl Planar {
             let w = om + v[2 + i];
             fx -= mi * w * w * c;
             fy -= mi * w * w * s;
-            out[2 + i] = 2.0 * om * (c * vx + s * vy)
-                + 2.0 * self.zeta_b[i] * dl * v[2 + i]
-                + om * om * (x * s - y * c);
+            put::<ADD>(
+                &mut out[2 + i],
+                2.0 * om * (c * vx + s * vy)
+                    + 2.0 * self.zeta_b[i] * dl * v[2 + i]
+                    + om * om * (x * s - y * c),
+            );
         }
-        out[0] = fx;
-        out[1] = fy;
+        put::<ADD>(&mut out[0], fx);
+        put::<ADD>(&mut out[1], fy);
     }
 
-    /// Returns a copy with one named parameter changed (used by scans and continuation).
+    /// Returns a copy with one named parameter changed (used by scans and continuation):
+    /// a registry name (`"mu"`, `"eta"` for every ball, `"eta[1]"`), revalidated.
     pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
-        let mut p = self.clone();
-        match name {
-            "mu" => p.mu = value,
-            "zeta" => p.zeta = value,
-            "zeta_b" => p.zeta_b.iter_mut().for_each(|z| *z = value),
-            "delta" => p.delta = value,
-            "Omega" => p.omega_s = value,
-            "eta" => p.eta.iter_mut().for_each(|e| *e = value),
+        let p = ParamRef::parse(name)
+            .filter(|p| PLANAR_OWNERS.contains(&p.id.spec().owner))
+            .ok_or_else(|| unknown(name, "planar balancer", &key_list(PLANAR_OWNERS)))?;
+        self.with(p, value)
+    }
+
+    /// [`Self::with_param`] by typed id.
+    pub fn with(&self, p: ParamRef, value: f64) -> Result<Self> {
+        let mut c = self.clone();
+        c.set(p, value)?;
+        Planar::new(c.mu, c.zeta, &c.zeta_b, c.delta, c.omega_s, &c.eta)
+    }
+
+    /// Sets one parameter in place, without revalidating the whole (continuation's
+    /// `dF/dp` perturbs one value); fails for a parameter the planar balancer does not
+    /// have or a ball it does not have.
+    pub fn set(&mut self, p: ParamRef, value: f64) -> Result<()> {
+        let n = self.n_balls();
+        let one = match p.id {
+            ParamId::Mu => &mut self.mu,
+            ParamId::Zeta => &mut self.zeta,
+            ParamId::Delta => &mut self.delta,
+            ParamId::Omega => &mut self.omega_s,
+            _ => return self.set_balls(p, value, n),
+        };
+        *one = value;
+        Ok(())
+    }
+
+    fn set_balls(&mut self, p: ParamRef, value: f64, n: usize) -> Result<()> {
+        let balls = match p.id {
+            ParamId::Eta => &mut self.eta,
+            ParamId::ZetaB => &mut self.zeta_b,
             _ => {
-                let slot = if let Some(i) = indexed(name, "eta") {
-                    p.eta.get_mut(i)
-                } else if let Some(i) = indexed(name, "zeta_b") {
-                    p.zeta_b.get_mut(i)
-                } else {
-                    return Err(Error::param(
-                        name,
-                        "is not a parameter of the planar balancer (mu, zeta, zeta_b, delta, Omega, eta, eta[i], zeta_b[i])",
-                    ));
-                };
-                match slot {
-                    Some(s) => *s = value,
-                    None => {
-                        return Err(Error::param(
-                            name,
-                            format!("ball index out of range 0..{}", self.n_balls()),
-                        ))
-                    }
-                }
+                return Err(unknown(
+                    &p.name(),
+                    "planar balancer",
+                    &key_list(PLANAR_OWNERS),
+                ))
             }
+        };
+        match p.ball {
+            None => balls.iter_mut().for_each(|x| *x = value),
+            Some(i) => match balls.get_mut(i) {
+                Some(x) => *x = value,
+                None => {
+                    return Err(Error::param(
+                        p.name(),
+                        format!("ball index out of range 0..{n}"),
+                    ))
+                }
+            },
         }
-        Planar::new(p.mu, p.zeta, &p.zeta_b, p.delta, p.omega_s, &p.eta)
+        Ok(())
+    }
+
+    /// The value of one parameter; for a per-ball parameter without a ball index, its
+    /// value when every ball shares it. `None` when the planar balancer has no such value.
+    pub fn get(&self, p: ParamRef) -> Option<f64> {
+        let balls = match p.id {
+            ParamId::Mu => return Some(self.mu),
+            ParamId::Zeta => return Some(self.zeta),
+            ParamId::Delta => return Some(self.delta),
+            ParamId::Omega => return Some(self.omega_s),
+            ParamId::Eta => &self.eta,
+            ParamId::ZetaB => &self.zeta_b,
+            _ => return None,
+        };
+        match p.ball {
+            Some(i) => balls.get(i).copied(),
+            None => balls.windows(2).all(|w| w[0] == w[1]).then(|| balls[0]),
+        }
     }
 
     /// Adds the inertia terms `M(q) a` to `out`.
@@ -184,22 +232,55 @@ impl Planar {
         c: &mut [f64],
         m: &mut [f64],
     ) {
+        self.jacobians_impl::<false>(om, q, v, a, k, c, m);
+    }
+
+    /// Adds [`Self::jacobians_at`] to `k`, `c`, `m`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub fn add_jacobians_at(
+        &self,
+        om: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
+        self.jacobians_impl::<true>(om, q, v, a, k, c, m);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn jacobians_impl<const ADD: bool>(
+        &self,
+        om: f64,
+        q: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k: &mut [f64],
+        c: &mut [f64],
+        m: &mut [f64],
+    ) {
         let d = self.ndof();
-        k.fill(0.0);
-        c.fill(0.0);
-        m.fill(0.0);
+        if !ADD {
+            k.fill(0.0);
+            c.fill(0.0);
+            m.fill(0.0);
+        }
         let (z, dl) = (self.zeta, self.delta);
         let stiff = 1.0 - om * om;
-        k[0] = stiff;
-        k[1] = -2.0 * z * om;
-        k[d] = 2.0 * z * om;
-        k[d + 1] = stiff;
-        c[0] = 2.0 * z;
-        c[1] = -2.0 * om;
-        c[d] = 2.0 * om;
-        c[d + 1] = 2.0 * z;
-        m[0] = 1.0;
-        m[d + 1] = 1.0;
+        put::<ADD>(&mut k[0], stiff);
+        put::<ADD>(&mut k[1], -2.0 * z * om);
+        put::<ADD>(&mut k[d], 2.0 * z * om);
+        put::<ADD>(&mut k[d + 1], stiff);
+        put::<ADD>(&mut c[0], 2.0 * z);
+        put::<ADD>(&mut c[1], -2.0 * om);
+        put::<ADD>(&mut c[d], 2.0 * om);
+        put::<ADD>(&mut c[d + 1], 2.0 * z);
+        put::<ADD>(&mut m[0], 1.0);
+        put::<ADD>(&mut m[d + 1], 1.0);
         for i in 0..self.n_balls() {
             let j = 2 + i;
             let (s, cs) = q[j].sin_cos();
@@ -207,36 +288,41 @@ impl Planar {
             let w = om + v[j];
             let ab = a[j];
             // x row
-            m[j] = -mi * s;
-            c[j] = -2.0 * mi * w * cs;
-            k[j] = -mi * cs * ab + mi * w * w * s;
+            put::<ADD>(&mut m[j], -mi * s);
+            put::<ADD>(&mut c[j], -2.0 * mi * w * cs);
+            put::<ADD>(&mut k[j], -mi * cs * ab + mi * w * w * s);
             // y row
-            m[d + j] = mi * cs;
-            c[d + j] = -2.0 * mi * w * s;
-            k[d + j] = -mi * s * ab - mi * w * w * cs;
+            put::<ADD>(&mut m[d + j], mi * cs);
+            put::<ADD>(&mut c[d + j], -2.0 * mi * w * s);
+            put::<ADD>(&mut k[d + j], -mi * s * ab - mi * w * w * cs);
             // ball row
             let r = j * d;
-            m[r] = -s;
-            m[r + 1] = cs;
-            m[r + j] = dl;
-            c[r] = 2.0 * om * cs;
-            c[r + 1] = 2.0 * om * s;
-            c[r + j] = 2.0 * self.zeta_b[i] * dl;
-            k[r] = om * om * s;
-            k[r + 1] = -om * om * cs;
-            k[r + j] = -cs * a[0] - s * a[1]
-                + 2.0 * om * (-s * v[0] + cs * v[1])
-                + om * om * (q[0] * cs + q[1] * s);
+            put::<ADD>(&mut m[r], -s);
+            put::<ADD>(&mut m[r + 1], cs);
+            put::<ADD>(&mut m[r + j], dl);
+            put::<ADD>(&mut c[r], 2.0 * om * cs);
+            put::<ADD>(&mut c[r + 1], 2.0 * om * s);
+            put::<ADD>(&mut c[r + j], 2.0 * self.zeta_b[i] * dl);
+            put::<ADD>(&mut k[r], om * om * s);
+            put::<ADD>(&mut k[r + 1], -om * om * cs);
+            put::<ADD>(
+                &mut k[r + j],
+                -cs * a[0] - s * a[1]
+                    + 2.0 * om * (-s * v[0] + cs * v[1])
+                    + om * om * (q[0] * cs + q[1] * s),
+            );
         }
     }
 }
 
-fn indexed(name: &str, base: &str) -> Option<usize> {
-    let rest = name
-        .strip_prefix(base)?
-        .strip_prefix('[')?
-        .strip_suffix(']')?;
-    rest.parse().ok()
+/// `*x = v`, or `*x += v` when adding into a sum of components.
+#[inline(always)]
+fn put<const ADD: bool>(x: &mut f64, v: f64) {
+    if ADD {
+        *x += v;
+    } else {
+        *x = v;
+    }
 }
 
 impl Dynamics for Planar {

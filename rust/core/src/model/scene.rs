@@ -32,22 +32,26 @@
 //! where `A, B` are the disk's Euler tilts scaled by `delta` (the rim's axial
 //! displacement over `e`). The rotor and ball terms, including spin ramp and gravity,
 //! come from `scripts/derive_tilt.py`, which derives them from the Lagrangian and
-//! writes [`crate::model::tilt_terms`]; springs and the impulsive load are added here as for
-//! the planar disk. The shaft is massless, simply supported, the disk at distances
+//! writes [`crate::model::tilt_terms`]; the support's spring and damper, springs and the
+//! impulsive load are their own components, as for the planar disk. The shaft is massless, simply supported, the disk at distances
 //! `a`, `b` (over `r_t`) from the bearings: beam theory gives the translational
 //! stiffness `k = 3 E I (1/a^3 + 1/b^3)` (the `k` of `w_n`), the coupling
 //! `kappa_c = a b (a - b) / (a^2 - a b + b^2)` and tilt stiffness
 //! `kappa_t = a^2 b^2 / (a^2 - a b + b^2)` (over `k r_t` and `k r_t^2`). With `a = b`
 //! the coupling vanishes and a disk started flat stays flat: the planar equations.
 
-use crate::error::{check_range, Error, Result};
-use crate::model::tilt_terms::{
-    ball_jacobians, ball_mass, ball_residual, rotor_jacobians, rotor_mass, rotor_residual,
-    RotorConsts,
+use crate::error::{Error, Result};
+use crate::model::assembly::{Assembly, PlanarAssembly};
+use crate::model::component::{Component, Composed, Drive};
+use crate::model::components::{
+    BallSprings, FusedPlanar, FusedTilting, Gravity, IsotropicSupport, TiltingBalls, TiltingDisk,
 };
-use crate::model::{Dynamics, Planar};
-use nalgebra::DMatrix;
-use std::f64::consts::PI;
+use crate::model::params::{key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
+use crate::model::tilt_terms::RotorConsts;
+use crate::model::{Dynamics, Layout, Planar};
+use std::sync::Arc;
+
+pub use crate::model::components::{Impulse, SpringLayout};
 
 /// A disk that tilts on a flexible shaft, with gyroscopic coupling (seed 004).
 #[derive(Debug, Clone, PartialEq)]
@@ -67,21 +71,21 @@ pub struct Tilt {
 
 impl Tilt {
     fn validate(&self) -> Result<()> {
-        check_range("tilt.a", self.a, 0.0, true, f64::INFINITY, true)?;
-        check_range("tilt.b", self.b, 0.0, true, f64::INFINITY, true)?;
-        check_range("tilt.j_t", self.j_t, 0.0, true, f64::INFINITY, true)?;
-        check_range("tilt.j_z", self.j_z, 0.0, false, 2.0 * self.j_t, false)
-            .map_err(|_| {
-                Error::param(
-                    "tilt.j_z",
-                    format!(
-                        "must be in [0, 2 j_t] = [0, {}] (a rigid body's polar moment is at most the sum of the other two), got {}",
-                        2.0 * self.j_t,
-                        self.j_z
-                    ),
-                )
-            })?;
-        check_range("tilt.zeta_r", self.zeta_r, 0.0, false, f64::INFINITY, true)
+        ParamId::TiltA.check(self.a)?;
+        ParamId::TiltB.check(self.b)?;
+        ParamId::TiltJt.check(self.j_t)?;
+        // a range that depends on j_t: [0, 2 j_t]
+        if !(self.j_z >= 0.0 && self.j_z <= 2.0 * self.j_t) {
+            return Err(Error::param(
+                "tilt.j_z",
+                format!(
+                    "must be in [0, 2 j_t] = [0, {}] (a rigid body's polar moment is at most the sum of the other two), got {}",
+                    2.0 * self.j_t,
+                    self.j_z
+                ),
+            ));
+        }
+        ParamId::TiltZetaR.check(self.zeta_r)
     }
 
     /// Translation–tilt coupling stiffness `kappa_c` of the simply supported shaft.
@@ -106,26 +110,11 @@ pub struct Ramp {
     pub duration: f64,
 }
 
-/// `F(t) = amplitude exp(-sharpness (t - t0)^2)` along the ground direction `angle`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Impulse {
-    pub amplitude: f64,
-    pub t0: f64,
-    pub sharpness: f64,
-    pub angle: f64,
-}
-
-/// How the ball springs join the balls.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum SpringLayout {
-    /// `n` springs round the track, the last from ball n to ball 1.
-    #[default]
-    Ring,
-    /// `n - 1` springs, ball 1 to 2, ..., n - 1 to n (seed 004).
-    Chain,
-}
-
-#[derive(Debug, Clone, PartialEq)]
+/// A scene: a description (the public fields) and the model assembled from exactly the
+/// components it switches on (built once, by [`Scene::new`], [`Scene::set`] and the
+/// `with_*` methods; a field changed in place is not seen by the dynamics until
+/// [`Scene::reassemble`]).
+#[derive(Debug, Clone)]
 pub struct Scene {
     pub planar: Planar,
     /// `k_d / k`; 0 for no springs.
@@ -137,7 +126,31 @@ pub struct Scene {
     pub gravity: f64,
     pub impulse: Option<Impulse>,
     pub tilt: Option<Tilt>,
+    model: Assembly,
 }
+
+impl PartialEq for Scene {
+    /// Scenes are equal when their descriptions are (the model follows from it).
+    fn eq(&self, o: &Self) -> bool {
+        self.planar == o.planar
+            && self.springs == o.springs
+            && self.spring_layout == o.spring_layout
+            && self.ramp == o.ramp
+            && self.gravity == o.gravity
+            && self.impulse == o.impulse
+            && self.tilt == o.tilt
+    }
+}
+
+/// The components a scene without a tilting disk may have, as the registry names them.
+const SCENE_OWNERS: &[&str] = &[
+    "rotor",
+    "support",
+    "balls",
+    "drive",
+    "ball_springs",
+    "gravity",
+];
 
 impl Scene {
     pub fn new(
@@ -148,7 +161,7 @@ impl Scene {
         impulse: Option<Impulse>,
         tilt: Option<Tilt>,
     ) -> Result<Self> {
-        check_range("springs", springs, 0.0, false, f64::INFINITY, true)?;
+        ParamId::Springs.check(springs)?;
         if springs > 0.0 && planar.n_balls() < 2 {
             return Err(Error::param(
                 "springs",
@@ -156,39 +169,27 @@ impl Scene {
             ));
         }
         if let Some(r) = &ramp {
-            check_range("ramp.to", r.to, 0.0, true, f64::INFINITY, true)?;
-            check_range(
-                "ramp.start",
-                r.start,
-                f64::NEG_INFINITY,
-                true,
-                f64::INFINITY,
-                true,
-            )?;
-            check_range("ramp.duration", r.duration, 0.0, true, f64::INFINITY, true)?;
+            ParamId::RampTo.check(r.to)?;
+            ParamId::RampStart.check(r.start)?;
+            ParamId::RampDuration.check(r.duration)?;
         }
-        check_range("gravity", gravity, 0.0, false, f64::INFINITY, true)?;
+        ParamId::Gravity.check(gravity)?;
         if let Some(f) = &impulse {
-            for (name, v) in [
-                ("impulse.amplitude", f.amplitude),
-                ("impulse.t0", f.t0),
-                ("impulse.angle", f.angle),
-            ] {
-                check_range(name, v, f64::NEG_INFINITY, true, f64::INFINITY, true)?;
-            }
-            check_range(
-                "impulse.sharpness",
-                f.sharpness,
-                0.0,
-                true,
-                f64::INFINITY,
-                true,
-            )?;
+            ParamId::ImpulseAmplitude.check(f.amplitude)?;
+            ParamId::ImpulseT0.check(f.t0)?;
+            ParamId::ImpulseAngle.check(f.angle)?;
+            ParamId::ImpulseSharpness.check(f.sharpness)?;
         }
         if let Some(tl) = &tilt {
             tl.validate()?;
         }
-        Ok(Scene {
+        let mut s = Scene {
+            model: Assembly::Composed(Composed::new(
+                Layout::planar(0),
+                Drive::Constant(0.0),
+                vec![],
+                vec![],
+            )),
             planar,
             springs,
             spring_layout: SpringLayout::Ring,
@@ -196,13 +197,72 @@ impl Scene {
             gravity,
             impulse,
             tilt,
-        })
+        };
+        s.reassemble();
+        Ok(s)
     }
 
-    /// The tilting rotor's constants, derived from the public fields on every call (a
-    /// few flops beside the generated terms), so a scene changed in place never carries
-    /// stale ones. `None` for a planar disk.
-    #[inline]
+    /// Assembles the model from the description: exactly the components switched on,
+    /// in the order their terms are summed. A planar disk on the isotropic support runs
+    /// the planar balancer's fused code ([`FusedPlanar`]).
+    pub fn reassemble(&mut self) {
+        let p = &self.planar;
+        let n = p.n_balls();
+        let m: Vec<f64> = (0..n).map(|i| p.m(i)).collect();
+        let drive = match &self.ramp {
+            None => Drive::Constant(p.omega_s),
+            Some(r) => Drive::Ramp {
+                from: p.omega_s,
+                to: r.to,
+                start: r.start,
+                duration: r.duration,
+            },
+        };
+        let springs = (self.springs > 0.0).then_some(BallSprings {
+            kd: self.springs * p.delta * p.delta,
+            layout: self.spring_layout,
+        });
+        let Some(consts) = self.rotor_consts() else {
+            // the planar balancer's fused code, the effects dispatched statically, summed
+            // in the order springs, load, gravity
+            self.model = Assembly::Planar(PlanarAssembly::new(
+                FusedPlanar { planar: p.clone() },
+                drive,
+                springs,
+                self.impulse.clone(),
+                (self.gravity != 0.0).then_some(Gravity { g: self.gravity }),
+            ));
+            return;
+        };
+        // a tilting disk's gravity is in its generated terms (it depends on the tilt)
+        let mut parts: Vec<Arc<dyn Component>> = vec![
+            Arc::new(FusedTilting {
+                disk: TiltingDisk { consts },
+                balls: TiltingBalls {
+                    consts,
+                    zeta_b: p.zeta_b.clone(),
+                },
+            }),
+            Arc::new(IsotropicSupport { zeta: p.zeta }),
+        ];
+        if let Some(s) = springs {
+            parts.push(Arc::new(s));
+        }
+        if let Some(f) = &self.impulse {
+            parts.push(Arc::new(f.clone()));
+        }
+        self.model = Assembly::Composed(
+            Composed::new(Layout::tilting(n), drive, m, parts)
+                .with_modulo_turns(self.springs == 0.0),
+        );
+    }
+
+    /// The assembled model.
+    pub fn model(&self) -> &Assembly {
+        &self.model
+    }
+
+    /// The tilting rotor's constants. `None` for a planar disk.
     fn rotor_consts(&self) -> Option<RotorConsts> {
         let tl = self.tilt.as_ref()?;
         let p = &self.planar;
@@ -218,7 +278,6 @@ impl Scene {
             kc: tl.kappa_c(),
             kt,
             cr: 2.0 * tl.zeta_r * (kt * tl.j_t).sqrt(),
-            zeta: p.zeta,
             g: self.gravity,
         })
     }
@@ -226,346 +285,150 @@ impl Scene {
     /// The same scene with its springs joined as `layout`.
     pub fn with_spring_layout(mut self, layout: SpringLayout) -> Self {
         self.spring_layout = layout;
+        self.reassemble();
         self
     }
 
-    /// Number of ball springs (when `springs > 0`).
-    #[inline]
-    fn n_springs(&self) -> usize {
-        let n = self.planar.n_balls();
-        match self.spring_layout {
-            SpringLayout::Ring => n,
-            SpringLayout::Chain => n - 1,
+    /// The names `with_param` takes, as its error lists them.
+    fn keys() -> String {
+        format!(
+            "{}; with a tilting disk {}",
+            key_list(SCENE_OWNERS),
+            key_list(&["tilting_disk"])
+        )
+    }
+
+    /// Returns a copy with one named parameter changed (scans and continuation): a
+    /// registry name ([`crate::model::params::REGISTRY`]): the planar balancer's,
+    /// `springs`, `gravity`, and the tilt's `a`, `b`, `j_t`, `j_z`, `zeta_r`. The copy is
+    /// revalidated and reassembled, so constants derived from the tilt follow the change.
+    pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
+        let p = ParamRef::parse(name).ok_or_else(|| unknown(name, "scene", &Self::keys()))?;
+        self.with(p, value)
+    }
+
+    /// [`Self::with_param`] by typed id.
+    pub fn with(&self, p: ParamRef, value: f64) -> Result<Self> {
+        let mut s = self.clone();
+        s.set_field(p, value)?;
+        Scene::new(s.planar, s.springs, s.ramp, s.gravity, s.impulse, s.tilt)
+            .map(|x| x.with_spring_layout(self.spring_layout))
+    }
+
+    /// Sets one parameter in place and reassembles, without revalidating (continuation's
+    /// `dF/dp` perturbs one value); fails for a parameter the scene does not have.
+    pub fn set(&mut self, p: ParamRef, value: f64) -> Result<()> {
+        self.set_field(p, value)?;
+        self.reassemble();
+        Ok(())
+    }
+
+    /// The value of one parameter (see [`Planar::get`]); `None` when the scene has none.
+    pub fn get(&self, p: ParamRef) -> Option<f64> {
+        use ParamId as P;
+        let (t, r, f) = (
+            self.tilt.as_ref(),
+            self.ramp.as_ref(),
+            self.impulse.as_ref(),
+        );
+        match p.id {
+            P::Springs => Some(self.springs),
+            P::Gravity => Some(self.gravity),
+            P::TiltA => t.map(|t| t.a),
+            P::TiltB => t.map(|t| t.b),
+            P::TiltJt => t.map(|t| t.j_t),
+            P::TiltJz => t.map(|t| t.j_z),
+            P::TiltZetaR => t.map(|t| t.zeta_r),
+            P::RampTo => r.map(|r| r.to),
+            P::RampStart => r.map(|r| r.start),
+            P::RampDuration => r.map(|r| r.duration),
+            P::ImpulseAmplitude => f.map(|f| f.amplitude),
+            P::ImpulseT0 => f.map(|f| f.t0),
+            P::ImpulseSharpness => f.map(|f| f.sharpness),
+            P::ImpulseAngle => f.map(|f| f.angle),
+            _ => self.planar.get(p),
         }
     }
 
-    /// Returns a copy with one named parameter changed (scans and continuation): the
-    /// planar balancer's names, `springs`, `gravity`, and the tilt's `a`, `b`, `j_t`,
-    /// `j_z`, `zeta_r`. The copy is rebuilt and revalidated, so the rotor constants
-    /// derived from the tilt follow the change.
-    pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
-        let mut planar = self.planar.clone();
-        let mut springs = self.springs;
-        let mut gravity = self.gravity;
-        let mut tilt = self.tilt.clone();
-        match name {
-            "springs" => springs = value,
-            "gravity" => gravity = value,
-            "a" | "b" | "j_t" | "j_z" | "zeta_r" => {
-                let Some(t) = tilt.as_mut() else {
+    fn set_field(&mut self, p: ParamRef, value: f64) -> Result<()> {
+        use ParamId as P;
+        let missing = |what: &str| {
+            Error::param(
+                p.name(),
+                format!("is a {what} parameter, and the scene has no {what}"),
+            )
+        };
+        let slot: &mut f64 = match p.id {
+            P::Springs => &mut self.springs,
+            P::Gravity => &mut self.gravity,
+            P::TiltA | P::TiltB | P::TiltJt | P::TiltJz | P::TiltZetaR => {
+                let Some(t) = self.tilt.as_mut() else {
                     return Err(Error::param(
-                        name,
+                        p.name(),
                         "is a tilt parameter, and the scene has no tilting disk",
                     ));
                 };
-                match name {
-                    "a" => t.a = value,
-                    "b" => t.b = value,
-                    "j_t" => t.j_t = value,
-                    "j_z" => t.j_z = value,
-                    _ => t.zeta_r = value,
+                match p.id {
+                    P::TiltA => &mut t.a,
+                    P::TiltB => &mut t.b,
+                    P::TiltJt => &mut t.j_t,
+                    P::TiltJz => &mut t.j_z,
+                    _ => &mut t.zeta_r,
+                }
+            }
+            P::RampTo | P::RampStart | P::RampDuration => {
+                let r = self.ramp.as_mut().ok_or_else(|| missing("ramp"))?;
+                match p.id {
+                    P::RampTo => &mut r.to,
+                    P::RampStart => &mut r.start,
+                    _ => &mut r.duration,
+                }
+            }
+            P::ImpulseAmplitude | P::ImpulseT0 | P::ImpulseSharpness | P::ImpulseAngle => {
+                let f = self.impulse.as_mut().ok_or_else(|| missing("impulse"))?;
+                match p.id {
+                    P::ImpulseAmplitude => &mut f.amplitude,
+                    P::ImpulseT0 => &mut f.t0,
+                    P::ImpulseSharpness => &mut f.sharpness,
+                    _ => &mut f.angle,
                 }
             }
             _ => {
-                planar = self.planar.with_param(name, value).map_err(|e| match e {
-                    Error::InvalidParameter {
-                        name: n, message, ..
-                    } if message.starts_with("is not a") => Error::param(
-                        n,
-                        "is not a parameter of the scene (mu, zeta, zeta_b, delta, Omega, \
-                             eta, eta[i], zeta_b[i], springs, gravity; with a tilting disk \
-                             a, b, j_t, j_z, zeta_r)",
-                    ),
-                    e => e,
-                })?
+                debug_assert!(PLANAR_OWNERS.contains(&p.id.spec().owner));
+                return self.planar.set(p, value);
             }
-        }
-        Scene::new(
-            planar,
-            springs,
-            self.ramp.clone(),
-            gravity,
-            self.impulse.clone(),
-            tilt,
-        )
-        .map(|s| s.with_spring_layout(self.spring_layout))
+        };
+        *slot = value;
+        Ok(())
     }
 
     /// `(Omega(t), Omega'(t), theta(t))`, with `theta(0) = 0`.
     #[inline]
     pub fn spin(&self, t: f64) -> (f64, f64, f64) {
-        let w0 = self.planar.omega_s;
-        match &self.ramp {
-            None => (w0, 0.0, w0 * t),
-            Some(r) => {
-                let rate = (r.to - w0) / r.duration;
-                let end = r.start + r.duration;
-                if t < r.start {
-                    (w0, 0.0, w0 * t)
-                } else if t < end {
-                    let u = t - r.start;
-                    (w0 + rate * u, rate, w0 * t + 0.5 * rate * u * u)
-                } else {
-                    let th_end = w0 * end + 0.5 * rate * r.duration * r.duration;
-                    (r.to, 0.0, th_end + r.to * (t - end))
-                }
-            }
-        }
-    }
-
-    /// The ground-frame force on the rotor other than gravity.
-    #[inline]
-    fn load(&self, t: f64) -> (f64, f64) {
-        match &self.impulse {
-            None => (0.0, 0.0),
-            Some(f) => {
-                let a = f.amplitude * (-f.sharpness * (t - f.t0).powi(2)).exp();
-                (a * f.angle.cos(), a * f.angle.sin())
-            }
-        }
-    }
-
-    /// Index of the first ball angle in `q`.
-    #[inline]
-    fn off(&self) -> usize {
-        if self.tilt.is_some() {
-            4
-        } else {
-            2
-        }
-    }
-
-    /// Spring spacing of spring `j` (ball j to ball j + 1, the last one closing the ring).
-    #[inline]
-    fn spacing(&self, q: &[f64], j: usize) -> f64 {
-        let n = self.planar.n_balls();
-        let o = self.off();
-        let rest = 2.0 * PI / n as f64;
-        if j + 1 < n {
-            q[o + 1 + j] - q[o + j] - rest
-        } else {
-            q[o] + 2.0 * PI - q[o + j] - rest
-        }
-    }
-
-    fn add_springs(&self, q: &[f64], out: &mut [f64]) {
-        let p = &self.planar;
-        let (n, o) = (p.n_balls(), self.off());
-        let kd = self.springs * p.delta * p.delta;
-        for j in 0..self.n_springs() {
-            let f = kd * self.spacing(q, j);
-            let b = (j + 1) % n;
-            // dV/db_j = -k s_j, dV/db_{j+1} = +k s_j
-            out[o + j] -= f / p.m(j);
-            out[o + b] += f / p.m(b);
-        }
-    }
-
-    fn add_spring_jacobian(&self, k: &mut [f64]) {
-        let p = &self.planar;
-        let (n, o, d) = (p.n_balls(), self.off(), self.ndof());
-        let kd = self.springs * p.delta * p.delta;
-        for jj in 0..self.n_springs() {
-            let b = (jj + 1) % n;
-            let (ra, rb) = (o + jj, o + b);
-            // Hessian of kd/2 (b_b - b_a - rest)^2, rows divided by the ball's m.
-            let (ma, mb) = (p.m(jj), p.m(b));
-            k[ra * d + ra] += kd / ma;
-            k[ra * d + rb] -= kd / ma;
-            k[rb * d + rb] += kd / mb;
-            k[rb * d + ra] -= kd / mb;
-        }
-    }
-
-    /// The seed-002 load on the disk centre, turned into the rotating frame.
-    fn add_load(&self, t: f64, th: f64, out: &mut [f64]) {
-        let (lx, ly) = self.load(t);
-        if lx != 0.0 || ly != 0.0 {
-            let (sn, cs) = th.sin_cos();
-            out[0] -= cs * lx + sn * ly;
-            out[1] -= -sn * lx + cs * ly;
-        }
-    }
-
-    /// One ball's `(x, y, A, B, b_i)` slice of a tilting state.
-    #[inline]
-    fn ball_view(x: &[f64], i: usize) -> [f64; 5] {
-        [x[0], x[1], x[2], x[3], x[4 + i]]
-    }
-
-    fn tilt_residual(
-        &self,
-        c: &RotorConsts,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        out: &mut [f64],
-    ) {
-        let p = &self.planar;
-        let spin = self.spin(t);
-        rotor_residual(c, spin, q, v, a, out);
-        let mut r = [0.0; 5];
-        for i in 0..p.n_balls() {
-            let (qb, vb, ab) = (
-                Self::ball_view(q, i),
-                Self::ball_view(v, i),
-                Self::ball_view(a, i),
-            );
-            ball_residual(c, p.zeta_b[i], spin, &qb, &vb, &ab, &mut r);
-            let mi = p.m(i);
-            for (o, ri) in out[..4].iter_mut().zip(&r[..4]) {
-                *o += mi * ri;
-            }
-            out[4 + i] = r[4];
-        }
-        if self.springs > 0.0 {
-            self.add_springs(q, out);
-        }
-        self.add_load(t, spin.2, out);
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn tilt_jacobians(
-        &self,
-        cn: &RotorConsts,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        let p = &self.planar;
-        let d = self.ndof();
-        let spin = self.spin(t);
-        k.fill(0.0);
-        c.fill(0.0);
-        m.fill(0.0);
-        let (mut rk, mut rc, mut rm) = ([0.0; 16], [0.0; 16], [0.0; 16]);
-        rotor_jacobians(cn, spin, q, v, a, &mut rk, &mut rc, &mut rm);
-        for (big, block) in [(&mut *k, &rk), (&mut *c, &rc), (&mut *m, &rm)] {
-            Self::set_rotor_block(d, block, big);
-        }
-        let (mut bk, mut bc, mut bm) = ([0.0; 25], [0.0; 25], [0.0; 25]);
-        for i in 0..p.n_balls() {
-            let (qb, vb, ab) = (
-                Self::ball_view(q, i),
-                Self::ball_view(v, i),
-                Self::ball_view(a, i),
-            );
-            ball_jacobians(
-                cn,
-                p.zeta_b[i],
-                spin,
-                &qb,
-                &vb,
-                &ab,
-                &mut bk,
-                &mut bc,
-                &mut bm,
-            );
-            for (big, block) in [(&mut *k, &bk), (&mut *c, &bc), (&mut *m, &bm)] {
-                self.add_ball_block(i, block, big);
-            }
-        }
-        if self.springs > 0.0 {
-            self.add_spring_jacobian(k);
-        }
-    }
-
-    /// Copies the rotor's 4 x 4 block into the top left of a `d x d` matrix.
-    fn set_rotor_block(d: usize, block: &[f64; 16], big: &mut [f64]) {
-        for i in 0..4 {
-            big[i * d..i * d + 4].copy_from_slice(&block[i * 4..i * 4 + 4]);
-        }
-    }
-
-    /// Adds ball `i`'s 5 x 5 block (rows and columns x, y, A, B, b_i) to a `d x d`
-    /// matrix, its rotor rows scaled by the ball's mass (its own row is already over it).
-    fn add_ball_block(&self, i: usize, block: &[f64; 25], big: &mut [f64]) {
-        let d = self.ndof();
-        let mi = self.planar.m(i);
-        let idx = [0, 1, 2, 3, 4 + i];
-        for (r, &row) in idx.iter().enumerate() {
-            let scale = if r < 4 { mi } else { 1.0 };
-            for (s, &col) in idx.iter().enumerate() {
-                big[row * d + col] += scale * block[r * 5 + s];
-            }
-        }
-    }
-
-    /// The tilting model's mass matrix `dF/da` (it depends on `q` only).
-    fn tilt_mass(&self, q: &[f64]) -> DMatrix<f64> {
-        let d = self.ndof();
-        let cn = &self.rotor_consts().expect("tilting scene");
-        let mut m = vec![0.0; d * d];
-        let mut rm = [0.0; 16];
-        rotor_mass(cn, q, &mut rm);
-        Self::set_rotor_block(d, &rm, &mut m);
-        let mut bm = [0.0; 25];
-        for i in 0..self.planar.n_balls() {
-            ball_mass(cn, &Self::ball_view(q, i), &mut bm);
-            self.add_ball_block(i, &bm, &mut m);
-        }
-        DMatrix::from_row_slice(d, d, &m)
-    }
-
-    fn add_effects(&self, t: f64, q: &[f64], out: &mut [f64]) {
-        let p = &self.planar;
-        let n = p.n_balls();
-        let (_, dom, th) = self.spin(t);
-        if dom != 0.0 {
-            let (x, y) = (q[0], q[1]);
-            out[0] -= dom * y;
-            out[1] += dom * (x + p.mu);
-            for i in 0..n {
-                let (s, c) = q[2 + i].sin_cos();
-                let mi = p.m(i);
-                out[0] -= mi * dom * s;
-                out[1] += mi * dom * c;
-                out[2 + i] += dom * (p.delta + x * c + y * s);
-            }
-        }
-        if self.springs > 0.0 {
-            self.add_springs(q, out);
-        }
-        self.add_load(t, th, out);
-        if self.gravity != 0.0 {
-            let (sn, cs) = th.sin_cos();
-            out[0] += sn * self.gravity;
-            out[1] += cs * self.gravity;
-            for i in 0..n {
-                out[2 + i] += self.gravity * (th + q[2 + i]).cos();
-            }
-        }
+        self.model.drive().spin(t).tuple()
     }
 }
 
 impl Dynamics for Scene {
+    #[inline]
     fn ndof(&self) -> usize {
-        self.planar.ndof() + if self.tilt.is_some() { 2 } else { 0 }
+        self.model.ndof()
     }
 
-    fn first_ball(&self) -> usize {
-        self.off()
+    fn layout(&self) -> Layout {
+        self.model.layout()
     }
 
     fn angles_modulo_turns(&self) -> bool {
-        self.springs == 0.0
+        self.model.angles_modulo_turns()
     }
 
+    #[inline]
     fn residual(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
-        if let Some(c) = &self.rotor_consts() {
-            return self.tilt_residual(c, t, q, v, a, out);
-        }
-        let (om, _, _) = self.spin(t);
-        self.planar.forces_at(om, q, v, out);
-        self.planar.add_inertia(q, a, out);
-        self.add_effects(t, q, out);
+        self.model.residual(t, q, v, a, out)
     }
 
+    #[inline]
     fn jacobians(
         &self,
         t: f64,
@@ -576,95 +439,37 @@ impl Dynamics for Scene {
         c: &mut [f64],
         m: &mut [f64],
     ) {
-        if let Some(cn) = &self.rotor_consts() {
-            return self.tilt_jacobians(cn, t, q, v, a, k, c, m);
-        }
-        let p = &self.planar;
-        let (om, dom, th) = self.spin(t);
-        p.jacobians_at(om, q, v, a, k, c, m);
-        let n = p.n_balls();
-        let d = n + 2;
-        if dom != 0.0 {
-            k[1] -= dom;
-            k[d] += dom;
-            for i in 0..n {
-                let j = 2 + i;
-                let (s, cs) = q[j].sin_cos();
-                let mi = p.m(i);
-                k[j] -= mi * dom * cs;
-                k[d + j] -= mi * dom * s;
-                k[j * d] += dom * cs;
-                k[j * d + 1] += dom * s;
-                k[j * d + j] += dom * (-q[0] * s + q[1] * cs);
-            }
-        }
-        if self.springs > 0.0 {
-            self.add_spring_jacobian(k);
-        }
-        if self.gravity != 0.0 {
-            for i in 0..n {
-                let j = 2 + i;
-                k[j * d + j] -= self.gravity * (th + q[j]).sin();
-            }
-        }
+        self.model.jacobians(t, q, v, a, k, c, m)
     }
 
+    #[inline]
     fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]) {
-        if self.tilt.is_none() {
-            return self.planar.solve_mass(t, q, rhs);
-        }
-        self.solve_mass_columns(t, q, rhs);
+        self.model.solve_mass(t, q, rhs)
     }
 
+    #[inline]
     fn solve_mass_columns(&self, t: f64, q: &[f64], cols: &mut [f64]) {
-        if self.tilt.is_none() {
-            return self.planar.solve_mass_columns(t, q, cols);
-        }
-        let d = self.ndof();
-        // M is the kinetic-energy Hessian with rows scaled: never singular.
-        let lu = self.tilt_mass(q).lu();
-        let mut b = DMatrix::from_column_slice(d, cols.len() / d, cols);
-        lu.solve_mut(&mut b);
-        cols.copy_from_slice(b.as_slice());
+        self.model.solve_mass_columns(t, q, cols)
     }
 
+    #[inline]
     fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let d = self.ndof();
-        let zero = [0.0; 16];
-        let heap: Vec<f64>;
-        let a: &[f64] = if d <= 16 {
-            &zero[..d]
-        } else {
-            heap = vec![0.0; d];
-            &heap
-        };
-        self.residual(t, q, v, a, out);
-        for o in out.iter_mut() {
-            *o = -*o;
-        }
-        self.solve_mass(t, q, out);
+        self.model.accel(t, q, v, out)
     }
 
     fn time_dependence(&self) -> Option<String> {
-        if self.ramp.is_some() {
-            Some("ramp".into())
-        } else if self.gravity != 0.0 {
-            Some("gravity".into())
-        } else if self.impulse.is_some() {
-            Some("impulse".into())
-        } else {
-            None
-        }
+        self.model.time_dependence()
     }
 
     fn base_spin(&self) -> f64 {
-        self.planar.omega_s
+        self.model.base_spin()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     fn planar() -> Planar {
         Planar::new(0.2, 0.05, &[0.07, 0.05, 0.06], 50.0, 1.3, &[0.9, 1.1, 0.8]).unwrap()
@@ -830,7 +635,10 @@ mod tests {
         let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
         let (mut k, mut c, mut m) = (vec![0.0; 49], vec![0.0; 49], vec![0.0; 49]);
         s.jacobians(0.8, &q, &v, &v, &mut k, &mut c, &mut m);
-        let alone = s.tilt_mass(&q);
+        let Assembly::Composed(model) = &s.model else {
+            panic!("a tilting scene is a composed model")
+        };
+        let alone = model.mass_matrix(0.8, &q);
         for i in 0..7 {
             for j in 0..7 {
                 assert!((alone[(i, j)] - m[i * 7 + j]).abs() < 1e-14, "[{i}][{j}]");

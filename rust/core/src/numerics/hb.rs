@@ -301,8 +301,16 @@ impl HbSolution {
     /// [`Self::tail`] relative to the support's first-harmonic amplitude (at least 1): a
     /// series whose last harmonic is as large as its motion has not resolved the orbit
     /// (such "solutions" appear where a rotating branch creeps towards omega = 0).
+    /// The support is coordinates 0 and 1, as in every layout the core builds; with a
+    /// model at hand, [`Self::tail_ratio_on`] its `layout().support()`.
     pub fn tail_ratio(&self) -> f64 {
-        let amp = (0..2)
+        self.tail_ratio_on(crate::model::Layout::planar(0).support())
+    }
+
+    /// [`Self::tail_ratio`] relative to the motion of the coordinates `support`.
+    pub fn tail_ratio_on(&self, support: [usize; 2]) -> f64 {
+        let amp = support
+            .into_iter()
             .map(|j| {
                 let c = self.coord(j);
                 c[1].hypot(c[2])
@@ -360,7 +368,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             d,
             basis,
             winding: winding.to_vec(),
-            phase_coord: rot.unwrap_or(0),
+            phase_coord: rot.unwrap_or(model.layout().x),
             phase_rotating: rot.is_some(),
             q: vec![0.0; s * d],
             qt: vec![0.0; s * d],
