@@ -6,6 +6,7 @@ use crate::equilibria::{
     analyse_all, analyse_model, equal_balls, equilibria, equilibria_in_track_order, equilibria_of,
     newton_static, Equilibrium, EquilibriumKind,
 };
+use crate::model::assembly::Assembly;
 use crate::model::{Dynamics, Scene};
 use std::f64::consts::PI;
 
@@ -72,9 +73,11 @@ pub fn scene_equilibria(sc: &Scene) -> Vec<Equilibrium> {
     let p = &sc.planar;
     let equal = equal_balls(p);
     if sc.springs == 0.0 {
-        return match sc.tilt {
-            None => equilibria(p),
-            Some(_) => equilibria_of(sc, equal, true),
+        // The closed forms and lattice of `equilibria` are the planar disk's on the
+        // isotropic support: any other assembly gets the general search.
+        return match sc.model() {
+            Assembly::Planar(_) => equilibria(p),
+            _ => equilibria_of(sc, equal, true),
         };
     }
     let balanced = balanced_q(sc);

@@ -193,6 +193,9 @@ pub struct Periodic {
     pub target_met: Option<bool>,
     /// Hill's-method multipliers and verdict, when asked for and computable.
     pub hill: Option<(Vec<(f64, f64)>, Stability)>,
+    /// The series' tail relative to the support's motion ([`HbSolution::tail_ratio_on`]
+    /// the model's layout).
+    pub tail: f64,
 }
 
 impl Periodic {
@@ -273,7 +276,7 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
             loop {
                 sol = refine(p, sol, &opts.hb, a);
                 (fl, fl_err) = run_floquet(&sol);
-                let tail_ok = sol.tail_ratio() <= a.target;
+                let tail_ok = sol.tail_ratio_on(p.layout().support()) <= a.target;
                 let triv_ok = fl
                     .as_ref()
                     .is_none_or(|f| f.trivial_error <= a.target.max(floor));
@@ -327,6 +330,7 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
     } else {
         None
     };
+    let tail = sol.tail_ratio_on(p.layout().support());
     Periodic {
         sol,
         closure,
@@ -334,6 +338,7 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
         floquet_error: fl_err,
         target_met,
         hill,
+        tail,
     }
 }
 
@@ -368,7 +373,10 @@ pub fn refine<D: Dynamics + ?Sized>(
     a: &AutoHarmonics,
 ) -> HbSolution {
     let mut sol = sol;
-    while sol.status == Status::Converged && sol.tail_ratio() > a.target && sol.n_harm < a.n_max {
+    while sol.status == Status::Converged
+        && sol.tail_ratio_on(p.layout().support()) > a.target
+        && sol.n_harm < a.n_max
+    {
         match more_harmonics(p, &sol, hb, a) {
             Some(s) => sol = s,
             // Keep the last converged solution; the caller sees the target unmet.

@@ -63,7 +63,7 @@ pub fn solution_cells(r: &Periodic) -> [Cell; 19] {
         Cell::V(part(|z| z.0)),
         Cell::V(part(|z| z.1)),
         Cell::F(Some(s.residual)),
-        Cell::F(Some(s.tail_ratio())),
+        Cell::F(Some(r.tail)),
         Cell::F(r.closure),
         Cell::F(fl.and_then(|f| f.separation_error)),
         Cell::F(Some(s.pivot_ratio)),

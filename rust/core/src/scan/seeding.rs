@@ -85,7 +85,7 @@ pub(super) fn run_seeds<D: Family>(
             // This point's own states: "at rest in the ground frame" depends on its spin.
             let y0 = &initial_states(model)[starts[s]];
             let g = guess_from_state(model, y0, None, n_harm, &spec.opts.guess)?;
-            let rot: Vec<bool> = g.winding[model.first_ball()..]
+            let rot: Vec<bool> = g.winding[model.layout().balls()]
                 .iter()
                 .map(|w| *w != 0.0)
                 .collect();
@@ -94,7 +94,7 @@ pub(super) fn run_seeds<D: Family>(
             if !accept(model, &sol, &g, spec) {
                 return None;
             }
-            let key = orbit_key(&sol);
+            let key = orbit_key(&sol, model.layout().support());
             let res = finish(model, sol, &spec.opts);
             if res.sol.status != Status::Converged {
                 return None;

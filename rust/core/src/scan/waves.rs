@@ -42,7 +42,8 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
         f.parent
     }
     fn key(&self, p: &HbSolution) -> Vec<f64> {
-        orbit_key(p)
+        // every point of a block has the base model's layout
+        orbit_key(p, self.spec.base.layout().support())
     }
     fn found_key(f: &Found) -> &Vec<f64> {
         &f.key
@@ -88,7 +89,7 @@ pub(super) fn accept<D: Family>(
 ) -> bool {
     if !(s.status == Status::Converged
         && s.winding == guess.winding
-        && s.tail_ratio() <= spec.max_tail)
+        && s.tail_ratio_on(model.layout().support()) <= spec.max_tail)
     {
         return false;
     }
@@ -115,12 +116,12 @@ pub(super) fn admit(have: &[Found], pattern: usize, key: &[f64]) -> bool {
 /// Phase-free description of an orbit: omega, the sorted windings, and the amplitude
 /// of every harmonic of the support motion (a time shift changes only phases, and
 /// swapping identical balls does not change x, y).
-pub(super) fn orbit_key(s: &HbSolution) -> Vec<f64> {
+pub(super) fn orbit_key(s: &HbSolution, support: [usize; 2]) -> Vec<f64> {
     let mut key = vec![s.omega];
     let mut w: Vec<f64> = s.winding.clone();
     w.sort_by(f64::total_cmp);
     key.extend(w);
-    let (cx, cy) = (s.coord(0), s.coord(1));
+    let (cx, cy) = (s.coord(support[0]), s.coord(support[1]));
     key.push(cx[0].hypot(cy[0]));
     for m in 1..=s.n_harm {
         let (i, j) = (2 * m - 1, 2 * m);
