@@ -3,7 +3,7 @@
 Run from the repository root: ``python scripts/derive_tilt.py`` (needs sympy). It
 rewrites ``rust/core/src/model/tilt_terms.rs``; the tests check the result against a
 closed-form whirl spectrum, the planar model and the energy integral, and
-``tests/test_scenes.py`` reruns this script when sympy is installed to check the
+``tests/test_tilt.py`` reruns this script when sympy is installed to check the
 committed file is what the derivation gives.
 
 Coordinates (nondimensional as in ``model.md``: lengths over ``e``, time over
