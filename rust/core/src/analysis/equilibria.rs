@@ -813,7 +813,7 @@ mod tests {
         use crate::numerics::problem::tangent;
         // dF/dq against central differences, at an arbitrary point of three unequal balls.
         let p3 = Planar::new(0.2, 0.05, &[0.1], 50.0, 1.4, &[0.4, 0.6, 0.5]).unwrap();
-        let mut prob = EquilibriumProblem::new(ModelAt::family(&p3, "Omega", 1.4));
+        let mut prob = EquilibriumProblem::new(ModelAt::family_of(&p3, "Omega").unwrap());
         let q = [0.01, -0.02, 0.3, 2.0, -2.5];
         let n = prob.size();
         let (mut r, mut jac) = (vec![0.0; n], vec![0.0; n * n]);

@@ -4,6 +4,7 @@
 
 use crate::equilibria::{equilibria, Equilibrium, EquilibriumKind};
 use crate::error::Result;
+use crate::model::ParamRef;
 use crate::numerics::problem::Parametric;
 use crate::{Planar, Scene};
 
@@ -17,6 +18,9 @@ pub trait Family: Parametric {
 impl Parametric for Planar {
     fn with_param(&self, name: &str, value: f64) -> Result<Self> {
         Planar::with_param(self, name, value)
+    }
+    fn param_value(&self, name: &str) -> Result<f64> {
+        registry_value(name, ParamRef::parse(name).and_then(|p| self.get(p)))
     }
 }
 
@@ -32,10 +36,18 @@ impl Parametric for Scene {
     fn with_param(&self, name: &str, value: f64) -> Result<Self> {
         Scene::with_param(self, name, value)
     }
+    fn param_value(&self, name: &str) -> Result<f64> {
+        registry_value(name, ParamRef::parse(name).and_then(|p| self.get(p)))
+    }
 }
 
 impl Family for Scene {
     fn balance(&self) -> Option<Equilibrium> {
         crate::analysis::balanced::balanced_state(self)
     }
+}
+
+/// A parameter's value looked up in the registry, or an error naming it.
+fn registry_value(name: &str, v: Option<f64>) -> Result<f64> {
+    v.ok_or_else(|| crate::Error::param(name, "is not a parameter of this model"))
 }

@@ -12,6 +12,8 @@ use crate::model::Dynamics;
 pub trait Parametric: Dynamics + Clone {
     /// A copy with the parameter `name` set to `value`, validated.
     fn with_param(&self, name: &str, value: f64) -> Result<Self>;
+    /// The current value of the parameter `name` (the names `with_param` takes).
+    fn param_value(&self, name: &str) -> Result<f64>;
 }
 
 /// A square system `F(x, p) = 0`: `size()` unknowns and as many equations.
@@ -75,6 +77,14 @@ impl<'a, D: Dynamics + ?Sized> ModelAt<'a, D> {
             vary: None,
             cached: None,
         }
+    }
+
+    /// The family of `base` in the parameter `name`, at the value `base` has.
+    pub fn family_of(base: &'a D, name: &'a str) -> Result<Self>
+    where
+        D: Parametric + 'a,
+    {
+        Ok(Self::family(base, name, base.param_value(name)?))
     }
 
     /// The family of `base` in the parameter `name`, whose value in `base` is `value`.
