@@ -54,6 +54,14 @@ def _num(where: str, v: Any) -> float:
     return _check.real(where, v, finite=True)
 
 
+def _core_check(**part: Any) -> None:
+    """A scene part's ranges, checked by the core (where they are defined once) when the
+    part is made: the default balancer with only this part switched on."""
+    from . import _native
+
+    _native.validate(Scene(**part))
+
+
 @dataclass(frozen=True)
 class Ramp:
     to: float
@@ -63,8 +71,7 @@ class Ramp:
     def __post_init__(self) -> None:
         for f in fields(self):
             object.__setattr__(self, f.name, _num(f"ramp.{f.name}", getattr(self, f.name)))
-        _check.real("ramp.to", self.to, 0.0, lo_open=True)
-        _check.real("ramp.duration", self.duration, 0.0, lo_open=True)
+        _core_check(ramp=self)
 
 
 @dataclass(frozen=True)
@@ -77,7 +84,7 @@ class Impulse:
     def __post_init__(self) -> None:
         for f in fields(self):
             object.__setattr__(self, f.name, _num(f"impulse.{f.name}", getattr(self, f.name)))
-        _check.real("impulse.sharpness", self.sharpness, 0.0, lo_open=True)
+        _core_check(impulse=self)
 
 
 @dataclass(frozen=True)
@@ -102,13 +109,7 @@ class Tilt:
     def __post_init__(self) -> None:
         for f in fields(self):
             object.__setattr__(self, f.name, _num(f"tilt.{f.name}", getattr(self, f.name)))
-        for name in ("a", "b", "j_t"):
-            _check.real(f"tilt.{name}", getattr(self, name), 0.0, lo_open=True)
-        if not 0 <= self.j_z <= 2 * self.j_t:
-            raise ParameterError("tilt.j_z", f"must be in [0, 2 j_t] = [0, {2 * self.j_t}] (a "
-                                 "rigid body's polar moment is at most the sum of the other "
-                                 f"two), got {self.j_z}", allowed=f"[0, {2 * self.j_t}]")
-        _check.real("tilt.zeta_r", self.zeta_r, 0.0)
+        _core_check(tilt=self)
 
     @property
     def kappa_c(self) -> float:
