@@ -108,24 +108,6 @@ impl Dynamics for PlanarAssembly {
         self.core.planar.solve_mass_columns(t, q, cols)
     }
 
-    #[inline]
-    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let d = self.ndof();
-        let zero = [0.0; 16];
-        let heap: Vec<f64>;
-        let a: &[f64] = if d <= 16 {
-            &zero[..d]
-        } else {
-            heap = vec![0.0; d];
-            &heap
-        };
-        self.residual(t, q, v, a, out);
-        for o in out.iter_mut() {
-            *o = -*o;
-        }
-        self.solve_mass(t, q, out);
-    }
-
     fn time_dependence(&self) -> Option<String> {
         self.drive
             .time_dependence()

@@ -461,23 +461,6 @@ impl Dynamics for Composed {
         }
     }
 
-    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        let d = self.ndof();
-        let zero = [0.0; 16];
-        let heap: Vec<f64>;
-        let a: &[f64] = if d <= 16 {
-            &zero[..d]
-        } else {
-            heap = vec![0.0; d];
-            &heap
-        };
-        self.residual(t, q, v, a, out);
-        for o in out.iter_mut() {
-            *o = -*o;
-        }
-        self.solve_mass(t, q, out);
-    }
-
     fn time_dependence(&self) -> Option<String> {
         self.components()
             .find_map(|c| c.time_dependence())

@@ -61,8 +61,24 @@ pub trait Dynamics: Send + Sync {
             self.solve_mass(t, q, c);
         }
     }
-    /// Accelerations solving `F(t, q, v, a) = 0`: `a = -M^-1 F(t, q, v, 0)`.
-    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]);
+    /// Accelerations solving `F(t, q, v, a) = 0`: `a = -M^-1 F(t, q, v, 0)` (`F` is
+    /// affine in `a`). Models with a cheaper route override it.
+    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        let d = self.ndof();
+        let zero = [0.0; 16];
+        let heap: Vec<f64>;
+        let a: &[f64] = if d <= 16 {
+            &zero[..d]
+        } else {
+            heap = vec![0.0; d];
+            &heap
+        };
+        self.residual(t, q, v, a, out);
+        for o in out.iter_mut() {
+            *o = -*o;
+        }
+        self.solve_mass(t, q, out);
+    }
     /// `None` when the equations do not depend on `t`; otherwise the effect responsible.
     fn time_dependence(&self) -> Option<String> {
         None
