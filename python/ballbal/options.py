@@ -262,6 +262,11 @@ _LEGACY: dict[str, tuple[str, str]] = {
 }
 
 
+# Options built from keywords, by (options, keywords): a loop of small solves with the
+# same keywords pays for the dataclasses' checks once, not on every call.
+_BUILT: dict[Any, Any] = {}
+
+
 def with_keywords(options: Any, where: str, kwargs: dict[str, Any],
                   allowed: frozenset[str]) -> Any:
     """``options`` with the keyword arguments of the flat, older interface applied.
@@ -272,6 +277,23 @@ def with_keywords(options: Any, where: str, kwargs: dict[str, Any],
             raise TypeError(f"{where}() got an unexpected keyword argument {k!r}")
     if not kwargs:
         return options
+    try:
+        # types are part of the key: 1 and 1.0 and True are equal and hash alike
+        key: Any = (options, tuple((k, type(v), v) for k, v in sorted(kwargs.items())))
+        hit = _BUILT.get(key)
+    except TypeError:  # an unhashable value (a list): build it every time
+        key, hit = None, None
+    if hit is not None:
+        return hit
+    built = _with_keywords(options, kwargs)
+    if key is not None:
+        if len(_BUILT) >= 256:
+            _BUILT.clear()
+        _BUILT[key] = built
+    return built
+
+
+def _with_keywords(options: Any, kwargs: dict[str, Any]) -> Any:
     kw = dict(kwargs)
     if "guess_rtol" in kw and "guess_atol" not in kw:
         r = _check.real("guess_rtol", kw["guess_rtol"])
