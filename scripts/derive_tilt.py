@@ -27,7 +27,8 @@ translational spring and damper, ``(x^2 + y^2)/2`` and ``zeta |C'|^2`` (C's grou
 velocity), are not here: the support is a component of its own
 (``rust/core/src/model/components/support.rs``) that adds them to rows x, y. One ball
 (its mass factored out, so its own row is the ball's equation over its mass, as in the
-planar model): point mass ``1/delta`` at ``C + delta (cos phi E1 + sin phi E2)``, track drag ``zb delta phi'^2``.
+planar model): point mass ``1/delta`` at ``C + delta (cos phi E1 + sin phi E2)``,
+track drag ``zb delta phi'^2``.
 """
 
 from __future__ import annotations
