@@ -15,7 +15,7 @@ use ballbal_core::periodic::{
 };
 use ballbal_core::scan::{Family, ScanRow, ScanSpec};
 use ballbal_core::simulate::simulate as core_simulate;
-use ballbal_core::{cancel, Dynamics, Error};
+use ballbal_core::{cancel, Dynamics, Error, Scene};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -113,7 +113,6 @@ pub fn balanced_states<'py>(
     py: Python<'py>,
     models: Vec<ModelArgs>,
 ) -> PyResult<Vec<Option<Bound<'py, PyDict>>>> {
-    use rayon::prelude::*;
     let mut scenes = Vec::with_capacity(models.len());
     for m in &models {
         match autonomous(m, true, "balanced_state")? {
@@ -121,26 +120,33 @@ pub fn balanced_states<'py>(
             Model::Planar(_) => unreachable!("built as a scene"),
         }
     }
-    // Each point is solved on its own from the planar perfect balance, so the result
-    // does not depend on the thread count.
-    let eqs = guarded(py, || {
+    let eqs = each_scene(
+        py,
+        &scenes,
+        ballbal_core::analysis::balanced::balanced_state,
+    )?;
+    eqs.into_iter()
+        .map(|e| e.flatten().map(|e| equilibrium_dict(py, e)).transpose())
+        .collect()
+}
+
+/// `f` on every scene in parallel, off the GIL. Each point is solved on its own, so the
+/// result does not depend on the thread count. Points are short: once cancelled, the
+/// points not yet started are skipped (`None`), and `guarded` raises the interrupt.
+fn each_scene<T: Send>(
+    py: Python<'_>,
+    scenes: &[Scene],
+    f: impl Fn(&Scene) -> T + Sync,
+) -> PyResult<Vec<Option<T>>> {
+    use rayon::prelude::*;
+    guarded(py, || {
         // rayon's threads do not inherit the cancellation token: hand it on.
         let tok = cancel::current();
         Ok(scenes
             .par_iter()
-            .map(|s| {
-                // Each point is short: stop between points once cancelled.
-                cancel::with(tok.clone(), || {
-                    (!cancel::cancelled())
-                        .then(|| ballbal_core::analysis::balanced::balanced_state(s))
-                        .flatten()
-                })
-            })
-            .collect::<Vec<_>>())
-    })?;
-    eqs.into_iter()
-        .map(|e| e.map(|e| equilibrium_dict(py, e)).transpose())
-        .collect()
+            .map(|s| cancel::with(tok.clone(), || (!cancel::cancelled()).then(|| f(s))))
+            .collect())
+    })
 }
 
 /// One point of [`balance_map`]: its status and the balanced state, if any.
@@ -159,8 +165,6 @@ pub fn balance_map<'py>(
     points: Vec<Vec<f64>>,
 ) -> PyResult<Vec<MapPoint<'py>>> {
     use ballbal_core::analysis::balanced::balanced_state;
-    use ballbal_core::Scene;
-    use rayon::prelude::*;
     let Model::Scene(base) = autonomous(&model, true, "balance_map")? else {
         unreachable!("built as a scene")
     };
@@ -175,35 +179,26 @@ pub fn balance_map<'py>(
         }
         scenes.push(s);
     }
-    let found = guarded(py, || {
-        let tok = cancel::current();
-        Ok(scenes
-            .par_iter()
-            .map(|s| {
-                cancel::with(tok.clone(), || {
-                    if cancel::cancelled() {
-                        return ("cancelled", None);
-                    }
-                    match balanced_state(s) {
-                        Some(e) => ("ok", Some(e)),
-                        None => {
-                            // the planar disk of this point, no effects: can it balance?
-                            let plain = Scene::new(s.planar.clone(), 0.0, None, 0.0, None, None)
-                                .ok()
-                                .and_then(|p| balanced_state(&p));
-                            match plain {
-                                Some(_) => ("not_converged", None),
-                                None => ("no_balance", None),
-                            }
-                        }
-                    }
-                })
-            })
-            .collect::<Vec<_>>())
+    let found = each_scene(py, &scenes, |s| match balanced_state(s) {
+        Some(e) => ("ok", Some(e)),
+        None => {
+            // the planar disk of this point, no effects: can it balance?
+            let plain = Scene::new(s.planar.clone(), 0.0, None, 0.0, None, None)
+                .ok()
+                .and_then(|p| balanced_state(&p));
+            match plain {
+                Some(_) => ("not_converged", None),
+                None => ("no_balance", None),
+            }
+        }
     })?;
     found
         .into_iter()
-        .map(|(st, e)| Ok((st, e.map(|e| equilibrium_dict(py, e)).transpose()?)))
+        // every point ran: a cancelled run raised in `each_scene`
+        .map(|p| {
+            let (st, e) = p.expect("every point ran");
+            Ok((st, e.map(|e| equilibrium_dict(py, e)).transpose()?))
+        })
         .collect()
 }
 
