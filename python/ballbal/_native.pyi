@@ -9,13 +9,15 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from .bearing import Bearing
 from .model import Balancer
 from .options import PeriodicOptions, ScanOptions
 from .scene import Scene
 
 __all__ = [
     "simulate", "validate", "equilibria", "balanced_states", "periodic", "orbit_closure",
-    "balance_map", "scan", "default_chunk", "certificate_seconds", "__version__",
+    "balance_map", "scan", "default_chunk", "certificate_seconds", "validate_bearing",
+    "__version__",
 ]
 
 __version__: str
@@ -26,6 +28,7 @@ def simulate(
     t_eval: npt.NDArray[np.float64], rtol: float, atol: list[float], max_steps: int,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
 def validate(model: Balancer | Scene) -> None: ...
+def validate_bearing(bearing: Bearing) -> None: ...
 def equilibria(model: Balancer | Scene) -> list[dict[str, Any]]: ...
 def balanced_states(models: Sequence[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
 # (status, equilibrium dict or None) per point: "ok", "no_balance" or "not_converged"

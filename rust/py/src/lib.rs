@@ -5,6 +5,7 @@
 //! off the GIL, with panics contained and Ctrl-C working). This file only builds the
 //! module.
 
+mod bearing;
 mod convert;
 mod entries;
 mod errors;
@@ -61,6 +62,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::scan, m)?)?;
     m.add_function(wrap_pyfunction!(entries::default_chunk, m)?)?;
     m.add_function(wrap_pyfunction!(entries::certificate_seconds, m)?)?;
+    m.add_function(wrap_pyfunction!(bearing::validate_bearing, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

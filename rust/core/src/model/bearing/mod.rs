@@ -71,23 +71,30 @@ impl Grooves {
     pub fn validate(&self) -> Result<()> {
         if self.count == 0 {
             return Err(Error::param_range(
-                "groove_count",
+                "grooves.count",
                 "must be at least 1",
                 "integer >= 1",
             ));
         }
         check_range(
-            "groove_angle",
+            "grooves.angle",
             self.angle.to_degrees(),
             0.0,
             true,
             90.0,
             true,
         )?;
-        check_range("groove_depth", self.depth, 0.0, false, f64::INFINITY, true)?;
-        check_range("groove_width", self.width, 0.0, true, 1.0, true)?;
         check_range(
-            "groove_length_fraction",
+            "grooves.depth_ratio",
+            self.depth,
+            0.0,
+            false,
+            f64::INFINITY,
+            true,
+        )?;
+        check_range("grooves.width_ratio", self.width, 0.0, true, 1.0, true)?;
+        check_range(
+            "grooves.grooved_length",
             self.length_fraction,
             0.0,
             true,
@@ -157,7 +164,7 @@ impl Bearing {
     }
 
     pub fn validate(&self) -> Result<()> {
-        check_range("lambda", self.lambda, 0.0, true, f64::INFINITY, true)?;
+        check_range("length_ratio", self.lambda, 0.0, true, f64::INFINITY, true)?;
         if let Some(g) = &self.grooves {
             g.validate()?;
         }
@@ -181,14 +188,14 @@ impl Bearing {
             FilmModel::Finite { n_theta, n_zeta } => {
                 if n_theta < 8 {
                     return Err(Error::param_range(
-                        "n_theta",
+                        "grid.n_theta",
                         format!("must be at least 8, got {n_theta}"),
                         "integer >= 8",
                     ));
                 }
                 if n_zeta < 2 || n_zeta % 2 != 0 {
                     return Err(Error::param_range(
-                        "n_zeta",
+                        "grid.n_zeta",
                         format!("must be even and at least 2 (cells must not straddle the mid-plane), got {n_zeta}"),
                         "even integer >= 2",
                     ));
@@ -196,7 +203,7 @@ impl Bearing {
                 if let Some(g) = &self.grooves {
                     if n_theta % g.count != 0 || n_theta / g.count < MIN_CELLS_PER_PITCH {
                         return Err(Error::param_range(
-                            "n_theta",
+                            "grid.n_theta",
                             format!(
                                 "must be a multiple of the groove count {} with at least {} cells per groove pitch, got {n_theta}",
                                 g.count, MIN_CELLS_PER_PITCH
@@ -207,7 +214,7 @@ impl Bearing {
                     let per_pitch = (n_theta / g.count) as f64;
                     if g.width * per_pitch < 1.0 || (1.0 - g.width) * per_pitch < 1.0 {
                         return Err(Error::param_range(
-                            "n_theta",
+                            "grid.n_theta",
                             format!(
                                 "{per_pitch} cells per pitch cannot resolve a groove width ratio of {}; refine the grid",
                                 g.width

@@ -657,10 +657,19 @@ fn bearing_bad_input_names_the_parameter() {
     };
     let g = herringbone(1.0, GrooveSide::Sleeve);
     let cases = [
-        (with(Grooves { depth: -0.1, ..g }, fin), "groove_depth"),
-        (with(Grooves { width: 0.0, ..g }, fin), "groove_width"),
-        (with(Grooves { width: 1.0, ..g }, fin), "groove_width"),
-        (with(Grooves { angle: 0.0, ..g }, fin), "groove_angle"),
+        (
+            with(Grooves { depth: -0.1, ..g }, fin),
+            "grooves.depth_ratio",
+        ),
+        (
+            with(Grooves { width: 0.0, ..g }, fin),
+            "grooves.width_ratio",
+        ),
+        (
+            with(Grooves { width: 1.0, ..g }, fin),
+            "grooves.width_ratio",
+        ),
+        (with(Grooves { angle: 0.0, ..g }, fin), "grooves.angle"),
         (
             with(
                 Grooves {
@@ -669,10 +678,10 @@ fn bearing_bad_input_names_the_parameter() {
                 },
                 fin,
             ),
-            "groove_angle",
+            "grooves.angle",
         ),
-        (with(Grooves { angle: 2.0, ..g }, fin), "groove_angle"),
-        (with(Grooves { count: 0, ..g }, fin), "groove_count"),
+        (with(Grooves { angle: 2.0, ..g }, fin), "grooves.angle"),
+        (with(Grooves { count: 0, ..g }, fin), "grooves.count"),
         (
             with(
                 g,
@@ -681,7 +690,7 @@ fn bearing_bad_input_names_the_parameter() {
                     n_zeta: 32,
                 },
             ),
-            "n_theta",
+            "grid.n_theta",
         ),
         (
             with(
@@ -691,7 +700,7 @@ fn bearing_bad_input_names_the_parameter() {
                     n_zeta: 32,
                 },
             ),
-            "n_theta",
+            "grid.n_theta",
         ),
         (
             with(
@@ -701,10 +710,10 @@ fn bearing_bad_input_names_the_parameter() {
                     n_zeta: 15,
                 },
             ),
-            "n_zeta",
+            "grid.n_zeta",
         ),
         (with(g, FilmModel::Short), "model"),
-        (Bearing::plain(-1.0, FilmModel::Short), "lambda"),
+        (Bearing::plain(-1.0, FilmModel::Short), "length_ratio"),
         (
             Bearing {
                 cavitation: Cavitation::Reynolds,
