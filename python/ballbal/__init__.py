@@ -1,6 +1,6 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
-from . import exceptions
+from . import data, exceptions
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -54,6 +54,7 @@ __all__ = [
     "balanced_state",
     "disturbance_response",
     "equilibria",
+    "data",
     "exceptions",
     "from_seed003",
     "load_scene",
