@@ -381,3 +381,32 @@ def test_waterfall_table_and_plots(rr, tmp_path):
     ax2 = sp.plot_spectrum(sol.spectrum())
     ax2.figure.savefig(tmp_path / "s.png")
     assert ax.get_ylabel() == "Omega" and (tmp_path / "s.png").stat().st_size > 0
+
+
+def test_ground_signal_during_a_ramp_matches_the_ground_frame_equations():
+    """The disk's rate theta' is read off the theta column: during a run-up the
+    accelerations still agree with the independent ground-frame formulation."""
+    b = ballbal.Balancer(**THESIS, zeta=0.05, zeta_b=0.05, Omega=1.0, eta=(0.7, 0.7))
+    ramp = ballbal.Ramp(to=1.6, start=5.0, duration=20.0)
+    sc = ballbal.Scene(balancer=b, ramp=ramp)
+    h = 0.01
+    sim = ballbal.simulate(sc, None, np.arange(0.0, 30.0, h), rtol=1e-12, atol=1e-14)
+    g = sp.ground_signal(sim, "acceleration")
+    rate = (ramp.to - b.Omega) / ramp.duration
+    n = b.n_balls
+    worst = 0.0
+    rows = sim.slice(4, sim.height - 8)  # ground_signal's rows: two trimmed per end, twice
+    for r, (X2, Y2) in zip(rows.iter_rows(named=True), g.select("X", "Y").iter_rows(),
+                           strict=True):
+        t = r["t"]
+        if min(abs(t - ramp.start), abs(t - ramp.start - ramp.duration)) < 4.5 * h:
+            continue  # the rate has kinks: the two nested difference formulas span 4 h
+        w = b.Omega + rate * min(max(t - ramp.start, 0.0), ramp.duration)
+        rot = complex(math.cos(r["theta"]), math.sin(r["theta"]))
+        z = complex(r["x"], r["y"])
+        Z, V = rot * z, rot * (complex(r["dx"], r["dy"]) + 1j * w * z)
+        s = np.array([Z.real, Z.imag, *[r["theta"] + r[f"b{i + 1}"] for i in range(n)],
+                      V.real, V.imag, *[w + r[f"db{i + 1}"] for i in range(n)]])
+        acc = ground_rhs(sc, t, s)[n + 2 : n + 4]
+        worst = max(worst, abs(complex(X2 - acc[0], Y2 - acc[1])) / abs(complex(*acc)))
+    assert worst < 1e-6, worst
