@@ -355,6 +355,7 @@ def test_bad_arguments_name_the_parameter(rr):
          "natural_frequency_rpm"),
         (lambda: sol.spectrum(natural_frequency_rpm=-1), "natural_frequency_rpm"),
         (lambda: sol.spectrum(eccentricity=1e-3), "eccentricity"),
+        (lambda: sol.spectrum(Omega=1.2), "Omega"),
         (lambda: sp.signal_spectrum([0, 1, 3, 4, 5, 6, 7, 8], np.ones(8)), "t"),
         (lambda: sp.signal_spectrum(np.arange(10.0), np.ones(9)), "X"),
         (lambda: sp.signal_spectrum(np.arange(10.0), np.ones(10), window="kaiser"), "window"),

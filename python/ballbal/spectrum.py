@@ -92,8 +92,10 @@ def _lines(source: PeriodicSolution | Equilibrium, Omega: float | None,  # noqa:
         if source.omega is None:
             raise ValueError(f"no spectrum: the solve did not converge (status "
                              f"{source.status})")
-        spin = source.balancer.Omega if Omega is None else _check.real(
-            "Omega", Omega, finite=True)
+        spin = source.balancer.Omega
+        if Omega is not None and _check.real("Omega", Omega) != spin:
+            raise ParameterError("Omega", f"a periodic solution spins at its model's Omega "
+                                 f"({spin}), got {Omega}", value=Omega)
         n = source.N
         ax, ay = source.coeffs[0], source.coeffs[1]
         a_x, b_x = ax[1::2], ax[2::2]
@@ -163,10 +165,11 @@ def line_spectrum(
     Lines of equal ``|f_k|`` and opposite sign add in a spectrum of ``X`` alone (see
     :func:`signal_spectrum`); in the two-sided spectrum of ``X + i Y`` they stay apart.
 
-    ``Omega`` defaults to the solution's model's; an :class:`~ballbal.Equilibrium` needs
-    it (it does not carry its model) and has the single line ``k = 0`` at ``Omega``:
-    the disk centre's offset ``x + i y``, which the perfect balance makes zero. Lines
-    below ``min_relative`` times the largest are left out.
+    ``Omega`` is the solution's model's (giving another is an error); an
+    :class:`~ballbal.Equilibrium` needs it (it does not carry its model) and has the
+    single line ``k = 0`` at ``Omega``: the disk centre's offset ``x + i y``, which the
+    perfect balance makes zero. Lines below ``min_relative`` times the largest are left
+    out.
     """
     fn = _natural_hz(natural_frequency_hz, natural_frequency_rpm)
     k, f, C, spin, omega = _scaled_lines(solution, quantity, Omega)
@@ -272,8 +275,12 @@ def _exact_vibration(C: np.ndarray, k: np.ndarray, quantity: str) -> Vibration:
         last, m = mean, 2 * m
     h = 2 * np.pi / m
     s = np.arange(m) * h
+    # |g|^2 has degree 2 N, hence at most 4 N extrema: refine that many candidates (ties
+    # on a flat stretch would otherwise make every sample one)
     lo_i = np.flatnonzero((g <= np.roll(g, 1)) & (g <= np.roll(g, -1)))
     hi_i = np.flatnonzero((g >= np.roll(g, 1)) & (g >= np.roll(g, -1)))
+    lo_i = lo_i[np.argsort(g[lo_i], kind="stable")][: 4 * n]
+    hi_i = hi_i[np.argsort(-g[hi_i], kind="stable")][: 4 * n]
     gmax = max([float(g.max())] + [_refine(C, k, s[i], h, 1.0) for i in hi_i])
     gmin = min([float(g.min())] + [_refine(C, k, s[i], h, -1.0) for i in lo_i])
     return Vibration(quantity, mean, gmin, gmax, rms, True, m, err)
@@ -355,9 +362,10 @@ def vibration(
       Parseval (``sum |C_k|^2``); the mean is the periodic trapezoid rule on ``M``
       samples of ``|g|`` (from one inverse FFT), which converges geometrically for this
       analytic periodic function: ``M`` starts at ``64 (N + 1)`` (at least 256) and
-      doubles until the mean changes by less than ``1e-14`` relative (``mean_error``);
-      min and max: every local extremum of the samples refined by Newton on
-      ``d|g|^2/ds`` to round-off.
+      doubles until the mean changes by less than ``1e-14`` relative (``mean_error``;
+      where ``|g|`` touches zero it has a kink and converges algebraically: at most
+      ``2^20`` samples, ``mean_error`` then says how far it got); min and max: the
+      samples' local extrema refined by Newton on ``d|g|^2/ds`` to round-off.
     * An :class:`~ballbal.Equilibrium` (give ``Omega``): the constant ``Omega^p |x + i y|``.
     * A :func:`ballbal.simulate` table: from :func:`ground_signal`'s samples after
       ``t_min`` (leave out transients; over a whole number of periods or a long record
