@@ -23,6 +23,13 @@ from .options import (
 )
 from .scan import read_scan, scan, scan_meta
 from .scene import Impulse, Ramp, Scene, Tilt, load_scene
+from .spectrum import (
+    Vibration,
+    label_peaks,
+    line_spectrum,
+    signal_spectrum,
+    vibration,
+)
 from .transient import (
     DisturbanceResponse,
     RunUp,
@@ -48,6 +55,7 @@ __all__ = [
     "ScanOptions",
     "Scene",
     "Tilt",
+    "Vibration",
     "__version__",
     "accuracy_cost",
     "balance_map",
@@ -57,6 +65,8 @@ __all__ = [
     "data",
     "exceptions",
     "from_seed003",
+    "label_peaks",
+    "line_spectrum",
     "load_scene",
     "periodic",
     "plot_accuracy_cost",
@@ -65,7 +75,9 @@ __all__ = [
     "run_up",
     "scan",
     "scan_meta",
+    "signal_spectrum",
     "simulate",
     "track_damping_study",
+    "vibration",
     "zeta_from_log_decrement",
 ]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal, overload
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import numpy as np
 import polars as pl
@@ -15,6 +15,9 @@ from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
 from .options import PERIODIC_DEFAULTS, PERIODIC_KEYWORDS, PeriodicOptions, with_keywords
 from .scene import Scene
+
+if TYPE_CHECKING:
+    from .spectrum import Vibration
 
 Stability = Literal["stable", "unstable", "undetermined"]
 
@@ -276,6 +279,23 @@ class PeriodicSolution:
         for j in range(d):
             cols[names[d + j]] = dq[:, j]
         return pl.DataFrame(cols)
+
+    def spectrum(self, quantity: Literal["displacement", "velocity", "acceleration"]
+                 = "acceleration", **keywords: Any) -> pl.DataFrame:
+        """The exact ground-frame spectrum: lines at ``Omega + k omega`` from the
+        coefficients (:func:`ballbal.spectrum.line_spectrum`, which takes the keywords:
+        ``natural_frequency_hz`` / ``_rpm``, ``eccentricity``, ``min_relative``)."""
+        from .spectrum import line_spectrum
+
+        return line_spectrum(self, quantity, **keywords)
+
+    def vibration(self, quantity: Literal["displacement", "velocity", "acceleration"]
+                  = "acceleration") -> Vibration:
+        """Mean, min, max and rms of ``|Z''|`` (or ``|Z|``, ``|Z'|``) over the orbit,
+        exact from the coefficients (:func:`ballbal.spectrum.vibration`)."""
+        from .spectrum import vibration
+
+        return vibration(self, quantity)
 
     def state(self, t: float = 0.0) -> np.ndarray:
         """First-order state ``(q, q')`` on the orbit at time ``t``."""
