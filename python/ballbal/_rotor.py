@@ -148,10 +148,11 @@ def simulate_rotor(rotor: RotorOnBearing, x0: Any, t_span: Any, *, samples: int 
                    stiff_steps: int = 100_000, method: str = "explicit",
                    factor_reuse: float | None = 1e-10) -> RotorTrajectory:
     """Simulates ``rotor`` from ``x0`` = ``(x, y)``, ``(x, y, x', y')`` (units ``c`` and
-    ``c w``) or ``"equilibrium"`` (at rest at :func:`rotor_equilibrium`) over ``t_span = (tau0, tau1)``, with ``samples`` evenly spaced rows (or the
-    rows at ``t_eval``). ``method`` ``"explicit"`` (Dormand–Prince 5(4); a run whose steps
-    are held so small by stability that finishing would take more than ``stiff_steps``
-    steps ends ``"stiff"``, with ``stiff_eccentricity`` where they collapsed) or ``"implicit"``
+    ``c w``) or ``"equilibrium"`` (at rest at :func:`rotor_equilibrium`) over
+    ``t_span = (tau0, tau1)``, with ``samples`` evenly spaced rows (or the rows at
+    ``t_eval``). ``method`` ``"explicit"`` (Dormand–Prince 5(4); a run whose steps are held
+    so small by stability that finishing would take more than ``stiff_steps`` steps ends
+    ``"stiff"``, with ``stiff_eccentricity`` where they collapsed) or ``"implicit"``
     (Rosenbrock 2(3)). ``factor_reuse``: relative residual of the preconditioned solves of
     finite grooved films (``None``: a fresh factorisation per evaluation)."""
     from . import _native

@@ -17,6 +17,9 @@
 //! `[0.2, 5]`; dense output is the scheme's own continuous extension
 //! `y(t + s h) = y + h (s (1 - s) k1 + s (s - 2 d) k2) / (1 - 2 d)`.
 
+// The stages index several arrays in lockstep, as in `ode.rs`.
+#![allow(clippy::needless_range_loop)]
+
 use super::ode::{Options, Stats};
 use crate::cancel;
 use crate::error::{Error, Result};
