@@ -107,7 +107,8 @@ def tangential(ax: plt.Axes, runs: dict[str, RotorTrajectory], title: str) -> No
 def describe(label: str, tr: RotorTrajectory, seconds: float) -> None:
     t = tr.table
     last = t.row(-1, named=True)
-    print(f"{label}: {tr.outcome} at tau {tr.t_end:.2f}, max eps {t['eccentricity'].max():.3f}, "
+    peak = float(t["eccentricity"].max())  # type: ignore[arg-type]
+    print(f"{label}: {tr.outcome} at tau {tr.t_end:.2f}, max eps {peak:.3f}, "
           f"final eps {last['eccentricity']:.3f}, {tr.accepted_steps} steps, "
           f"{tr.force_evals} film solves, {seconds:.1f} s")
 

@@ -254,3 +254,35 @@ def test_ctrl_c_stops_a_long_run() -> None:
     time.sleep(0.5)
     p.send_signal(signal.SIGINT)
     assert p.wait(timeout=10) == 7
+
+
+def test_a_crawl_near_the_wall_is_reported_stiff_and_the_implicit_method_finishes() -> None:
+    # A light rotor pressed towards the wall (weight 250 F_S, static eps ~ 0.97): the
+    # squeeze film's damping over the mass parameter is ~ 1e7, far beyond the explicit
+    # step's stability limit over a time span of 50.
+    r = RotorOnBearing(SHORT, 1e-4, gravity=2.5e6)
+    tr = simulate_rotor(r, (0.9, 0.0), (0.0, 50.0), samples=6, eps_contact=0.995,
+                        stiff_steps=10_000)
+    assert tr.outcome == "stiff" and tr.stiff_eccentricity is not None
+    assert tr.stiff_eccentricity > 0.9 and tr.t_end < 50.0
+    tr = simulate_rotor(r, (0.9, 0.0), (0.0, 50.0), samples=6, eps_contact=0.995,
+                        method="implicit")
+    assert tr.outcome == "completed", tr.message
+    # it settles where the film carries the weight (Ocvirk's closed form)
+    xe, ye = static_position(250.0)
+    last = tr.table.row(-1, named=True)
+    assert abs(last["x"] - xe) < 1e-4 and abs(last["y"] - ye) < 1e-4
+
+
+def test_plot_trajectory_draws_orbit_and_tangential_force() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    from ballbal._rotor import plot_trajectory
+
+    tr = simulate_rotor(rotor(1.0, 5.73), (0.0, 0.3), (0.0, 20.0), samples=101)
+    orbit, force = plot_trajectory({"a": tr, "b": tr}, title="t")
+    assert isinstance(orbit, Figure) and isinstance(force, Figure)
+    assert len(force.axes[0].lines) == 2

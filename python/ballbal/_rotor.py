@@ -181,7 +181,8 @@ def simulate_rotor(rotor: RotorOnBearing, x0: Any, t_span: Any, *, samples: int 
     else:
         te = np.ascontiguousarray(_check.array("t_eval", t_eval), dtype=float)
     d = _native.simulate_rotor(
-        rotor, tuple(x), span[0], te, _check.real("rtol", rtol), _check.real("atol", atol),
+        rotor, (x[0], x[1], x[2], x[3]), span[0], te, _check.real("rtol", rtol),
+        _check.real("atol", atol),
         _check.integer("max_steps", max_steps), _check.real("eps_contact", eps_contact),
         _check.integer("stiff_steps", stiff_steps), _check.string("method", method),
         None if factor_reuse is None else _check.real("factor_reuse", factor_reuse))
