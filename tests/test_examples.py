@@ -107,7 +107,22 @@ def seed004(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "seed004.png"]
 
 
+def seed002(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # One equilibrium from every start; the seed's unbalance regimes: contact, then a
+    # whirl at the spin frequency (the forcing's: a stable response is synchronous) whose
+    # radius scales about linearly with the unbalance.
+    assert float(re.search(r"final positions agree to (\S+) c", stdout).group(1)) < 1e-6
+    assert re.search(r"unbalance 2.55 W: contact at tau", stdout)
+    whirl = dict(re.findall(r"unbalance (\S+) W: orbit radius \S+ c, whirl/spin (\S+)", stdout))
+    assert set(whirl) == {"0.255", "0.0255"} and all(
+        abs(float(v) - 1) < 0.01 for v in whirl.values()), whirl
+    radius = dict(re.findall(r"unbalance (\S+) W: orbit radius (\S+) c", stdout))
+    assert 5 < float(radius["0.255"]) / float(radius["0.0255"]) < 15, radius
+    return [out / "seed002.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "seed002.py": seed002,
     "accuracy_cost.py": accuracy_cost,
     "thesis_maps.py": thesis_maps,
     "scene_maps.py": scene_maps,
@@ -127,7 +142,8 @@ def test_example_runs_small(name, tmp_path):
     assert script.exists(), f"{script}: set BALLBAL_REPO to the repository checkout"
     out = tmp_path / "out"
     out.mkdir()
-    args = ["--out", str(out / "seed004.png")] if name == "seed004.py" else [str(out)]
+    args = ([f"--out={out / name.replace('.py', '.png')}"] if name in ("seed002.py", "seed004.py")
+            else [str(out)])
     env = {**os.environ, "BALLBAL_EXAMPLE_SMALL": "1", "MPLBACKEND": "Agg"}
     # From tmp_path, so that nothing can land in the checkout.
     res = subprocess.run([sys.executable, str(script), *args], cwd=tmp_path, env=env,

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ._rotor import RotorOnBearing
 from .bearing import Bearing
 from .model import Balancer
 from .options import PeriodicOptions, ScanOptions
@@ -17,7 +18,7 @@ from .scene import Scene
 __all__ = [
     "simulate", "validate", "equilibria", "balanced_states", "periodic", "orbit_closure",
     "balance_map", "scan", "default_chunk", "certificate_seconds", "validate_bearing",
-    "__version__",
+    "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor", "__version__",
 ]
 
 __version__: str
@@ -50,3 +51,16 @@ def scan(
 ) -> None: ...
 def default_chunk(lens: list[int]) -> int: ...
 def certificate_seconds() -> float: ...
+
+# rust/py/src/rotor.rs: a rigid rotor on one journal bearing (ballbal._rotor)
+def validate_rotor(rotor: RotorOnBearing) -> None: ...
+def rotor_equilibrium(rotor: RotorOnBearing) -> tuple[float, float]: ...
+def rotor_from_dimensions(
+    bearing: Bearing, radius: float, length: float, clearance: float, viscosity: float,
+    mass: float, speed: float, unbalance: float, g: float,
+) -> tuple[float, float, float]: ...
+def simulate_rotor(
+    rotor: RotorOnBearing, x0: tuple[float, float, float, float], t0: float,
+    t_eval: npt.NDArray[np.float64], rtol: float, atol: float, max_steps: int,
+    eps_contact: float, stiff_steps: int, method: str, factor_reuse: float | None,
+) -> dict[str, Any]: ...

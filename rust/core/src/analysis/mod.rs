@@ -5,6 +5,7 @@ pub mod attractors;
 pub mod balanced;
 pub mod equilibria;
 pub mod family;
+pub mod journal;
 pub mod periodic;
 pub mod record;
 pub mod simulate;

@@ -7,3 +7,4 @@ pub mod hb;
 pub mod linalg;
 pub mod ode;
 pub mod problem;
+pub mod rosenbrock;

@@ -419,6 +419,37 @@ impl Dense<'_> {
         self.y_new
     }
 
+    /// Hairer's stiffness indicator `|h| rho` of this step, `rho ~ |f(y7) - f(y6)| / |y7 - y6|`
+    /// (the dominant eigenvalue seen by the last two stages; above about 3.25 the step is
+    /// held by stability, not accuracy). Recomputes `y6` from the stages, so observers that
+    /// want a stiffness diagnostic pay for it and the stepping loop does not.
+    pub fn stiffness(&self) -> f64 {
+        let (h, k) = (self.h, self.k);
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..self.y.len() {
+            let y6 = self.y[i]
+                + h * (A61 * k[0][i]
+                    + A62 * k[1][i]
+                    + A63 * k[2][i]
+                    + A64 * k[3][i]
+                    + A65 * k[4][i]);
+            let a = k[6][i] - k[5][i];
+            let b = self.y_new[i] - y6;
+            num += a * a;
+            den += b * b;
+        }
+        if den > 0.0 {
+            h.abs() * (num / den).sqrt()
+        } else {
+            0.0
+        }
+    }
+
+    /// Start time and signed step of this step.
+    pub fn span(&self) -> (f64, f64) {
+        (self.t0, self.h)
+    }
+
     pub fn eval(&self, t: f64, out: &mut [f64]) {
         let th = (t - self.t0) / self.h;
         let th1 = 1.0 - th;
