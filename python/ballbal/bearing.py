@@ -339,8 +339,9 @@ class Coefficients:
 def coefficients(bearing: Bearing, position: Any, *, dimensions: Dimensions | None = None,
                  speed: float | None = None) -> Coefficients:
     """Stiffness and damping at ``position`` (a static journal position, units ``c``):
-    exact derivatives of the discrete film from one factorisation for the finite model
-    (half-Sommerfeld or no cavitation), central differences of the force otherwise."""
+    derivatives of the discrete film from one factorisation for the finite and
+    narrow-groove models (half-Sommerfeld or no cavitation), central differences of the
+    force otherwise."""
     from . import _native
 
     k, c = _native.bearing_coefficients(_bearing(bearing), _pair("position", position))

@@ -414,7 +414,7 @@ impl FilmSolver {
     }
 
     /// `dF/d(x, y, x', y')` rows `[dF_x; dF_y]` from one factorisation where the model allows
-    /// it (finite model, half-Sommerfeld or full film); `None` otherwise.
+    /// it (finite and narrow-groove models, half-Sommerfeld or full film); `None` otherwise.
     pub fn force_derivatives(
         &mut self,
         state: &JournalState,
@@ -422,6 +422,7 @@ impl FilmSolver {
         check_state(state)?;
         match &mut self.kind {
             SolverKind::Finite(s) => s.linearise(state),
+            SolverKind::Narrow(s) => s.linearise(state),
             _ => Ok(None),
         }
     }
@@ -451,7 +452,7 @@ fn check_grid(n_theta: usize, n_zeta: usize) -> Result<()> {
             "integer >= 8",
         ));
     }
-    if n_zeta < 2 || n_zeta % 2 != 0 {
+    if n_zeta < 2 || !n_zeta.is_multiple_of(2) {
         return Err(Error::param_range(
             "grid.n_zeta",
             format!("must be even and at least 2 (cells must not straddle the mid-plane), got {n_zeta}"),

@@ -422,6 +422,74 @@ impl NarrowSolver {
     pub fn grid(&self) -> (f64, usize, usize) {
         (self.lambda, self.nt, self.nz)
     }
+
+    /// The force at `s` and its derivatives with respect to position and velocity from
+    /// **one** factorisation, as [`FiniteSolver::linearise`]: `M dP/ds = -d rhs/ds - (dM/ds) P`.
+    /// The operator's derivatives `dM/ds`, `d rhs/ds` are central differences of the assembly
+    /// (step `1e-5`: smooth functions of the film, error about `1e-10`); the right-hand side is
+    /// affine in the velocity, so that difference is exact. `None` for the Reynolds condition.
+    pub fn linearise(&mut self, s: &JournalState) -> Result<Option<(FilmForce, [[f64; 4]; 2])>> {
+        if self.cavitation == Cavitation::Reynolds {
+            return Ok(None);
+        }
+        let n = self.nt * self.nz;
+        let (st, rhs) = self.assemble(s);
+        let vals = self.values(&st, None);
+        let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
+        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper).map_err(
+            |e| Error::Eigen(format!("narrow-groove matrix not positive definite: {e:?}")),
+        )?;
+        let mut b = faer::Mat::<f64>::zeros(n, 5);
+        for c in 0..n {
+            b[(c, 0)] = -rhs[c];
+        }
+        llt.solve_in_place(b.as_mut().subcols_mut(0, 1));
+        let p: Vec<f64> = (0..n).map(|c| b[(c, 0)]).collect();
+        let h = 1e-5;
+        let moved = |dx: f64, dy: f64| JournalState {
+            x: s.x + dx,
+            y: s.y + dy,
+            ..*s
+        };
+        for (col, (gx, gy)) in [(1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
+            let (stp, rp) = self.assemble(&moved(h * gx, h * gy));
+            let (stm, rm) = self.assemble(&moved(-h * gx, -h * gy));
+            let dst: Vec<f64> = stp.iter().zip(&stm).map(|(a, b)| (a - b) / (2.0 * h)).collect();
+            let dmp = self.apply(&dst, &p);
+            for c in 0..n {
+                b[(c, 1 + col)] = -(rp[c] - rm[c]) / (2.0 * h) - dmp[c];
+            }
+        }
+        let still = JournalState {
+            vx: 0.0,
+            vy: 0.0,
+            ..*s
+        };
+        let (_, r0) = self.assemble(&still);
+        for (col, (vx, vy)) in [(1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
+            let (_, r1) = self.assemble(&JournalState { vx, vy, ..still });
+            for c in 0..n {
+                b[(c, 3 + col)] = -(r1[c] - r0[c]);
+            }
+        }
+        llt.solve_in_place(b.as_mut().subcols_mut(1, 4));
+        let clip = self.cavitation == Cavitation::HalfSommerfeld;
+        let mut out = [[0.0; 4]; 2];
+        for k in 0..4 {
+            let dp: Vec<f64> = (0..n)
+                .map(|c| if clip && p[c] < 0.0 { 0.0 } else { b[(c, 1 + k)] })
+                .collect();
+            let (dfx, dfy) = self.plain.integrate(&dp);
+            out[0][k] = dfx;
+            out[1][k] = dfy;
+        }
+        let p = if clip {
+            p.into_iter().map(|v| v.max(0.0)).collect()
+        } else {
+            p
+        };
+        Ok(Some((self.plain.finish(s, p, false), out)))
+    }
 }
 
 #[cfg(test)]
@@ -635,6 +703,24 @@ mod tests {
             let en = s.force(&eccentric, false).unwrap();
             let d = (ef.fx - en.fx).hypot(ef.fy - en.fy) / en.fx.hypot(en.fy);
             println!("N_g 32, {per} cells per pitch ({nt} x {nz}): eps 0.5 force rel diff {d:.3e}");
+        }
+    }
+
+    #[test]
+    fn narrow_factor_reuse_derivatives_match_finite_differences() {
+        use super::super::linear_coefficients;
+        for (cav, side, x, y) in [
+            (Cavitation::HalfSommerfeld, GrooveSide::Sleeve, 0.3, -0.4),
+            (Cavitation::None, GrooveSide::Journal, -0.5, 0.2),
+        ] {
+            let g = herringbone(12, 30.0, 1.2, side);
+            let mut s = bearing(0.8, Some(g), cav, ngt(64, 16));
+            let a = linear_coefficients(&mut s, x, y).unwrap();
+            let f = linear_coefficients_fd(&mut s, x, y).unwrap();
+            let scale = a.k.abs().max().max(a.c.abs().max());
+            let d = (a.k - f.k).abs().max().max((a.c - f.c).abs().max());
+            println!("NGT factor reuse vs central differences: {:.2e}", d / scale);
+            assert!(d < 1e-6 * scale, "{a:?} vs {f:?}");
         }
     }
 
