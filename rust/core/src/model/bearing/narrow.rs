@@ -682,9 +682,8 @@ mod tests {
                 apex_d.push((af - an).abs() / an);
                 force_d.push(d);
             }
-            // The force difference falls like 1/N_g; the apex difference more slowly, towards
-            // the resolved film's own error at a fixed 16 cells per pitch (its face conductance
-            // is the cube of the face's mean film, not the mean of the cubes).
+            // The force difference falls like 1/N_g; the apex difference more slowly (the
+            // resolved chevron at the apex is a layer about a pitch wide; docs/guide.md).
             for w in force_d.windows(2) {
                 assert!(w[1] < 0.62 * w[0], "{side:?}: {force_d:?}");
             }
