@@ -32,11 +32,11 @@ use crate::error::{check_range, Error, Result};
 use std::f64::consts::PI;
 
 pub use finite::FiniteSolver;
-pub use narrow::NarrowSolver;
 pub use linear::{
     equilibrium, linear_coefficients, linear_coefficients_fd, rigid_rotor_stability, Equilibrium,
     LinearCoefficients, WhirlStability,
 };
+pub use narrow::NarrowSolver;
 
 /// Which surface carries the grooves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -455,7 +455,9 @@ fn check_grid(n_theta: usize, n_zeta: usize) -> Result<()> {
     if n_zeta < 2 || !n_zeta.is_multiple_of(2) {
         return Err(Error::param_range(
             "grid.n_zeta",
-            format!("must be even and at least 2 (cells must not straddle the mid-plane), got {n_zeta}"),
+            format!(
+                "must be even and at least 2 (cells must not straddle the mid-plane), got {n_zeta}"
+            ),
             "even integer >= 2",
         ));
     }

@@ -143,7 +143,10 @@ fn slot(di: isize, dj: isize) -> usize {
 impl NarrowSolver {
     pub fn new(bearing: &Bearing, nt: usize, nz: usize) -> Result<Self> {
         let grooves = bearing.grooves.ok_or_else(|| {
-            Error::param("grooves", "narrow-groove theory smooths grooves: none given")
+            Error::param(
+                "grooves",
+                "narrow-groove theory smooths grooves: none given",
+            )
         })?;
         let plain_bearing = Bearing {
             grooves: None,
@@ -291,14 +294,7 @@ impl NarrowSolver {
                     let c = i * nz + if j == 0 { 0 } else { nz - 1 };
                     st[c * 9 + slot(0, 0)] += azz * 2.0 * dth / dz;
                 } else {
-                    couple(
-                        &mut st,
-                        i * nz + j - 1,
-                        i * nz + j,
-                        0,
-                        1,
-                        azz * dth / dz,
-                    );
+                    couple(&mut st, i * nz + j - 1, i * nz + j, 0, 1, azz * dth / dz);
                 }
             }
         }
@@ -315,7 +311,11 @@ impl NarrowSolver {
                 let mut cells: [(usize, isize, isize, f64, f64); 4] = [(0, 0, 0, 0.0, 0.0); 4];
                 let mut m = 0;
                 let (ut, area) = (0.5 / dth, if j == 0 || j == nz { 0.5 } else { 1.0 });
-                let wz = if j == 0 || j == nz { 1.0 / dz } else { 0.5 / dz };
+                let wz = if j == 0 || j == nz {
+                    1.0 / dz
+                } else {
+                    0.5 / dz
+                };
                 if j > 0 {
                     cells[m] = (iw * nz + j - 1, -1, -1, -ut, -wz);
                     cells[m + 1] = (i * nz + j - 1, 0, -1, ut, -wz);
@@ -361,9 +361,10 @@ impl NarrowSolver {
     fn solve_fixed(&self, st: &[f64], rhs: &[f64], fixed: Option<&[bool]>) -> Result<Vec<f64>> {
         let vals = self.values(st, fixed);
         let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper).map_err(
-            |e| Error::Eigen(format!("narrow-groove matrix not positive definite: {e:?}")),
-        )?;
+        let llt =
+            Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper).map_err(|e| {
+                Error::Eigen(format!("narrow-groove matrix not positive definite: {e:?}"))
+            })?;
         let mut b: Vec<f64> = rhs
             .iter()
             .enumerate()
@@ -436,9 +437,10 @@ impl NarrowSolver {
         let (st, rhs) = self.assemble(s);
         let vals = self.values(&st, None);
         let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper).map_err(
-            |e| Error::Eigen(format!("narrow-groove matrix not positive definite: {e:?}")),
-        )?;
+        let llt =
+            Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper).map_err(|e| {
+                Error::Eigen(format!("narrow-groove matrix not positive definite: {e:?}"))
+            })?;
         let mut b = faer::Mat::<f64>::zeros(n, 5);
         for c in 0..n {
             b[(c, 0)] = -rhs[c];
@@ -454,7 +456,11 @@ impl NarrowSolver {
         for (col, (gx, gy)) in [(1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
             let (stp, rp) = self.assemble(&moved(h * gx, h * gy));
             let (stm, rm) = self.assemble(&moved(-h * gx, -h * gy));
-            let dst: Vec<f64> = stp.iter().zip(&stm).map(|(a, b)| (a - b) / (2.0 * h)).collect();
+            let dst: Vec<f64> = stp
+                .iter()
+                .zip(&stm)
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect();
             let dmp = self.apply(&dst, &p);
             for c in 0..n {
                 b[(c, 1 + col)] = -(rp[c] - rm[c]) / (2.0 * h) - dmp[c];
@@ -477,7 +483,13 @@ impl NarrowSolver {
         let mut out = [[0.0; 4]; 2];
         for k in 0..4 {
             let dp: Vec<f64> = (0..n)
-                .map(|c| if clip && p[c] < 0.0 { 0.0 } else { b[(c, 1 + k)] })
+                .map(|c| {
+                    if clip && p[c] < 0.0 {
+                        0.0
+                    } else {
+                        b[(c, 1 + k)]
+                    }
+                })
                 .collect();
             let (dfx, dfy) = self.plain.integrate(&dp);
             out[0][k] = dfx;
@@ -551,7 +563,9 @@ mod tests {
             Cavitation::None,
             Cavitation::Reynolds,
         ] {
-            let fp = bearing(0.8, None, cav, fin(64, 16)).force(&st, true).unwrap();
+            let fp = bearing(0.8, None, cav, fin(64, 16))
+                .force(&st, true)
+                .unwrap();
             for side in [GrooveSide::Sleeve, GrooveSide::Journal] {
                 for length_fraction in [1.0, 0.6] {
                     let g = Grooves {
@@ -603,7 +617,10 @@ mod tests {
                 let g1 = muijderman_g1(1.0 + depth, width, f64::to_radians(angle));
                 for (k, v) in p.values.iter().enumerate() {
                     let want = 6.0 * g1 * (lambda - p.zeta[k % nz].abs());
-                    assert!((v - want).abs() < 1e-12 * 6.0 * g1 * lambda, "{v} vs {want}");
+                    assert!(
+                        (v - want).abs() < 1e-12 * 6.0 * g1 * lambda,
+                        "{v} vs {want}"
+                    );
                 }
                 println!(
                     "angle {angle}, depth {depth}, width {width}, {side:?}: apex P = 6 g1 lambda = {:.5}",
@@ -734,7 +751,10 @@ mod tests {
             .force(&st, true)
             .unwrap();
         let (wh, wr) = (fh.fx.hypot(fh.fy), fr.fx.hypot(fr.fy));
-        println!("NGT L/D 1, eps 0.6: load Reynolds / half-Sommerfeld = {:.4}", wr / wh);
+        println!(
+            "NGT L/D 1, eps 0.6: load Reynolds / half-Sommerfeld = {:.4}",
+            wr / wh
+        );
         let pr = fr.pressure.unwrap().values;
         assert!(pr.contains(&0.0) && pr.iter().all(|v| *v >= 0.0));
         assert!((0.9..1.3).contains(&(wr / wh)));
