@@ -36,14 +36,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ballbal._rotor import (  # noqa: E402
-    Impulse,
+from ballbal.bearing import (  # noqa: E402
+    Bearing,
+    Grooves,
+    RotorImpulse,
     RotorOnBearing,
     RotorTrajectory,
     rotor_equilibrium,
     simulate_rotor,
 )
-from ballbal.bearing import Bearing, Grooves  # noqa: E402
 
 SMALL = os.environ.get("BALLBAL_EXAMPLE_SMALL") == "1"
 GRID = (64, 8) if SMALL else (96, 12)
@@ -73,7 +74,8 @@ def impulse_run(angle: float = 40.0, lam: float = 1.0, depth: float = 1.0,
                 width: float = 0.5) -> RotorTrajectory:
     key = (angle, lam, depth, width)
     if key not in _cache:
-        r = RotorOnBearing(grooved(*key), MASS, gravity=GRAVITY, impulse=Impulse(5.0, 3.0, 2.0))
+        r = RotorOnBearing(grooved(*key), MASS, gravity=GRAVITY,
+                           impulse=RotorImpulse(5.0, 3.0, 2.0))
         _cache[key] = simulate_rotor(r, "equilibrium", (0.0, IMPULSE_SPAN), samples=401)
     return _cache[key]
 

@@ -20,8 +20,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from ballbal._rotor import Impulse, RotorOnBearing, simulate_rotor
-from ballbal.bearing import Bearing
+from ballbal.bearing import Bearing, RotorImpulse, RotorOnBearing, simulate_rotor
 from ballbal.exceptions import ParameterError
 
 LAM = 0.5  # L/D; then F0 = mu w R L^3 / c^2 = (2 lambda)^2 F_S = F_S
@@ -172,7 +171,7 @@ def test_contact_is_an_outcome_with_its_time() -> None:
 @pytest.mark.parametrize("method", ["explicit", "implicit"])
 def test_trajectory_matches_solve_ivp(method: str) -> None:
     m, gn, rho = 2.0, 0.4, 0.05
-    imp = Impulse(amplitude=5.0, center=3.0, sharpness=2.0, direction=30.0)
+    imp = RotorImpulse(amplitude=5.0, center=3.0, sharpness=2.0, direction=30.0)
     r = RotorOnBearing(SHORT, m, gravity=gn, unbalance=rho, impulse=imp,
                        unbalance_phase=20.0)
     t = np.linspace(0.0, 30.0, 61)
@@ -214,8 +213,8 @@ def test_from_dimensions_gives_the_mass_parameter() -> None:
     (lambda: RotorOnBearing(SHORT, -1.0), "mass_parameter"),
     (lambda: RotorOnBearing(SHORT, 1.0, gravity=-1.0), "gravity"),
     (lambda: RotorOnBearing(SHORT, 1.0, unbalance=-0.1), "unbalance"),
-    (lambda: RotorOnBearing(SHORT, 1.0, impulse=Impulse()), "impulse.amplitude"),
-    (lambda: RotorOnBearing(SHORT, 1.0, gravity=1.0, impulse=Impulse(sharpness=0.0)),
+    (lambda: RotorOnBearing(SHORT, 1.0, impulse=RotorImpulse()), "impulse.amplitude"),
+    (lambda: RotorOnBearing(SHORT, 1.0, gravity=1.0, impulse=RotorImpulse(sharpness=0.0)),
      "impulse.sharpness"),
     (lambda: RotorOnBearing(SHORT, "a"), "mass_parameter"),  # type: ignore[arg-type]
     (lambda: simulate_rotor(RotorOnBearing(SHORT, 1.0), (0.99, 0.0), (0, 1)), "x0"),
@@ -241,7 +240,7 @@ def test_bad_input_names_the_parameter(make: object, name: str) -> None:
 
 def test_ctrl_c_stops_a_long_run() -> None:
     code = (
-        "import sys\nfrom ballbal._rotor import RotorOnBearing, simulate_rotor\n"
+        "import sys\nfrom ballbal.bearing import RotorOnBearing, simulate_rotor\n"
         "from ballbal.bearing import Bearing\n"
         "r = RotorOnBearing(Bearing(length_ratio=0.5, model='short'), 1.0, gravity=5.0,"
         " unbalance=0.05)\n"
@@ -280,7 +279,7 @@ def test_plot_trajectory_draws_orbit_and_tangential_force() -> None:
     matplotlib.use("Agg")
     from matplotlib.figure import Figure
 
-    from ballbal._rotor import plot_trajectory
+    from ballbal.bearing import plot_trajectory
 
     tr = simulate_rotor(rotor(1.0, 5.73), (0.0, 0.3), (0.0, 20.0), samples=101)
     orbit, force = plot_trajectory({"a": tr, "b": tr}, title="t")

@@ -1,6 +1,6 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
-from . import data, exceptions
+from . import bearing, data, exceptions
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -60,6 +60,7 @@ __all__ = [
     "accuracy_cost",
     "balance_map",
     "balanced_state",
+    "bearing",
     "disturbance_response",
     "equilibria",
     "data",

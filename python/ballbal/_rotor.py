@@ -13,9 +13,9 @@ clearance ``c``, time ``tau = w t``, film forces over ``F_S = mu w L R^3 / c^2``
   i.e. the Sommerfeld number is ``1 / (pi m g_n)``;
 * ``unbalance`` ``rho_u = e_u / c``: the unbalance force ``M e_u w^2`` is ``rho_u / g_n``
   times the weight;
-* :class:`Impulse`: ``amplitude`` times the weight, ``exp(-sharpness (tau - center)^2)``,
+* :class:`RotorImpulse`: ``amplitude`` times the weight, ``exp(-sharpness (tau - center)^2)``,
   along ``direction`` (degrees); the seed's ``5 W exp(-5e5 (t - 0.006)^2)`` at 500 rad/s
-  is ``Impulse(5, 3, 2)``.
+  is ``RotorImpulse(5, 3, 2)``.
 
 Runs end ``"completed"``, ``"contact"`` (eccentricity reached ``eps_contact``, the time
 found on the step's dense output), ``"stiff"`` (the explicit integrator's steps held down
@@ -44,7 +44,7 @@ METHODS = ("explicit", "implicit")
 
 
 @dataclass(frozen=True)
-class Impulse:
+class RotorImpulse:
     """Force ``amplitude * W * exp(-sharpness (tau - center)^2)`` along ``direction``
     (degrees in the fixed frame; 0 is the seed's gravity direction ``x``)."""
 
@@ -62,13 +62,13 @@ class Impulse:
 class RotorOnBearing:
     """A rigid rotor of bearing mass parameter ``mass_parameter`` on ``bearing`` under
     ``gravity`` (``g / (c w^2)``), ``unbalance`` (``e_u / c``) and an optional
-    :class:`Impulse` (module docstring). Angles in degrees."""
+    :class:`RotorImpulse` (module docstring). Angles in degrees."""
 
     bearing: Bearing
     mass_parameter: float
     gravity: float = 0.0
     unbalance: float = 0.0
-    impulse: Impulse | None = None
+    impulse: RotorImpulse | None = None
     gravity_direction: float = 0.0
     unbalance_phase: float = 0.0
 
@@ -77,10 +77,11 @@ class RotorOnBearing:
             raise ParameterTypeError(
                 "bearing", f"bearing must be ballbal.bearing.Bearing, got "
                 f"{type(self.bearing).__name__}", allowed="Bearing")
-        if self.impulse is not None and not isinstance(self.impulse, Impulse):
+        if self.impulse is not None and not isinstance(self.impulse, RotorImpulse):
             raise ParameterTypeError(
-                "impulse", f"impulse must be Impulse or None, got {type(self.impulse).__name__}",
-                allowed="Impulse or None")
+                "impulse",
+                f"impulse must be RotorImpulse or None, got {type(self.impulse).__name__}",
+                allowed="RotorImpulse or None")
         for name in ("mass_parameter", "gravity", "unbalance", "gravity_direction",
                      "unbalance_phase"):
             object.__setattr__(self, name, _check.real(name, getattr(self, name)))
@@ -92,7 +93,7 @@ class RotorOnBearing:
     def from_dimensions(cls, bearing: Bearing, *, radius: float, length: float,
                         clearance: float, viscosity: float, mass: float, speed: float,
                         unbalance: float = 0.0, g: float = 9.81,
-                        impulse: Impulse | None = None) -> RotorOnBearing:
+                        impulse: RotorImpulse | None = None) -> RotorOnBearing:
         """From SI quantities: journal ``radius``, bearing ``length``, radial ``clearance``
         (m), ``viscosity`` (Pa s), rotor ``mass`` carried by the bearing (kg), ``speed``
         (rad/s), unbalance eccentricity ``unbalance`` ``e_u`` (m), gravity ``g`` (m/s^2,

@@ -9,13 +9,44 @@ stationary ``"sleeve"`` (the seed's configuration) or on the rotating ``"journal
 angle is in degrees **from the circumferential direction** (90 would be axial grooves).
 The apex at the mid-plane points in the direction in which the smooth surface moves
 relative to the grooved one, so the grooves pump towards the mid-plane.
+
+Film forces and what follows from them (the guide's "Journal bearings"):
+:func:`film_force` (force, pressure field), :func:`equilibrium` (journal position under a
+load), :func:`coefficients` (linearised stiffness and damping), :func:`stability` (whirl
+threshold of a rigid rotor), :func:`plot_pressure`; :class:`Dimensions` converts to and
+from SI units.
+
+Conventions: the fixed frame ``(x, y)``, spin ``w > 0`` counter-clockwise; the journal
+centre at ``c (x, y)``, velocity ``c w (x', y')``; angles in radians. A force's
+``radial`` component is along the line of centres, positive towards the bearing centre
+(restoring), its ``tangential`` one along ``(-sin phi, cos phi)`` (the direction of
+rotation), ``phi`` the direction of the journal centre (and of the minimum film). The
+**attitude** angle is ``atan2(tangential, radial)``: the journal lies at the load's
+direction turned by the attitude in the direction of rotation.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
 
 from . import _check
+from .exceptions import ParameterError
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = [
+    "Bearing", "BearingEquilibrium", "Coefficients", "Dimensions", "FilmForce", "Grooves",
+    "RotorImpulse", "RotorOnBearing", "RotorTrajectory", "Stability", "coefficients",
+    "default_grid", "equilibrium", "film_force", "plot_pressure", "plot_trajectory",
+    "rotor_equilibrium", "simulate_rotor", "stability",
+]
 
 MODELS = ("short", "long", "finite", "narrow_groove")
 CAVITATION = ("half_sommerfeld", "reynolds", "none")
@@ -51,9 +82,10 @@ class Grooves:
         _validate(Bearing(grooves=self))
 
 
-def default_grid(grooves: Grooves | None) -> tuple[int, int]:
-    """The finite-volume grid used when a bearing gives none."""
-    if grooves is None:
+def default_grid(grooves: Grooves | None, model: str = "finite") -> tuple[int, int]:
+    """The finite-volume grid used when a bearing gives none (narrow-groove theory need
+    not resolve the grooves: the plain grid)."""
+    if grooves is None or model == "narrow_groove":
         return PLAIN_GRID
     per = max(CELLS_PER_PITCH, -(-256 // grooves.count))
     return (grooves.count * per, 32)
@@ -64,8 +96,12 @@ class Bearing:
     """A journal bearing: ``length_ratio`` = L/D, optional :class:`Grooves`, the
     ``cavitation`` condition (``"half_sommerfeld"``, the seed's and the default;
     ``"reynolds"``; ``"none"``), the film ``model`` (``"short"``, ``"long"``,
-    ``"finite"``, ``"narrow_groove"``) and the finite model's ``grid`` ``(n_theta,
-    n_zeta)`` (``None``: :func:`default_grid`)."""
+    ``"finite"``, ``"narrow_groove"``) and the grid ``(n_theta, n_zeta)`` of the finite
+    and narrow-groove models (``None``: :func:`default_grid`).
+
+    ``"narrow_groove"`` is Vohr and Chow's narrow-groove theory: the grooves smoothed into
+    an anisotropic film, exact as the groove count grows, on a grid that need not resolve
+    them (without grooves it is the plain finite film)."""
 
     length_ratio: float = 1.0
     grooves: Grooves | None = None
@@ -80,7 +116,7 @@ class Bearing:
         object.__setattr__(self, "cavitation", _check.string("cavitation", self.cavitation))
         object.__setattr__(self, "model", _check.string("model", self.model))
         if self.grid is None:
-            object.__setattr__(self, "grid", default_grid(self.grooves))
+            object.__setattr__(self, "grid", default_grid(self.grooves, self.model))
         else:
             g = _check.sequence("grid", self.grid)
             if len(g) != 2:
@@ -111,3 +147,299 @@ def _validate(bearing: Bearing) -> None:
     from . import _native
 
     _native.validate_bearing(bearing)
+
+
+def _pair(name: str, v: Any) -> tuple[float, float]:
+    items = _check.sequence(name, v)
+    if len(items) != 2:
+        raise ParameterError(name, f"must be two numbers (x, y), got {len(items)}",
+                             allowed="two finite numbers", value=v)
+    x, y = (_check.real(f"{name}[{k}]", items[k], finite=True) for k in range(2))
+    return x, y
+
+
+def _bearing(bearing: Any) -> Bearing:
+    if not isinstance(bearing, Bearing):
+        from .exceptions import ParameterTypeError
+
+        raise ParameterTypeError(
+            "bearing", f"must be ballbal.bearing.Bearing, got {type(bearing).__name__}",
+            allowed="Bearing",
+        )
+    return bearing
+
+
+@dataclass(frozen=True)
+class Dimensions:
+    """Physical size of a bearing, SI units: journal ``radius`` R [m], ``length`` L [m],
+    radial ``clearance`` c [m] and ``viscosity`` mu [Pa s]. The nondimensional film
+    (``length_ratio`` = L/D) converts with the scales below at spin ``speed`` w [rad/s]."""
+
+    radius: float
+    length: float
+    clearance: float
+    viscosity: float
+
+    def __post_init__(self) -> None:
+        for name in ("radius", "length", "clearance", "viscosity"):
+            object.__setattr__(self, name, _check.real(name, getattr(self, name), 0.0,
+                                                      lo_open=True, finite=True))
+        if self.clearance >= self.radius:
+            raise ParameterError("clearance", "must be smaller than the radius",
+                                 allowed=f"(0, {self.radius})", value=self.clearance)
+
+    @property
+    def length_ratio(self) -> float:
+        """``L / D``."""
+        return self.length / (2.0 * self.radius)
+
+    def force_scale(self, speed: float) -> float:
+        """``F_S = mu w L R^3 / c^2`` [N]: forces of this module are in ``F_S``."""
+        w = _check.real("speed", speed, 0.0, lo_open=True, finite=True)
+        return self.viscosity * w * self.length * self.radius**3 / self.clearance**2
+
+    def pressure_scale(self, speed: float) -> float:
+        """``mu w R^2 / c^2`` [Pa]: pressures of this module are in this unit."""
+        w = _check.real("speed", speed, 0.0, lo_open=True, finite=True)
+        return self.viscosity * w * self.radius**2 / self.clearance**2
+
+    def stiffness_scale(self, speed: float) -> float:
+        """``F_S / c`` [N/m], the unit of :func:`coefficients`' ``K``."""
+        return self.force_scale(speed) / self.clearance
+
+    def damping_scale(self, speed: float) -> float:
+        """``F_S / (c w)`` [N s/m], the unit of :func:`coefficients`' ``C``."""
+        return self.force_scale(speed) / (self.clearance * speed)
+
+    def sommerfeld(self, speed: float, load: float) -> float:
+        """Sommerfeld number ``S = mu N L D (R/c)^2 / W``, ``N = w / 2 pi`` rev/s, load
+        ``W`` [N]."""
+        w = _check.real("load", load, 0.0, lo_open=True, finite=True)
+        n = _check.real("speed", speed, 0.0, lo_open=True, finite=True) / (2.0 * math.pi)
+        return (self.viscosity * n * self.length * 2.0 * self.radius
+                * (self.radius / self.clearance) ** 2 / w)
+
+    def force(self, f: FilmForce, speed: float) -> tuple[float, float]:
+        """A film force's ``(F_x, F_y)`` in newtons."""
+        k = self.force_scale(speed)
+        return (f.fx * k, f.fy * k)
+
+    def pressure(self, f: FilmForce, speed: float) -> npt.NDArray[np.float64]:
+        """A film force's pressure field in pascals (``film_force(..., field=True)``)."""
+        if f.pressure is None:
+            raise ParameterError("field", "the film force carries no pressure field: "
+                                 "call film_force(..., field=True)")
+        return f.pressure * self.pressure_scale(speed)
+
+
+@dataclass(frozen=True)
+class FilmForce:
+    """The film's force on the journal, nondimensional (module doc: units, conventions).
+
+    ``fx, fy``: fixed frame, units ``F_S``; ``radial`` (positive towards the centre) and
+    ``tangential`` (positive in the direction of rotation); ``eccentricity`` ``e / c``;
+    ``position_angle`` ``phi`` of the journal centre, radians; ``attitude`` radians
+    (``atan2(tangential, radial)``); ``load`` = ``|F| / F_S``; ``sommerfeld`` = ``S = mu N L D
+    (R/c)^2 / W = 1 / (pi |F| / F_S)`` with this force as the load ``W``; ``peak_pressure``
+    over ``mu w R^2 / c^2``; ``min_film`` ``h_min / c`` (over the lands). With
+    ``field=True``: ``pressure[i, j]`` at ``(theta[i], zeta[j])``, ``zeta = z / R`` in
+    ``[-L/D, L/D]``."""
+
+    fx: float
+    fy: float
+    radial: float
+    tangential: float
+    eccentricity: float
+    position_angle: float
+    attitude: float
+    load: float
+    sommerfeld: float
+    peak_pressure: float
+    min_film: float
+    pressure: npt.NDArray[np.float64] | None = None
+    theta: npt.NDArray[np.float64] | None = None
+    zeta: npt.NDArray[np.float64] | None = None
+
+
+def film_force(bearing: Bearing, position: Any, velocity: Any = (0.0, 0.0), *,
+               field: bool = False, tau: float = 0.0) -> FilmForce:
+    """Film force at journal ``position`` ``(x, y)`` (units ``c``, eccentricity below 1)
+    and ``velocity`` ``(x', y')`` (units ``c w``); ``tau`` is the journal's angle ``w t``
+    (only journal grooves of the ``finite`` model depend on it). ``field=True`` adds the
+    pressure field."""
+    from . import _native
+
+    b = _bearing(bearing)
+    d = _native.bearing_force(b, _pair("position", position), _pair("velocity", velocity),
+                              _check.real("tau", tau, finite=True),
+                              _check.boolean("field", field))
+    return FilmForce(load=math.hypot(d["fx"], d["fy"]), **d)
+
+
+@dataclass(frozen=True)
+class BearingEquilibrium:
+    """Static journal position under a load: ``position`` ``(x, y)`` (units ``c``),
+    ``eccentricity``, ``attitude`` (radians from the load's direction to the journal's, in
+    the direction of rotation), ``load`` ``(W_x, W_y)`` in ``F_S``, ``sommerfeld`` ``S = 1
+    / (pi |W| / F_S)``, Newton ``iterations``."""
+
+    position: tuple[float, float]
+    eccentricity: float
+    attitude: float
+    load: tuple[float, float]
+    sommerfeld: float
+    iterations: int
+
+
+def _load(load: Any, dimensions: Dimensions | None, speed: float | None) -> tuple[float, float]:
+    """The load in ``F_S``: a magnitude (along ``-y``) or ``(W_x, W_y)``; in newtons with
+    ``dimensions`` and ``speed``."""
+    if _check.is_real(load):
+        w = (0.0, -_check.real("load", load, 0.0, lo_open=True, finite=True))
+    else:
+        w = _pair("load", load)
+        if w == (0.0, 0.0):
+            raise ParameterError("load", "must not be zero", allowed="|load| > 0")
+    if dimensions is None:
+        if speed is not None:
+            raise ParameterError("speed", "a speed needs dimensions= (the load is then in N)")
+        return w
+    if not isinstance(dimensions, Dimensions):
+        from .exceptions import ParameterTypeError
+
+        raise ParameterTypeError("dimensions", "must be ballbal.bearing.Dimensions",
+                                 allowed="Dimensions or None")
+    if speed is None:
+        raise ParameterError("speed", "dimensions= needs the speed [rad/s]")
+    k = dimensions.force_scale(speed)
+    return (w[0] / k, w[1] / k)
+
+
+def equilibrium(bearing: Bearing, load: Any, *, dimensions: Dimensions | None = None,
+                speed: float | None = None) -> BearingEquilibrium:
+    """Journal position where the film carries ``load``: a magnitude (along ``-y``,
+    gravity) or a vector ``(W_x, W_y)``, in ``F_S``, or in newtons with ``dimensions`` and
+    ``speed`` [rad/s]. Newton on the two coordinates."""
+    from . import _native
+
+    w = _load(load, dimensions, speed)
+    d = _native.bearing_equilibrium(_bearing(bearing), w)
+    return BearingEquilibrium(
+        position=(d["x"], d["y"]), eccentricity=d["eccentricity"], attitude=d["attitude"],
+        load=w, sommerfeld=1.0 / (math.pi * math.hypot(*w)), iterations=d["iterations"],
+    )
+
+
+@dataclass(frozen=True)
+class Coefficients:
+    """Linearised film at a static position, ``f(q0 + dq, dq') ~ f(q0) - K dq - C dq'``,
+    ``[i, j]`` = force ``i`` per displacement (velocity) ``j``, ``x, y`` fixed frame:
+    ``k`` in ``F_S / c``, ``c`` in ``F_S / (c w)``; ``k_si`` [N/m] and ``c_si`` [N s/m] when
+    dimensions and speed are given."""
+
+    k: npt.NDArray[np.float64]
+    c: npt.NDArray[np.float64]
+    k_si: npt.NDArray[np.float64] | None = None
+    c_si: npt.NDArray[np.float64] | None = None
+
+
+def coefficients(bearing: Bearing, position: Any, *, dimensions: Dimensions | None = None,
+                 speed: float | None = None) -> Coefficients:
+    """Stiffness and damping at ``position`` (a static journal position, units ``c``):
+    derivatives of the discrete film from one factorisation for the finite and
+    narrow-groove models (half-Sommerfeld or no cavitation), central differences of the
+    force otherwise."""
+    from . import _native
+
+    k, c = _native.bearing_coefficients(_bearing(bearing), _pair("position", position))
+    if dimensions is None:
+        return Coefficients(k=k, c=c)
+    if speed is None:
+        raise ParameterError("speed", "dimensions= needs the speed [rad/s]")
+    return Coefficients(k=k, c=c, k_si=k * dimensions.stiffness_scale(speed),
+                        c_si=c * dimensions.damping_scale(speed))
+
+
+@dataclass(frozen=True)
+class Stability:
+    """Whirl threshold of a rigid rotor (mass ``M``, fixed frame, no balls) on the bearing
+    at the equilibrium under the load ``W``.
+
+    ``threshold_speed``: the spin at the threshold over ``sqrt(W / (M c))`` (``sqrt(g / c)``
+    for a weight), at this operating point (this Sommerfeld number): faster whirls;
+    ``inf`` stable at every speed, ``0`` unstable at every speed. ``whirl_ratio``: whirl
+    over spin frequency at the threshold. ``critical_mass``: the mass parameter ``M c w^2 /
+    F_S`` there. Also the ``equilibrium`` and the ``coefficients`` there."""
+
+    threshold_speed: float
+    whirl_ratio: float
+    critical_mass: float
+    equilibrium: BearingEquilibrium
+    coefficients: Coefficients
+
+
+def stability(bearing: Bearing, load: Any, *, dimensions: Dimensions | None = None,
+              speed: float | None = None) -> Stability:
+    """Rigid-rotor whirl threshold under ``load`` (as :func:`equilibrium`'s), from the
+    linearised film (Lund's closed form for one film)."""
+    from . import _native
+
+    w = _load(load, dimensions, speed)
+    d = _native.bearing_stability(_bearing(bearing), w)
+    eq = BearingEquilibrium(
+        position=(d["x"], d["y"]), eccentricity=d["eccentricity"], attitude=d["attitude"],
+        load=w, sommerfeld=1.0 / (math.pi * math.hypot(*w)), iterations=0,
+    )
+    return Stability(threshold_speed=d["threshold_speed"], whirl_ratio=d["whirl_ratio"],
+                     critical_mass=d["critical_mass"], equilibrium=eq,
+                     coefficients=Coefficients(k=d["k"], c=d["c"]))
+
+
+def plot_pressure(force_or_bearing: FilmForce | Bearing, position: Any = None,
+                  velocity: Any = (0.0, 0.0), *, ax: Axes | None = None) -> Figure:
+    """Contour of the film pressure over ``theta`` (degrees) and ``zeta = z / R``, the
+    minimum film marked. Give a :class:`FilmForce` computed with ``field=True``, or a
+    :class:`Bearing` and a ``position`` (and ``velocity``)."""
+    from .plot import _pyplot
+
+    if isinstance(force_or_bearing, Bearing):
+        if position is None:
+            raise ParameterError("position", "a bearing needs the journal position")
+        f = film_force(force_or_bearing, position, velocity, field=True)
+    elif isinstance(force_or_bearing, FilmForce):
+        f = force_or_bearing
+    else:
+        from .exceptions import ParameterTypeError
+
+        raise ParameterTypeError("force_or_bearing", "must be a FilmForce or a Bearing",
+                                 allowed="FilmForce, Bearing")
+    if f.pressure is None or f.theta is None or f.zeta is None:
+        raise ParameterError("force_or_bearing", "the film force carries no pressure "
+                             "field: call film_force(..., field=True)")
+    plt = _pyplot()
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(7, 3.5))
+    else:
+        fig = ax.figure
+    cs = ax.contourf(np.degrees(f.theta), f.zeta, f.pressure.T, levels=24, cmap="viridis")
+    fig.colorbar(cs, ax=ax, label="P = p c² / (μ ω R²)")
+    phi = math.degrees(f.position_angle) % 360.0
+    ax.axvline(phi, color="w", ls="--", lw=1.0, label=f"minimum film h/c = {f.min_film:.3g}")
+    ax.set_xlabel("θ [deg]")
+    ax.set_ylabel("ζ = z / R")
+    ax.set_title(f"ε = {f.eccentricity:.3g}, attitude {math.degrees(f.attitude):.1f}°, "
+                 f"P_max = {f.peak_pressure:.3g}")
+    ax.legend(loc="upper right", fontsize="small")
+    return fig
+
+
+# A rigid rotor on the bearing (fixed frame, no balls): trajectories, seed 002's scenarios.
+# Imported last: ``_rotor`` needs :class:`Bearing`, defined above.
+from ._rotor import (  # noqa: E402
+    RotorImpulse,
+    RotorOnBearing,
+    RotorTrajectory,
+    plot_trajectory,
+    rotor_equilibrium,
+    simulate_rotor,
+)

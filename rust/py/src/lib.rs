@@ -65,6 +65,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::certificate_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::validate_bearing, m)?)?;
     rotor::register(m)?;
+    m.add_function(wrap_pyfunction!(bearing::bearing_force, m)?)?;
+    m.add_function(wrap_pyfunction!(bearing::bearing_equilibrium, m)?)?;
+    m.add_function(wrap_pyfunction!(bearing::bearing_coefficients, m)?)?;
+    m.add_function(wrap_pyfunction!(bearing::bearing_stability, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

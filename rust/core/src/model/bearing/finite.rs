@@ -654,30 +654,46 @@ impl FiniteSolver {
         out
     }
 
-    /// Swift–Stieber: `P >= 0`, `w = M P + rhs >= 0`, `P w = 0`, by a primal–dual active set
-    /// started from the linear solution (finite for an M-matrix).
+    /// Swift–Stieber cavitation: see [`active_set`].
     fn active_set(&self, film: &Film, rhs: &[f64], p0: Vec<f64>) -> Result<Vec<f64>> {
-        let mut fixed: Vec<bool> = p0.iter().map(|v| *v < 0.0).collect();
-        for _ in 0..100 {
-            let p = self.solve_sparse(film, rhs, Some(&fixed))?;
-            let mp = self.apply(film, &p);
-            let mut changed = false;
-            for c in 0..p.len() {
-                let w = mp[c] + rhs[c];
-                let next = if fixed[c] { w > 0.0 } else { p[c] < 0.0 };
-                if next != fixed[c] {
-                    fixed[c] = next;
-                    changed = true;
-                }
-            }
-            if !changed {
-                return Ok(p.into_iter().map(|v| v.max(0.0)).collect());
+        active_set(
+            rhs,
+            p0,
+            |fixed| self.solve_sparse(film, rhs, Some(fixed)),
+            |p| self.apply(film, p),
+        )
+    }
+}
+
+/// Swift–Stieber: `P >= 0`, `w = M P + rhs >= 0`, `P w = 0`, by a primal–dual active set
+/// started from the linear solution `p0` (finite for an M-matrix). `solve` solves `M P = -rhs`
+/// with the cells marked fixed held at 0, `apply` is `P -> M P`.
+pub(crate) fn active_set(
+    rhs: &[f64],
+    p0: Vec<f64>,
+    mut solve: impl FnMut(&[bool]) -> Result<Vec<f64>>,
+    apply: impl Fn(&[f64]) -> Vec<f64>,
+) -> Result<Vec<f64>> {
+    let mut fixed: Vec<bool> = p0.iter().map(|v| *v < 0.0).collect();
+    for _ in 0..100 {
+        let p = solve(&fixed)?;
+        let mp = apply(&p);
+        let mut changed = false;
+        for c in 0..p.len() {
+            let w = mp[c] + rhs[c];
+            let next = if fixed[c] { w > 0.0 } else { p[c] < 0.0 };
+            if next != fixed[c] {
+                fixed[c] = next;
+                changed = true;
             }
         }
-        Err(Error::Integration(
-            "Reynolds cavitation: the active set did not settle in 100 iterations".into(),
-        ))
+        if !changed {
+            return Ok(p.into_iter().map(|v| v.max(0.0)).collect());
+        }
     }
+    Err(Error::Integration(
+        "Reynolds cavitation: the active set did not settle in 100 iterations".into(),
+    ))
 }
 
 /// Workspace for a symmetric periodic tridiagonal solve (Sherman–Morrison on Thomas).

@@ -119,9 +119,10 @@ fn wrap(a: f64) -> f64 {
     (a + PI).rem_euclid(2.0 * PI) - PI
 }
 
-/// Linearised stiffness and damping at a static position: for the finite model (half-Sommerfeld
-/// or full film) the exact derivatives of the discrete force from one factorisation
-/// ([`super::FiniteSolver::linearise`]), otherwise central differences of the force.
+/// Linearised stiffness and damping at a static position: for the finite and narrow-groove
+/// models (half-Sommerfeld or full film) the derivatives of the discrete force from one
+/// factorisation ([`super::FiniteSolver::linearise`], [`super::NarrowSolver::linearise`]),
+/// otherwise central differences of the force.
 pub fn linear_coefficients(solver: &mut FilmSolver, x: f64, y: f64) -> Result<LinearCoefficients> {
     if let Some((_, d)) = solver.force_derivatives(&JournalState::at(x, y))? {
         let mut k = Matrix2::zeros();

@@ -16,12 +16,14 @@
 //! is `(2 lambda)^2 F_S`.
 //!
 //! Layout: this file holds the description and validation; [`short`] and [`long`] the
-//! closed forms, [`finite`] the finite-volume Reynolds solver, [`linear`] the static
+//! closed forms, [`finite`] the finite-volume Reynolds solver, [`narrow`] narrow-groove
+//! theory (the smoothed film of many grooves, on the same grid), [`linear`] the static
 //! equilibrium, linearised coefficients and whirl threshold.
 
 pub mod finite;
 pub mod linear;
 pub mod long;
+pub mod narrow;
 pub mod short;
 #[cfg(test)]
 mod tests;
@@ -34,6 +36,7 @@ pub use linear::{
     equilibrium, linear_coefficients, linear_coefficients_fd, rigid_rotor_stability, Equilibrium,
     LinearCoefficients, WhirlStability,
 };
+pub use narrow::NarrowSolver;
 
 /// Which surface carries the grooves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -135,8 +138,10 @@ pub enum FilmModel {
     Long,
     /// Finite-volume solve on `n_theta x n_zeta` cells.
     Finite { n_theta: usize, n_zeta: usize },
-    /// Vohr & Chow's narrow-groove theory (not implemented yet).
-    NarrowGroove,
+    /// Vohr & Chow's narrow-groove theory: the grooves smoothed into an anisotropic film,
+    /// solved on `n_theta x n_zeta` cells that need not resolve them (no grooves: the plain
+    /// finite film).
+    NarrowGroove { n_theta: usize, n_zeta: usize },
 }
 
 /// A journal bearing, nondimensional.
@@ -186,20 +191,7 @@ impl Bearing {
                 }
             }
             FilmModel::Finite { n_theta, n_zeta } => {
-                if n_theta < 8 {
-                    return Err(Error::param_range(
-                        "grid.n_theta",
-                        format!("must be at least 8, got {n_theta}"),
-                        "integer >= 8",
-                    ));
-                }
-                if n_zeta < 2 || n_zeta % 2 != 0 {
-                    return Err(Error::param_range(
-                        "grid.n_zeta",
-                        format!("must be even and at least 2 (cells must not straddle the mid-plane), got {n_zeta}"),
-                        "even integer >= 2",
-                    ));
-                }
+                check_grid(n_theta, n_zeta)?;
                 if let Some(g) = &self.grooves {
                     if n_theta % g.count != 0 || n_theta / g.count < MIN_CELLS_PER_PITCH {
                         return Err(Error::param_range(
@@ -224,13 +216,7 @@ impl Bearing {
                     }
                 }
             }
-            FilmModel::NarrowGroove => {
-                return Err(Error::param_range(
-                    "model",
-                    "narrow-groove theory is not implemented yet",
-                    "short, long, finite",
-                ));
-            }
+            FilmModel::NarrowGroove { n_theta, n_zeta } => check_grid(n_theta, n_zeta)?,
         }
         Ok(())
     }
@@ -245,7 +231,10 @@ impl Bearing {
             FilmModel::Finite { n_theta, n_zeta } => {
                 SolverKind::Finite(Box::new(FiniteSolver::new(self, n_theta, n_zeta)?))
             }
-            FilmModel::NarrowGroove => unreachable!("rejected by validate"),
+            FilmModel::NarrowGroove { n_theta, n_zeta } => match self.grooves {
+                Some(_) => SolverKind::Narrow(Box::new(NarrowSolver::new(self, n_theta, n_zeta)?)),
+                None => SolverKind::Finite(Box::new(FiniteSolver::new(self, n_theta, n_zeta)?)),
+            },
         };
         Ok(FilmSolver {
             bearing: self.clone(),
@@ -396,6 +385,7 @@ enum SolverKind {
     Short,
     Long,
     Finite(Box<FiniteSolver>),
+    Narrow(Box<NarrowSolver>),
 }
 
 /// Evaluates the film force of one bearing, reusing whatever the model can reuse.
@@ -419,11 +409,12 @@ impl FilmSolver {
             SolverKind::Short => Ok(short::force(lambda, cav, state, want_field)),
             SolverKind::Long => Ok(long::force(lambda, cav, state, want_field)),
             SolverKind::Finite(s) => s.force(state, want_field),
+            SolverKind::Narrow(s) => s.force(state, want_field),
         }
     }
 
     /// `dF/d(x, y, x', y')` rows `[dF_x; dF_y]` from one factorisation where the model allows
-    /// it (finite model, half-Sommerfeld or full film); `None` otherwise.
+    /// it (finite and narrow-groove models, half-Sommerfeld or full film); `None` otherwise.
     pub fn force_derivatives(
         &mut self,
         state: &JournalState,
@@ -431,6 +422,7 @@ impl FilmSolver {
         check_state(state)?;
         match &mut self.kind {
             SolverKind::Finite(s) => s.linearise(state),
+            SolverKind::Narrow(s) => s.linearise(state),
             _ => Ok(None),
         }
     }
@@ -449,6 +441,27 @@ impl FilmSolver {
         let f = self.force(state, false)?;
         Ok([f.fx, f.fy])
     }
+}
+
+/// The finite-volume grid's own limits (grooves add theirs for the resolved model).
+fn check_grid(n_theta: usize, n_zeta: usize) -> Result<()> {
+    if n_theta < 8 {
+        return Err(Error::param_range(
+            "grid.n_theta",
+            format!("must be at least 8, got {n_theta}"),
+            "integer >= 8",
+        ));
+    }
+    if n_zeta < 2 || !n_zeta.is_multiple_of(2) {
+        return Err(Error::param_range(
+            "grid.n_zeta",
+            format!(
+                "must be even and at least 2 (cells must not straddle the mid-plane), got {n_zeta}"
+            ),
+            "even integer >= 2",
+        ));
+    }
+    Ok(())
 }
 
 fn check_state(s: &JournalState) -> Result<()> {
