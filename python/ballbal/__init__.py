@@ -22,7 +22,7 @@ from .options import (
     ScanOptions,
 )
 from .scan import read_scan, scan, scan_meta
-from .scene import Impulse, Ramp, Scene, Tilt, load_scene
+from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene
 from .transient import (
     DisturbanceResponse,
     RunUp,
@@ -33,6 +33,7 @@ from .transient import (
 
 __all__ = [
     "Balancer",
+    "BearingSupport",
     "DisturbanceResponse",
     "Equilibrium",
     "Execution",

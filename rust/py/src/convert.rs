@@ -2,8 +2,10 @@
 //! and the option dataclasses of `ballbal.options`, read by attribute, and NumPy arrays.
 //! Values are not checked here: the core's constructors and `validate` do that, once.
 
+use crate::bearing::BearingArgs;
 use crate::errors::CoreResult;
 use ballbal_core::floquet::FloquetOptions;
+use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::hb::HbOptions;
 use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
 use ballbal_core::periodic::{AutoHarmonics, GuessOptions, PeriodicOptions};
@@ -54,6 +56,13 @@ struct TiltArgs {
     zeta_r: f64,
 }
 
+/// `ballbal.BearingSupport`'s fields: the film and `rho = e / c`.
+#[derive(FromPyObject)]
+struct SupportArgs {
+    bearing: BearingArgs,
+    rho: f64,
+}
+
 /// `ballbal.Scene`'s fields.
 #[derive(FromPyObject)]
 pub struct SceneArgs {
@@ -64,6 +73,7 @@ pub struct SceneArgs {
     impulse: Option<ImpulseArgs>,
     tilt: Option<TiltArgs>,
     spring_layout: String,
+    support: Option<SupportArgs>,
 }
 
 /// What every analysis takes first. A scene is tried first: a balancer has no
@@ -112,6 +122,7 @@ impl SceneArgs {
             || self.gravity != 0.0
             || self.impulse.is_some()
             || self.tilt.is_some()
+            || self.support.is_some()
     }
 
     fn scene(&self, p: Planar) -> Result<Scene, Error> {
@@ -149,7 +160,18 @@ impl SceneArgs {
                 zeta_r: t.zeta_r,
             }),
         )
-        .map(|s| s.with_spring_layout(layout))
+        .map(|s| s.with_spring_layout(layout))?
+        .with_bearing(
+            self.support
+                .as_ref()
+                .map(|b| -> Result<JournalSupport, Error> {
+                    Ok(JournalSupport {
+                        film: SupportFilm::Reynolds(b.bearing.to_core()?),
+                        rho: b.rho,
+                    })
+                })
+                .transpose()?,
+        )
     }
 }
 
