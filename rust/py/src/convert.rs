@@ -78,6 +78,8 @@ pub struct SceneArgs {
 
 /// What every analysis takes first. A scene is tried first: a balancer has no
 /// `balancer` attribute.
+// Read once per call (pyo3 cannot extract into a box): the size difference costs nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(FromPyObject)]
 pub enum ModelArgs {
     Scene(SceneArgs),
