@@ -212,3 +212,16 @@ def test_bearing_scene_file_round_trips(tmp_path):
     with pytest.raises(ParameterError) as e:
         ballbal.load_scene(p)
     assert e.value.parameter == "bearing.rho"
+
+
+def test_maps_and_scans_refuse_a_value_that_makes_the_scene_time_dependent():
+    # depth 0 on the sleeve is a plain (autonomous) bearing; cutting the grooves makes
+    # the scene time-periodic, which the map and the scan must refuse, not mislabel
+    flat = on(Bearing(length_ratio=0.5, grooves=Grooves(8, 30.0, 0.0), grid=(64, 8)))
+    assert flat.time_dependence is None
+    with pytest.raises(NotAutonomousError) as e:
+        ballbal.balance_map(flat, Omega=[2.0], depth_ratio=[0.0, 0.5])
+    assert e.value.effect == "grooved_sleeve"
+    with pytest.raises(NotAutonomousError) as e:
+        ballbal.scan(flat, Omega=[2.0], depth_ratio=[0.5])
+    assert e.value.effect == "grooved_sleeve"
