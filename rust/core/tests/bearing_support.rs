@@ -4,13 +4,14 @@
 
 use ballbal_core::analysis::balanced::balanced_state;
 use ballbal_core::equilibria::Verdict;
+use ballbal_core::hb::{solve, HbOptions, Status};
 use ballbal_core::model::bearing::{
     Bearing, Cavitation, FilmModel, GrooveSide, Grooves, JournalState,
 };
 use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::model::Dynamics;
 use ballbal_core::ode::Options;
-use ballbal_core::periodic::require_autonomous;
+use ballbal_core::periodic::{guess_from_state, require_autonomous, GuessOptions};
 use ballbal_core::simulate::simulate;
 use ballbal_core::{Error, Planar, Scene};
 use std::f64::consts::PI;
@@ -97,6 +98,22 @@ fn a_linear_film_is_the_spring_damper_support() {
     for (ya, yb) in a.y.iter().zip(&b.y) {
         assert!(rel_err(ya, yb) < 1e-7, "{ya:?} {yb:?}");
     }
+    // the same R-R orbit by harmonic balance, from one guess
+    let guess = guess_from_state(&want, &y0, Some(&[true, true]), 8, &GuessOptions::default())
+        .expect("a rotating attractor to start from");
+    let opts = HbOptions {
+        n_harm: 8,
+        ..HbOptions::default()
+    };
+    let (sa, sb) = (solve(&want, &guess, &opts), solve(&got, &guess, &opts));
+    assert_eq!(sa.status, Status::Converged);
+    assert_eq!(sb.status, Status::Converged);
+    assert!(
+        (sa.omega - sb.omega).abs() < 1e-10 * sa.omega,
+        "{} {}",
+        sa.omega,
+        sb.omega
+    );
     // and the same perfect balance with the same eigenvalues
     let (ea, eb) = (
         balanced_state(&Scene::new(want, 0.0, None, 0.0, None, None).unwrap()).unwrap(),

@@ -5,8 +5,8 @@
 use crate::bearing::BearingArgs;
 use crate::errors::CoreResult;
 use ballbal_core::floquet::FloquetOptions;
-use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::hb::HbOptions;
+use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
 use ballbal_core::periodic::{AutoHarmonics, GuessOptions, PeriodicOptions};
 use ballbal_core::{Error, Planar, Scene, SpringLayout};
