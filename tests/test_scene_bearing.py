@@ -198,6 +198,11 @@ def test_bearing_scene_file_round_trips(tmp_path):
     p = tmp_path / "bearing.toml"
     sc.save(p)
     assert ballbal.load_scene(p) == sc
+    moved = sc.replace(rho=0.5, Omega=3.0)
+    assert moved.support is not None and moved.support.rho == 0.5 and moved.Omega == 3.0
+    with pytest.raises(ParameterError) as e:
+        ballbal.Scene(balancer=BAL).replace(rho=0.5)
+    assert e.value.parameter == "rho"
     p.write_text("Omega = 2.0\nballs = 2\n[bearing]\nrho = 0.4\nmodel = \"short\"\n"
                  "length_ratio = 0.5\n")
     back = ballbal.load_scene(p)
