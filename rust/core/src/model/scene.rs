@@ -230,14 +230,16 @@ impl Scene {
                     "a bearing support carries a planar disk; the tilting disk's support is its shaft",
                 ));
             }
-            Self::check_bearing_spin(&self.planar, &self.ramp)?;
+            Self::check_bearing_spin(&self.planar)?;
         }
         self.bearing = bearing;
         self.reassemble();
         Ok(self)
     }
 
-    fn check_bearing_spin(p: &Planar, ramp: &Option<Ramp>) -> Result<()> {
+    /// The film's force scales with the spin: `Omega > 0` (a ramp's `to` is positive by
+    /// its own range).
+    fn check_bearing_spin(p: &Planar) -> Result<()> {
         if !(p.omega_s > 0.0) {
             return Err(Error::param_range(
                 "Omega",
@@ -248,7 +250,6 @@ impl Scene {
                 "(0, inf)",
             ));
         }
-        let _ = ramp; // ramp.to is positive by its own range
         Ok(())
     }
 
