@@ -22,7 +22,7 @@ from .options import (
     ScanOptions,
 )
 from .scan import read_scan, scan, scan_meta
-from .scene import Impulse, Ramp, Scene, Tilt, load_scene
+from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene
 from .spectrum import (
     Vibration,
     label_peaks,
@@ -40,6 +40,7 @@ from .transient import (
 
 __all__ = [
     "Balancer",
+    "BearingSupport",
     "DisturbanceResponse",
     "Equilibrium",
     "Execution",

@@ -33,8 +33,9 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     """The balanced state's stability over a grid: one row per point of the product of
     ``axes`` (parameter name = values; balancer fields such as ``Omega``, ``eta``,
     ``zeta_b``, ``zeta``, the scene's ``springs`` and tilt fields ``j_t``, ``j_z``,
-    ``zeta_r``, ``a``, ``b``). Points are solved in parallel in the core, each on its own,
-    so the table does not depend on the thread count.
+    ``zeta_r``, ``a``, ``b``; on a bearing ``rho``, ``depth_ratio``, ``groove_angle``).
+    Points are solved in parallel in the core, each on its own, so the table does not
+    depend on the thread count.
 
     Columns: the axes, ``status`` (``"ok"``; ``"no_balance"`` where the balls cannot
     balance the disk; ``"not_converged"`` where the continuation from the planar
@@ -47,7 +48,8 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
         raise ParameterError("axes", "give at least one parameter to vary, e.g. Omega=[...]")
     scene = model if isinstance(model, Scene) else Scene(balancer=model)
     names = list(axes)
-    allowed = _MAP_AXES | (_TILT_AXES if scene.tilt is not None else set())
+    allowed = (_MAP_AXES | (_TILT_AXES if scene.tilt is not None else set())
+               | (_BEARING_AXES if scene.support is not None else set()))
     values: list[list[float]] = []
     for name in names:
         if name not in allowed:
@@ -88,6 +90,8 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
 
 _MAP_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta", "springs"}
 _TILT_AXES = {"a", "b", "j_t", "j_z", "zeta_r"}
+#: On a bearing support: ``rho = e / c``, and the grooves' depth ratio and angle (degrees).
+_BEARING_AXES = {"rho", "depth_ratio", "groove_angle"}
 
 
 def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: str = "",

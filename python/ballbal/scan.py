@@ -44,8 +44,10 @@ except ImportError:  # pragma: no cover - not on POSIX: scan directories are not
     fcntl = None  # type: ignore[assignment]
 
 SCANNABLE = ("mu", "zeta", "zeta_b", "delta", "Omega", "eta")
-#: Scene parameters a scan can vary besides the balancer's (tilt fields need a tilt).
-SCENE_SCANNABLE = ("springs", "a", "b", "j_t", "j_z", "zeta_r")
+#: Scene parameters a scan can vary besides the balancer's (tilt fields need a tilt; the
+#: bearing's ``rho`` and groove ``depth_ratio``, ``groove_angle`` need a bearing support).
+SCENE_SCANNABLE = ("springs", "a", "b", "j_t", "j_z", "zeta_r", "rho", "depth_ratio",
+                   "groove_angle")
 _INDEXED = ("eta[", "zeta_b[")
 
 GridSpec = Sequence[float] | np.ndarray | tuple[float, float, float] | str

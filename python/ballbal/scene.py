@@ -18,18 +18,32 @@ the eccentricity ``e``, time over ``1/w_n``, forces over ``M e w_n^2``):
   ``A, B``, the Euler tilts ``alpha, beta`` scaled by ``delta`` (the track rim's axial
   displacement over ``e``; radians are ``A / delta``).
 
-The support is the isotropic spring–damper of ``model.md`` (a fluid-film bearing is a
-later issue: it will be one more support kind here).
+The support is the isotropic spring–damper of ``model.md`` unless ``support`` is a
+:class:`BearingSupport`: a hydrodynamic journal bearing (:class:`ballbal.bearing.Bearing`)
+with ``rho = e / c`` (unbalance eccentricity over radial clearance). On a bearing there is
+no spring, so the units change: time is over ``1 / w_ref`` with ``w_ref = C_S / M``,
+``C_S = mu_oil L R^3 / c^3`` (``M`` the translating mass, ``mu_oil`` the viscosity, ``R``,
+``L``, ``c`` the journal radius, length and clearance), forces over ``M e w_ref^2``;
+``Omega = w / w_ref`` is the classical mass parameter ``M c^3 w / (mu_oil L R^3)``.
+``zeta`` becomes an external damper on the centre's ground velocity in parallel with the
+film, ``c_ext / (2 M w_ref)`` (0 for the film alone); ``zeta_b`` is ``c_b / (2 m_b w_ref)``.
+Converting a spring–damper scene keeps the numbers but not their meaning: a ratio over
+``w_n`` becomes one over ``w_ref``, so the same lab ``zeta_b`` is ``zeta_b w_n / w_ref``.
+A plain bearing, grooves on the journal or narrow-groove theory keep the scene
+autonomous; resolved grooves (``model="finite"``) on the stationary sleeve make it
+time-periodic (effect ``"grooved_sleeve"``): simulation only.
 
 Every analysis accepts a scene. Time simulation works with any; periodic solutions,
 Floquet, equilibria, scans and the balanced state need an autonomous scene (no ramp,
-gravity or impulse: asking is an error that names the effect).
+gravity, impulse or grooved sleeve: asking is an error that names the effect).
 
 Files (TOML): the balancer's keys at the top level or in ``[balancer]`` (``balls`` for
 equal balls), and optional tables ``[springs] stiffness, layout`` (``"ring"`` when
 omitted), ``[ramp] to, start,
 duration``, ``[gravity] g``, ``[impulse] amplitude, t0, sharpness, angle``, ``[tilt] a,
-b, j_t, j_z, zeta_r``. Unknown keys and tables are errors.
+b, j_t, j_z, zeta_r``, ``[bearing] rho, length_ratio, cavitation, model, grid`` with an
+optional ``[bearing.grooves] count, angle, depth_ratio, width_ratio, grooved_length,
+side``. Unknown keys and tables are errors.
 """
 
 from __future__ import annotations
@@ -41,6 +55,7 @@ from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
 from . import _check
+from .bearing import Bearing, Grooves
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer, _is_number
 
@@ -125,6 +140,33 @@ class Tilt:
 
 
 @dataclass(frozen=True)
+class BearingSupport:
+    """The disk centre carried by a journal bearing: the film ``bearing`` and ``rho = e /
+    c``, the unbalance eccentricity over the radial clearance (the journal sits at ``rho
+    (x, y)`` clearances from the centre). See the module documentation for the units."""
+
+    bearing: Bearing
+    rho: float
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.bearing, Bearing):
+            raise ParameterTypeError("bearing", f"must be a ballbal.bearing.Bearing, got "
+                                     f"{type(self.bearing).__name__}")
+        object.__setattr__(self, "rho", _num("rho", self.rho))
+        _core_check(support=self)
+
+    @property
+    def time_dependence(self) -> str | None:
+        """``"grooved_sleeve"`` when resolved grooves on the sleeve make the film
+        time-periodic in the disk's frame, else None."""
+        g = self.bearing.grooves
+        if (g is not None and g.side == "sleeve" and g.depth_ratio > 0
+                and self.bearing.model == "finite"):
+            return "grooved_sleeve"
+        return None
+
+
+@dataclass(frozen=True)
 class Scene:
     balancer: Balancer = field(default_factory=Balancer)
     springs: float = 0.0
@@ -133,6 +175,7 @@ class Scene:
     impulse: Impulse | None = None
     tilt: Tilt | None = None
     spring_layout: str = "ring"
+    support: BearingSupport | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.balancer, Balancer):
@@ -145,11 +188,18 @@ class Scene:
         if not isinstance(self.spring_layout, str) or self.spring_layout not in ("ring", "chain"):
             raise ParameterError("spring_layout", f"must be 'ring' or 'chain', "
                                  f"got {self.spring_layout!r:.60}", allowed="ring, chain")
-        for name, kind in (("ramp", Ramp), ("impulse", Impulse), ("tilt", Tilt)):
+        for name, kind in (("ramp", Ramp), ("impulse", Impulse), ("tilt", Tilt),
+                           ("support", BearingSupport)):
             v = getattr(self, name)
             if v is not None and not isinstance(v, kind):
                 raise ParameterTypeError(name, f"must be a {kind.__name__} or None, got "
                                          f"{type(v).__name__}")
+        if self.support is not None:
+            # what the support asks of the rest (Omega > 0, a planar disk), checked once,
+            # in the core
+            from . import _native
+
+            _native.validate(self)
 
     # the interface the analyses use, shared with Balancer
     @property
@@ -170,7 +220,8 @@ class Scene:
         """A copy with fields changed; balancer fields (``Omega``, ``eta``, ...) and tilt
         fields (``j_t``, ``a``, ...) may be given directly; a single ``eta`` sets every
         ball's."""
-        known = _BALANCER_FIELDS | _TILT_FIELDS | {f.name for f in fields(Scene)}
+        known = (_BALANCER_FIELDS | _TILT_FIELDS | {f.name for f in fields(Scene)}
+                 | {"rho"})
         for k in changes:
             if k not in known:
                 raise ParameterError(k, "not a field of the scene, its balancer or its tilt "
@@ -181,6 +232,11 @@ class Scene:
         tl = {k: changes.pop(k) for k in list(changes) if k in _TILT_FIELDS}
         if bal:
             changes["balancer"] = self.balancer.replace(**bal).validate()
+        if "rho" in changes:
+            rho = changes.pop("rho")
+            if self.support is None:
+                raise ParameterError("rho", "the scene has no bearing support to change")
+            changes["support"] = replace(self.support, rho=rho)
         if tl:
             if self.tilt is None:
                 raise ParameterError(next(iter(tl)), "the scene has no tilt to change")
@@ -190,7 +246,8 @@ class Scene:
     def _effects_on(self) -> bool:
         """Whether any effect is on (else every analysis runs the planar code)."""
         return bool(self.springs != 0 or self.ramp is not None or self.gravity != 0
-                    or self.impulse is not None or self.tilt is not None)
+                    or self.impulse is not None or self.tilt is not None
+                    or self.support is not None)
 
     @property
     def time_dependence(self) -> str | None:
@@ -201,6 +258,8 @@ class Scene:
             return "gravity"
         if self.impulse is not None:
             return "impulse"
+        if self.support is not None:
+            return self.support.time_dependence
         return None
 
     def to_dict(self) -> dict[str, Any]:
@@ -221,15 +280,31 @@ class Scene:
             d["impulse"] = asdict(self.impulse)
         if self.tilt is not None:
             d["tilt"] = asdict(self.tilt)
+        if self.support is not None:
+            bearing = self.support.bearing
+            t: dict[str, Any] = {"rho": self.support.rho,
+                                 "length_ratio": bearing.length_ratio,
+                                 "cavitation": bearing.cavitation, "model": bearing.model,
+                                 "grid": list(bearing.grid or ())}
+            if bearing.grooves is not None:
+                t["grooves"] = asdict(bearing.grooves)
+            d["bearing"] = t
         return d
 
     def to_toml(self) -> str:
         lines: list[str] = []
         for table, values in self.to_dict().items():
             lines.append(f"[{table}]")
+            subs = {k: v for k, v in values.items() if isinstance(v, dict)}
             for k, v in values.items():
-                lines.append(f"{k} = {_toml_value(v)}")
+                if k not in subs:
+                    lines.append(f"{k} = {_toml_value(v)}")
             lines.append("")
+            for sub, inner in subs.items():
+                lines.append(f"[{table}.{sub}]")
+                for k, v in inner.items():
+                    lines.append(f"{k} = {_toml_value(v)}")
+                lines.append("")
         return "\n".join(lines)
 
     def save(self, path: str | os.PathLike[str]) -> None:
@@ -242,14 +317,19 @@ def _toml_value(v: Any) -> str:
         return '"' + v + '"'  # layout names only: no quotes or escapes inside
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, int) and not isinstance(v, bool):
+        return str(v)  # groove counts and grids
     return repr(float(v))
 
 
 _TABLES = {"springs": {"stiffness", "layout"}, "ramp": {"to", "start", "duration"},
            "gravity": {"g"}, "impulse": {"amplitude", "t0", "sharpness", "angle"},
-           "tilt": {"a", "b", "j_t", "j_z", "zeta_r"}}
+           "tilt": {"a", "b", "j_t", "j_z", "zeta_r"},
+           "bearing": {"rho", "length_ratio", "grooves", "cavitation", "model", "grid"}}
 _REQUIRED = {"springs": {"stiffness"}, "ramp": {"to"}, "gravity": {"g"},
-             "impulse": {"amplitude", "t0", "sharpness"}, "tilt": {"a", "b", "j_t", "j_z"}}
+             "impulse": {"amplitude", "t0", "sharpness"}, "tilt": {"a", "b", "j_t", "j_z"},
+             "bearing": {"rho"}}
+_GROOVE_KEYS = {f.name for f in fields(Grooves)}
 #: A scene file is a few lines; anything much longer is the wrong file.
 MAX_SCENE_BYTES = 1 << 20
 _BALANCER_FIELDS = {f.name for f in fields(Balancer)}
@@ -319,9 +399,11 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
         if missing:
             raise ParameterError(f"{t}.{missing[0]}", f"{where}: [{t}] needs "
                                  f"{', '.join(missing)}")
+    support = _support_from_dict(d["bearing"], where) if "bearing" in d else None
     try:
         return Scene(
             balancer=b,
+            support=support,
             springs=d["springs"]["stiffness"] if "springs" in d else 0.0,
             spring_layout=d["springs"].get("layout", "ring") if "springs" in d else "ring",
             ramp=Ramp(**d["ramp"]) if "ramp" in d else None,
@@ -331,6 +413,32 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
         )
     except (KeyError, TypeError) as e:
         raise ParameterError("scene", f"{where}: incomplete effect table ({e})") from e
+
+
+def _support_from_dict(t: dict[str, Any], where: str) -> BearingSupport:
+    """The ``[bearing]`` table (keys checked by the caller) as a :class:`BearingSupport`."""
+    t = dict(t)
+    rho = t.pop("rho")
+    g = t.pop("grooves", None)
+    grooves = None
+    if g is not None:
+        if not isinstance(g, dict):
+            raise ParameterTypeError("bearing.grooves", f"{where}: [bearing.grooves] must be a "
+                                     "table")
+        extra = sorted(set(g) - _GROOVE_KEYS)
+        if extra:
+            raise ParameterError(f"bearing.grooves.{extra[0]}", f"{where}: unknown key(s) "
+                                 f"{', '.join(extra)} (allowed: "
+                                 f"{', '.join(sorted(_GROOVE_KEYS))})",
+                                 allowed=", ".join(sorted(_GROOVE_KEYS)))
+        try:
+            grooves = Grooves(**g)
+        except TypeError as e:
+            raise ParameterError("bearing.grooves", f"{where}: [bearing.grooves] needs count, "
+                                 f"angle and depth_ratio ({e})") from e
+    if isinstance(t.get("grid"), list):
+        t["grid"] = tuple(t["grid"])
+    return BearingSupport(bearing=Bearing(grooves=grooves, **t), rho=rho)
 
 
 def load_scene(path: str | os.PathLike[str]) -> Scene:

@@ -2,9 +2,11 @@
 //! and the option dataclasses of `ballbal.options`, read by attribute, and NumPy arrays.
 //! Values are not checked here: the core's constructors and `validate` do that, once.
 
+use crate::bearing::BearingArgs;
 use crate::errors::CoreResult;
 use ballbal_core::floquet::FloquetOptions;
 use ballbal_core::hb::HbOptions;
+use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
 use ballbal_core::periodic::{AutoHarmonics, GuessOptions, PeriodicOptions};
 use ballbal_core::{Error, Planar, Scene, SpringLayout};
@@ -54,6 +56,13 @@ struct TiltArgs {
     zeta_r: f64,
 }
 
+/// `ballbal.BearingSupport`'s fields: the film and `rho = e / c`.
+#[derive(FromPyObject)]
+struct SupportArgs {
+    bearing: BearingArgs,
+    rho: f64,
+}
+
 /// `ballbal.Scene`'s fields.
 #[derive(FromPyObject)]
 pub struct SceneArgs {
@@ -64,10 +73,13 @@ pub struct SceneArgs {
     impulse: Option<ImpulseArgs>,
     tilt: Option<TiltArgs>,
     spring_layout: String,
+    support: Option<SupportArgs>,
 }
 
 /// What every analysis takes first. A scene is tried first: a balancer has no
 /// `balancer` attribute.
+// Read once per call (pyo3 cannot extract into a box): the size difference costs nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(FromPyObject)]
 pub enum ModelArgs {
     Scene(SceneArgs),
@@ -112,6 +124,7 @@ impl SceneArgs {
             || self.gravity != 0.0
             || self.impulse.is_some()
             || self.tilt.is_some()
+            || self.support.is_some()
     }
 
     fn scene(&self, p: Planar) -> Result<Scene, Error> {
@@ -149,7 +162,18 @@ impl SceneArgs {
                 zeta_r: t.zeta_r,
             }),
         )
-        .map(|s| s.with_spring_layout(layout))
+        .map(|s| s.with_spring_layout(layout))?
+        .with_bearing(
+            self.support
+                .as_ref()
+                .map(|b| -> Result<JournalSupport, Error> {
+                    Ok(JournalSupport {
+                        film: SupportFilm::Reynolds(b.bearing.to_core()?),
+                        rho: b.rho,
+                    })
+                })
+                .transpose()?,
+        )
     }
 }
 

@@ -177,6 +177,8 @@ pub fn balance_map<'py>(
         for (n, &v) in names.iter().zip(pt) {
             s = s.with_param(n, v).py()?;
         }
+        // a parameter can switch an effect on (grooves cut into a bearing's sleeve)
+        require_autonomous(&s).map_err(|e| not_autonomous(e, "balance_map"))?;
         scenes.push(s);
     }
     let found = each_scene(py, &scenes, |s| match balanced_state(s) {

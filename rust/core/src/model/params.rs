@@ -29,6 +29,9 @@ pub enum ParamId {
     ImpulseT0,
     ImpulseSharpness,
     ImpulseAngle,
+    Rho,
+    GrooveDepth,
+    GrooveAngle,
 }
 
 /// An interval with open or closed ends; infinite ends are always open.
@@ -218,6 +221,25 @@ pub const REGISTRY: &[ParamSpec] = &[
         None,
         "impulse",
         FINITE,
+        false,
+    ),
+    // the journal-bearing support: e / c, and its grooves (angle in degrees from the
+    // circumferential direction, as ballbal.bearing.Grooves gives it)
+    spec(P::Rho, "rho", Some("rho"), "bearing", POSITIVE, false),
+    spec(
+        P::GrooveDepth,
+        "grooves.depth_ratio",
+        Some("depth_ratio"),
+        "bearing",
+        NON_NEGATIVE,
+        false,
+    ),
+    spec(
+        P::GrooveAngle,
+        "grooves.angle",
+        Some("groove_angle"),
+        "bearing",
+        iv(0.0, true, 90.0, false),
         false,
     ),
 ];

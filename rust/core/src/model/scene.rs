@@ -39,12 +39,21 @@
 //! `kappa_c = a b (a - b) / (a^2 - a b + b^2)` and tilt stiffness
 //! `kappa_t = a^2 b^2 / (a^2 - a b + b^2)` (over `k r_t` and `k r_t^2`). With `a = b`
 //! the coupling vanishes and a disk started flat stays flat: the planar equations.
+//!
+//! Support: the isotropic spring–damper (the default), or a hydrodynamic journal bearing
+//! ([`Scene::with_bearing`], [`BearingSupport`]): the planar disk and free balls as
+//! components with the film force on the centre. Its units are the film's, not `w_n`'s
+//! (no spring): time over `1 / w_ref` with `w_ref = C_S / M`, `C_S = mu_oil L R^3 / c^3`;
+//! the balancer's `zeta` is an external damper in parallel with the film, relative to
+//! `w_ref` (see [`crate::model::components::BearingSupport`]).
 
 use crate::error::{Error, Result};
 use crate::model::assembly::{Assembly, PlanarAssembly};
 use crate::model::component::{Component, Composed, Drive};
 use crate::model::components::{
-    BallSprings, FusedPlanar, FusedTilting, Gravity, IsotropicSupport, TiltingBalls, TiltingDisk,
+    no_bearing, BallSprings, BearingSupport, FreeBalls, FusedPlanar, FusedTilting, Gravity,
+    IsotropicSupport, JournalSupport, PlanarDisk, SolverPool, SupportFilm, TiltingBalls,
+    TiltingDisk,
 };
 use crate::model::params::{key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
 use crate::model::tilt_terms::RotorConsts;
@@ -126,7 +135,12 @@ pub struct Scene {
     pub gravity: f64,
     pub impulse: Option<Impulse>,
     pub tilt: Option<Tilt>,
+    /// The journal-bearing support (`None`: the spring–damper); set with
+    /// [`Scene::with_bearing`].
+    pub bearing: Option<JournalSupport>,
     model: Assembly,
+    /// The bearing's film solvers, kept across reassembly while the film is unchanged.
+    pool: Option<Arc<SolverPool>>,
 }
 
 impl PartialEq for Scene {
@@ -139,6 +153,7 @@ impl PartialEq for Scene {
             && self.gravity == o.gravity
             && self.impulse == o.impulse
             && self.tilt == o.tilt
+            && self.bearing == o.bearing
     }
 }
 
@@ -197,9 +212,45 @@ impl Scene {
             gravity,
             impulse,
             tilt,
+            bearing: None,
+            pool: None,
         };
         s.reassemble();
         Ok(s)
+    }
+
+    /// The same scene on a journal bearing (`None`: back on the spring–damper). Needs a
+    /// planar disk and `Omega > 0` (the film's force scale is the spin).
+    pub fn with_bearing(mut self, bearing: Option<JournalSupport>) -> Result<Self> {
+        if let Some(b) = &bearing {
+            b.validate()?;
+            if self.tilt.is_some() {
+                return Err(Error::param(
+                    "bearing",
+                    "a bearing support carries a planar disk; the tilting disk's support is its shaft",
+                ));
+            }
+            Self::check_bearing_spin(&self.planar)?;
+        }
+        self.bearing = bearing;
+        self.reassemble();
+        Ok(self)
+    }
+
+    /// The film's force scales with the spin: `Omega > 0` (a ramp's `to` is positive by
+    /// its own range).
+    fn check_bearing_spin(p: &Planar) -> Result<()> {
+        if !(p.omega_s > 0.0) {
+            return Err(Error::param_range(
+                "Omega",
+                format!(
+                    "must be > 0 on a bearing (the film's force scales with the spin), got {}",
+                    p.omega_s
+                ),
+                "(0, inf)",
+            ));
+        }
+        Ok(())
     }
 
     /// Assembles the model from the description: exactly the components switched on,
@@ -222,6 +273,35 @@ impl Scene {
             kd: self.springs * p.delta * p.delta,
             layout: self.spring_layout,
         });
+        if let Some(b) = &self.bearing {
+            // the planar disk and free balls as components (their inertia is the planar
+            // balancer's: its arrow mass solve), then the film
+            let mut parts: Vec<Arc<dyn Component>> = vec![
+                Arc::new(PlanarDisk { mu: p.mu }),
+                Arc::new(FreeBalls {
+                    zeta_b: p.zeta_b.clone(),
+                    delta: p.delta,
+                }),
+            ];
+            if let Some(s) = springs {
+                parts.push(Arc::new(s));
+            }
+            if self.gravity != 0.0 {
+                parts.push(Arc::new(Gravity { g: self.gravity }));
+            }
+            if let Some(f) = &self.impulse {
+                parts.push(Arc::new(f.clone()));
+            }
+            let support = BearingSupport::new(b.clone(), p.zeta, self.pool.take());
+            self.pool = support.pool().cloned();
+            parts.push(Arc::new(support));
+            self.model = Assembly::Composed(
+                Composed::new(Layout::planar(n), drive, m, parts)
+                    .with_planar_mass(p)
+                    .with_modulo_turns(self.springs == 0.0),
+            );
+            return;
+        }
         let Some(consts) = self.rotor_consts() else {
             // the planar balancer's fused code, the effects dispatched statically, summed
             // in the order springs, load, gravity
@@ -292,9 +372,10 @@ impl Scene {
     /// The names `with_param` takes, as its error lists them.
     fn keys() -> String {
         format!(
-            "{}; with a tilting disk {}",
+            "{}; with a tilting disk {}; on a bearing {}",
             key_list(SCENE_OWNERS),
-            key_list(&["tilting_disk"])
+            key_list(&["tilting_disk"]),
+            key_list(&["bearing"])
         )
     }
 
@@ -311,8 +392,12 @@ impl Scene {
     pub fn with(&self, p: ParamRef, value: f64) -> Result<Self> {
         let mut s = self.clone();
         s.set_field(p, value)?;
-        Scene::new(s.planar, s.springs, s.ramp, s.gravity, s.impulse, s.tilt)
-            .map(|x| x.with_spring_layout(self.spring_layout))
+        let pool = s.pool.take();
+        let mut out = Scene::new(s.planar, s.springs, s.ramp, s.gravity, s.impulse, s.tilt)?
+            .with_spring_layout(self.spring_layout);
+        // a copy whose film is unchanged shares the solvers (results do not depend on them)
+        out.pool = pool;
+        out.with_bearing(s.bearing)
     }
 
     /// Sets one parameter in place and reassembles, without revalidating (continuation's
@@ -346,7 +431,18 @@ impl Scene {
             P::ImpulseT0 => f.map(|f| f.t0),
             P::ImpulseSharpness => f.map(|f| f.sharpness),
             P::ImpulseAngle => f.map(|f| f.angle),
+            P::Rho => self.bearing.as_ref().map(|b| b.rho),
+            P::GrooveDepth => self.grooves().map(|g| g.depth),
+            P::GrooveAngle => self.grooves().map(|g| g.angle.to_degrees()),
             _ => self.planar.get(p),
+        }
+    }
+
+    /// The bearing's grooves, if it has any.
+    fn grooves(&self) -> Option<&crate::model::bearing::Grooves> {
+        match &self.bearing.as_ref()?.film {
+            SupportFilm::Reynolds(b) => b.grooves.as_ref(),
+            SupportFilm::Linear { .. } => None,
         }
     }
 
@@ -392,6 +488,35 @@ impl Scene {
                     P::ImpulseSharpness => &mut f.sharpness,
                     _ => &mut f.angle,
                 }
+            }
+            P::Rho => {
+                let b = self
+                    .bearing
+                    .as_mut()
+                    .ok_or_else(|| no_bearing(p.name().as_str()))?;
+                &mut b.rho
+            }
+            P::GrooveDepth | P::GrooveAngle => {
+                let b = self
+                    .bearing
+                    .as_mut()
+                    .ok_or_else(|| no_bearing(p.name().as_str()))?;
+                let g = match &mut b.film {
+                    SupportFilm::Reynolds(bb) => bb.grooves.as_mut(),
+                    SupportFilm::Linear { .. } => None,
+                }
+                .ok_or_else(|| {
+                    Error::param(
+                        p.name(),
+                        "is a groove parameter, and the bearing has no grooves",
+                    )
+                })?;
+                if p.id == P::GrooveAngle {
+                    // degrees here, radians in the film
+                    g.angle = value.to_radians();
+                    return Ok(());
+                }
+                &mut g.depth
             }
             _ => {
                 debug_assert!(PLANAR_OWNERS.contains(&p.id.spec().owner));

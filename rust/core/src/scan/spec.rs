@@ -50,7 +50,8 @@ impl<D: Family> ScanSpec<'_, D> {
                 return Err(Error::param(name.as_str(), "the grid is empty"));
             }
             for &v in vals {
-                self.base.with_param(name, v)?;
+                // a value can switch an effect on (grooves cut into a bearing's sleeve)
+                require_autonomous(&self.base.with_param(name, v)?)?;
             }
         }
         // Every combination must be valid, not just every value (e.g. ball masses).

@@ -1,0 +1,232 @@
+"""The balancer on a journal-bearing support (bearing.md section 4), each check against
+something computed here: a ground-frame simulation with the short-bearing film written
+out by quadrature, the growth rate of a simulated perturbation, the refusals of
+time-dependent scenes, bad input naming its parameter, files round-tripping."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import ballbal
+from ballbal.bearing import Bearing, Grooves
+from ballbal.exceptions import NotAutonomousError, ParameterError
+
+BAL = ballbal.Balancer(mu=0.2, zeta=0.0, zeta_b=0.05, delta=50.0, Omega=2.0, eta=(1.0, 1.0))
+SHORT = Bearing(length_ratio=0.5, model="short")
+JOURNAL = Bearing(length_ratio=0.5, grooves=Grooves(8, 30.0, 1.0, side="journal"),
+                  grid=(64, 8))
+SLEEVE = Bearing(length_ratio=0.5, grooves=Grooves(8, 30.0, 1.0, side="sleeve"),
+                 grid=(64, 8))
+
+
+def on(bearing: Bearing, rho: float = 0.3, **kw: float) -> ballbal.Scene:
+    return ballbal.Scene(balancer=BAL.replace(**kw), support=ballbal.BearingSupport(bearing,
+                                                                                    rho))
+
+
+def short_film(lam, x, y, vx, vy, n=2048):
+    """Ocvirk's short-bearing force with squeeze and the half-Sommerfeld clip, by
+    quadrature of its pressure P = (zeta^2 - lam^2) (3 H_theta + 6 H_tau) / H^3 over
+    theta (the zeta integral is exact), in units F_S (bearing.md section 1)."""
+    th = (np.arange(n) + 0.5) * 2 * np.pi / n
+    c, s = np.cos(th), np.sin(th)
+    h = 1 - x * c - y * s
+    g = 3 * (x * s - y * c) - 6 * (vx * c + vy * s)
+    g = np.minimum(g, 0.0)  # P > 0 where g < 0 (zeta^2 < lam^2)
+    # F = -(1 / 2 lam) int int P n; int (zeta^2 - lam^2) dzeta = -4 lam^3 / 3
+    k = (2 * lam**2 / 3) * 2 * np.pi / n
+    return k * np.sum(g * c / h**3), k * np.sum(g * s / h**3)
+
+
+def ground_rhs(sc, t, s):
+    """The balancer in the ground frame (as tests/ground_frame.py) with the film force
+    (Omega / rho) F(rho X, rho X' / Omega) in place of the spring, plus the external
+    damper 2 zeta X'."""
+    b = sc.balancer
+    n = b.n_balls
+    eta = np.asarray(b.eta)
+    mu, dl, z, om = b.mu, b.delta, b.zeta, b.Omega
+    rho, lam = sc.support.rho, sc.support.bearing.length_ratio
+    fb = mu * eta / dl
+    X, Y, phi = s[0], s[1], s[2: 2 + n]
+    dX, dY, dphi = s[n + 2], s[n + 3], s[n + 4:]
+    th = om * t
+    fx, fy = short_film(lam, rho * X, rho * Y, rho * dX / om, rho * dY / om)
+    fx, fy = om / rho * fx, om / rho * fy
+    S, C = np.sin(phi), np.cos(phi)
+    M = np.eye(n + 2)
+    M[0, 2:] = M[2:, 0] = -fb * dl * S
+    M[1, 2:] = M[2:, 1] = fb * dl * C
+    M[2:, 2:] = np.diag(fb * dl**2)
+    rhs = np.empty(n + 2)
+    rhs[0] = fx - 2 * z * dX + mu * math.cos(th) * om**2 + np.sum(fb * dl * C * dphi**2)
+    rhs[1] = fy - 2 * z * dY + mu * math.sin(th) * om**2 + np.sum(fb * dl * S * dphi**2)
+    rhs[2:] = -2 * np.asarray(b.zeta_b) * mu * eta * dl * (dphi - om)
+    return np.concatenate([s[n + 2:], np.linalg.solve(M, rhs)])
+
+
+def test_rotating_frame_bearing_is_the_ground_frame_film():
+    # Omega 1.5, zeta 0.02: a transient with the journal well off-centre (eps up to ~0.6)
+    sc = on(SHORT, rho=0.25, Omega=1.5, zeta=0.02)
+    om = sc.Omega
+    y0 = np.array([0.4, -0.3, 0.5, 2.6, 0.1, -0.2, -1.2, -1.7])
+    t = np.linspace(0.0, 12.0, 25)
+    df = ballbal.simulate(sc, y0, t, rtol=1e-10, atol=1e-12)
+    x, y = y0[0], y0[1]
+    # ground state at t = 0 (theta = 0): X = q, X' = q' + Omega J q, phi = b, phi' = b' + Omega
+    s0 = np.array([x, y, y0[2], y0[3], y0[4] - om * y, y0[5] + om * x,
+                   y0[6] + om, y0[7] + om])
+    sol = solve_ivp(lambda tt, s: ground_rhs(sc, tt, s), (0, t[-1]), s0, t_eval=t,
+                    rtol=1e-9, atol=1e-11, method="DOP853")
+    th = df["theta"].to_numpy()
+    X = np.cos(th) * df["x"].to_numpy() - np.sin(th) * df["y"].to_numpy()
+    Y = np.sin(th) * df["x"].to_numpy() + np.cos(th) * df["y"].to_numpy()
+    # (the quadrature's error at the cavitation boundary is ~1e-7 here)
+    assert np.max(np.abs(X - sol.y[0])) < 1e-6
+    assert np.max(np.abs(Y - sol.y[1])) < 1e-6
+    for i in range(2):
+        assert np.max(np.abs(th + df[f"b{i + 1}"].to_numpy() - sol.y[2 + i])) < 1e-6
+    # the journal went well off-centre, so the film's nonlinearity was exercised
+    assert 0.25 * np.max(np.hypot(X, Y)) > 0.1
+
+
+def test_perfect_balance_on_a_plain_bearing_is_unstable_and_simulation_agrees():
+    for om in (0.5, 2.0, 8.0):
+        sc = on(SHORT, Omega=om)
+        pb = ballbal.balanced_state(sc)
+        assert pb is not None and pb.stability == "unstable"
+        assert abs(pb.q[0]) < 1e-12 and abs(pb.q[1]) < 1e-12
+        kinds = {e.kind: e for e in ballbal.equilibria(sc)}
+        assert kinds["perfect_balance"].stability == "unstable"
+    # Confirmed by simulation at Omega = 2: a perturbation of 1e-7 grows at the leading
+    # eigenvalue's rate while it is small.
+    sc = on(SHORT, Omega=2.0)
+    pb = ballbal.balanced_state(sc)
+    assert pb is not None
+    lead = max(np.real(pb.eigenvalues))
+    y0 = np.concatenate([pb.q, np.zeros(4)])
+    y0[0] += 1e-7
+    t = np.linspace(0.0, 30.0, 601)
+    df = ballbal.simulate(sc, y0, t, rtol=1e-11, atol=1e-15)
+    r = np.hypot(df["x"].to_numpy(), df["y"].to_numpy())
+    # envelope over windows of one whirl period, 10 time units apart
+    late, early = r[(t > 20) & (t <= 25)].max(), r[(t > 10) & (t <= 15)].max()
+    rate = math.log(late / early) / 10.0
+    assert abs(rate - lead) < 0.05 * lead, (rate, lead)
+    assert r[-1] > 100 * 1e-7
+
+
+def test_grooved_journal_balances_stably_and_simulation_agrees():
+    sc = on(JOURNAL, Omega=2.0)
+    assert sc.time_dependence is None
+    pb = ballbal.balanced_state(sc)
+    assert pb is not None and pb.stability == "stable"
+    y0 = np.concatenate([pb.q, np.zeros(4)])
+    y0[0] += 1e-3
+    df = ballbal.simulate(sc, y0, np.linspace(0.0, 80.0, 81))
+    r = np.hypot(df["x"].to_numpy(), df["y"].to_numpy())
+    lead = max(np.real(pb.eigenvalues))
+    assert r[-1] < 1e-3 * math.exp(0.5 * lead * 80.0)
+
+
+@pytest.mark.parametrize(("kw", "effect"), [
+    ({}, "grooved_sleeve"), ({"gravity": 0.1}, "gravity"),
+    ({"impulse": ballbal.Impulse(amplitude=1.0, t0=1.0, sharpness=1.0)}, "impulse"),
+])
+def test_time_dependent_bearing_scenes_refuse_autonomous_analyses(kw, effect):
+    bearing = SLEEVE if effect == "grooved_sleeve" else SHORT
+    sc = ballbal.Scene(balancer=BAL, support=ballbal.BearingSupport(bearing, 0.3), **kw)
+    assert sc.time_dependence == effect
+    for call in (lambda: ballbal.periodic(sc, "R-R"), lambda: ballbal.equilibria(sc),
+                 lambda: ballbal.balanced_state(sc)):
+        with pytest.raises(NotAutonomousError) as err:
+            call()
+        assert err.value.effect == effect
+    ballbal.simulate(sc, t_span=(0, 2))  # simulation always works
+
+
+def test_narrow_groove_or_journal_grooves_stay_autonomous():
+    assert on(JOURNAL).time_dependence is None
+    # a sleeve groove of depth 0 is a plain bearing
+    flat = Bearing(length_ratio=0.5, grooves=Grooves(8, 30.0, 0.0), grid=(64, 8))
+    assert on(flat).time_dependence is None
+
+
+def test_bad_bearing_input_names_the_parameter():
+    with pytest.raises(ParameterError) as e:
+        ballbal.BearingSupport(SHORT, rho=0.0)
+    assert e.value.parameter == "rho"
+    with pytest.raises(ParameterError) as e:
+        ballbal.BearingSupport(SHORT, rho=float("nan"))
+    assert e.value.parameter == "rho"
+    with pytest.raises(ParameterError) as e:
+        ballbal.BearingSupport("short", rho=0.3)  # type: ignore[arg-type]
+    assert e.value.parameter == "bearing"
+    with pytest.raises(ParameterError) as e:
+        on(SHORT, Omega=0.0)
+    assert e.value.parameter == "Omega"
+    with pytest.raises(ParameterError) as e:
+        ballbal.Scene(support=ballbal.BearingSupport(SHORT, 0.3),
+                      tilt=ballbal.Tilt(a=1.0, b=1.0, j_t=0.3, j_z=0.5))
+    assert e.value.parameter == "bearing"
+    with pytest.raises(ParameterError) as e:
+        ballbal.balance_map(on(SHORT), Omega=[1.0], depth_ratio=[0.5])
+    assert e.value.parameter == "depth_ratio"
+    with pytest.raises(ParameterError) as e:
+        ballbal.balance_map(on(JOURNAL), Omega=[1.0], groove_angle=[120.0])
+    assert e.value.parameter == "grooves.angle"
+    with pytest.raises(ParameterError) as e:
+        ballbal.balance_map(ballbal.Scene(balancer=BAL, springs=0.1), Omega=[1.0], rho=[0.5])
+    assert e.value.parameter == "rho"
+
+
+def test_balance_map_over_groove_depth_starts_from_the_plain_bearing():
+    df = ballbal.balance_map(on(JOURNAL), Omega=[2.0], depth_ratio=[0.0, 1.0])
+    plain = ballbal.balanced_state(on(Bearing(length_ratio=0.5, grid=(64, 8)), Omega=2.0))
+    assert plain is not None
+    rows = df.sort("depth_ratio").to_dicts()
+    # depth 0 is the plain finite film: the same index as the plain bearing's
+    assert rows[0]["stability"] == "unstable"
+    assert abs(rows[0]["index"] - max(np.real(plain.eigenvalues))) < 1e-8
+    assert rows[1]["stability"] == "stable"
+
+
+def test_bearing_scene_file_round_trips(tmp_path):
+    sc = ballbal.Scene(balancer=BAL, support=ballbal.BearingSupport(SLEEVE, 0.3))
+    p = tmp_path / "bearing.toml"
+    sc.save(p)
+    assert ballbal.load_scene(p) == sc
+    moved = sc.replace(rho=0.5, Omega=3.0)
+    assert moved.support is not None and moved.support.rho == 0.5 and moved.Omega == 3.0
+    with pytest.raises(ParameterError) as e:
+        ballbal.Scene(balancer=BAL).replace(rho=0.5)
+    assert e.value.parameter == "rho"
+    p.write_text("Omega = 2.0\nballs = 2\n[bearing]\nrho = 0.4\nmodel = \"short\"\n"
+                 "length_ratio = 0.5\n")
+    back = ballbal.load_scene(p)
+    assert back.support is not None and back.support.bearing.model == "short"
+    assert back.support.rho == 0.4
+    p.write_text("Omega = 2.0\n[bearing]\nrho = 0.4\n[bearing.grooves]\ncount = 4\n"
+                 "angle = 30\ndepth_ratio = 1\ncolour = 2\n")
+    with pytest.raises(ParameterError) as e:
+        ballbal.load_scene(p)
+    assert e.value.parameter == "bearing.grooves.colour"
+    p.write_text("Omega = 2.0\n[bearing]\nmodel = \"short\"\n")
+    with pytest.raises(ParameterError) as e:
+        ballbal.load_scene(p)
+    assert e.value.parameter == "bearing.rho"
+
+
+def test_maps_and_scans_refuse_a_value_that_makes_the_scene_time_dependent():
+    # depth 0 on the sleeve is a plain (autonomous) bearing; cutting the grooves makes
+    # the scene time-periodic, which the map and the scan must refuse, not mislabel
+    flat = on(Bearing(length_ratio=0.5, grooves=Grooves(8, 30.0, 0.0), grid=(64, 8)))
+    assert flat.time_dependence is None
+    with pytest.raises(NotAutonomousError) as e:
+        ballbal.balance_map(flat, Omega=[2.0], depth_ratio=[0.0, 0.5])
+    assert e.value.effect == "grooved_sleeve"
+    with pytest.raises(NotAutonomousError) as e:
+        ballbal.scan(flat, Omega=[2.0], depth_ratio=[0.5])
+    assert e.value.effect == "grooved_sleeve"
