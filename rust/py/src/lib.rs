@@ -5,6 +5,7 @@
 //! off the GIL, with panics contained and Ctrl-C working). This file only builds the
 //! module.
 
+mod basins;
 mod bearing;
 mod convert;
 mod entries;
@@ -63,6 +64,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::default_chunk, m)?)?;
     m.add_function(wrap_pyfunction!(entries::certificate_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::validate_bearing, m)?)?;
+    basins::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
