@@ -1,6 +1,6 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
-from . import data, exceptions
+from . import basins, data, exceptions, sweep
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -60,6 +60,7 @@ __all__ = [
     "accuracy_cost",
     "balance_map",
     "balanced_state",
+    "basins",
     "disturbance_response",
     "equilibria",
     "data",
@@ -77,6 +78,7 @@ __all__ = [
     "scan_meta",
     "signal_spectrum",
     "simulate",
+    "sweep",
     "track_damping_study",
     "vibration",
     "zeta_from_log_decrement",

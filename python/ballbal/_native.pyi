@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from .basins import BasinOptions
 from .bearing import Bearing
 from .model import Balancer
 from .options import PeriodicOptions, ScanOptions
@@ -17,6 +18,7 @@ from .scene import Scene
 __all__ = [
     "simulate", "validate", "equilibria", "balanced_states", "periodic", "orbit_closure",
     "balance_map", "scan", "default_chunk", "certificate_seconds", "validate_bearing",
+    "basins", "attractor_series", "classify_state",
     "__version__",
 ]
 
@@ -50,3 +52,16 @@ def scan(
 ) -> None: ...
 def default_chunk(lens: list[int]) -> int: ...
 def certificate_seconds() -> float: ...
+def basins(
+    model: Balancer | Scene, starts: list[list[float]], options: BasinOptions, threads: int,
+    chunk: int, chunks: list[int], on_chunk: Callable[[int, dict[str, Any]], None],
+) -> None: ...
+# (omega, coefficients, rotating) of the attractor reached from y0, or None
+def attractor_series(
+    model: Balancer | Scene, y0: npt.NDArray[np.float64], n_harm: int, settle: float,
+    window: float, rtol: float, atol: float,
+) -> tuple[float, npt.NDArray[np.float64], list[bool]] | None: ...
+# (one row of basins' columns, the state reached)
+def classify_state(
+    model: Balancer | Scene, y0: npt.NDArray[np.float64], options: BasinOptions,
+) -> tuple[dict[str, Any], npt.NDArray[np.float64]]: ...

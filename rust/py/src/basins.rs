@@ -193,9 +193,36 @@ pub fn attractor_series<'py>(
     })
 }
 
+/// Classifies the motion from the state `y0` (simulated for `options.t_end`) as
+/// `basins` does; returns `(columns of one row, the state reached)`.
+#[pyfunction]
+pub fn classify_state<'py>(
+    py: Python<'py>,
+    model: ModelArgs,
+    y0: PyReadonlyArray1<'py, f64>,
+    options: BasinArgs,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyArray1<f64>>)> {
+    let m = build(&model)?;
+    let opts = options.to_core();
+    opts.validate().py()?;
+    let y0 = slice(&y0, "y0")?.to_vec();
+    let dim = dispatch!(&m, d => 2 * d.ndof());
+    if y0.len() != dim || y0.iter().any(|v| !v.is_finite()) {
+        return Err(Error::param("y0", format!("needs {dim} finite values"))).py();
+    }
+    let mut out = guarded(
+        py,
+        || dispatch!(&m, d => ballbal_core::analysis::basins::classify_start(d, &y0, &opts)),
+    )?;
+    let y = std::mem::take(&mut out.y_end);
+    let cols = columns(py, std::slice::from_ref(&out), m.n_balls())?;
+    Ok((cols, PyArray1::from_vec(py, y)))
+}
+
 /// Adds this file's functions to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(basins, m)?)?;
     m.add_function(wrap_pyfunction!(attractor_series, m)?)?;
+    m.add_function(wrap_pyfunction!(classify_state, m)?)?;
     Ok(())
 }

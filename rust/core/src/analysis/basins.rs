@@ -123,6 +123,8 @@ pub struct Outcome {
     pub t_stop: f64,
     /// With the settle check: the label after the longer run.
     pub long_label: Option<Label>,
+    /// The state at `t_stop` (a speed sweep carries it on to the next step).
+    pub y_end: Vec<f64>,
 }
 
 /// The thesis' start: at rest in the ground frame (`x = y = x' = y' = 0`,
@@ -197,6 +199,7 @@ fn judge<D: Dynamics + ?Sized>(
         period: None,
         t_stop,
         long_label: None,
+        y_end: vec![],
     };
     let (t_stop, y_end) = match res {
         Ok((t, y, _)) => (t, y),
@@ -220,6 +223,7 @@ fn judge<D: Dynamics + ?Sized>(
             period: None,
             t_stop,
             long_label: None,
+            y_end: y.to_vec(),
         }
     };
     if at_rest || samples.len() < 4 {
@@ -249,6 +253,7 @@ fn judge<D: Dynamics + ?Sized>(
         period: None,
         t_stop,
         long_label: None,
+        y_end: y_end.clone(),
     };
     if rot1 != rot2 {
         return Ok(unsettled(String::new()));
@@ -265,17 +270,33 @@ fn judge<D: Dynamics + ?Sized>(
                 return Ok(unsettled(pattern));
             }
         }
-        let r = rot2.iter().position(|&b| b).expect("a rotating ball");
-        let mut crossings = vec![];
-        for w in samples.windows(2) {
-            let (a, b) = (w[0].1[o + r], w[1].1[o + r]);
-            let (ka, kb) = ((a / (2.0 * PI)).floor(), (b / (2.0 * PI)).floor());
-            if ka != kb {
-                let level = 2.0 * PI * ka.max(kb);
-                crossings.push(w[0].0 + (level - a) / (b - a) * DT);
+        // Whole-turn crossings of each rotating ball: its period and, over whole
+        // turns, its mean rate (free of the within-turn wobble a plain difference over
+        // the window would carry).
+        let crossings_of = |i: usize| {
+            let mut c = vec![];
+            for w in samples.windows(2) {
+                let (a, b) = (w[0].1[o + i], w[1].1[o + i]);
+                let (ka, kb) = ((a / (2.0 * PI)).floor(), (b / (2.0 * PI)).floor());
+                if ka != kb {
+                    let level = 2.0 * PI * ka.max(kb);
+                    c.push(w[0].0 + (level - a) / (b - a) * DT);
+                }
+            }
+            c
+        };
+        let mut rates = rates.clone();
+        let mut period = None;
+        for i in (0..n).filter(|&i| rot2[i]) {
+            let c = crossings_of(i);
+            if c.len() >= 2 {
+                let turns = (c.len() - 1) as f64 * 2.0 * PI;
+                rates[i] = rates[i].signum() * turns / (c[c.len() - 1] - c[0]);
+            }
+            if period.is_none() {
+                period = turn_period(&c).map(|p| p.1);
             }
         }
-        let period = turn_period(&crossings).map(|p| p.1);
         let omega = (0..n).filter(|&i| rot2[i]).map(|i| rates[i]).sum::<f64>() / n_rot as f64;
         let label = match (n, n_rot) {
             (2, 2) => {
@@ -300,6 +321,7 @@ fn judge<D: Dynamics + ?Sized>(
             period,
             t_stop,
             long_label: None,
+            y_end,
         });
     }
     // No ball rotates: at rest, on the way to rest, or oscillating.
@@ -332,6 +354,7 @@ fn judge<D: Dynamics + ?Sized>(
         period,
         t_stop,
         long_label: None,
+        y_end,
     })
 }
 
