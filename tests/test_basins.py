@@ -128,3 +128,27 @@ def test_plot(tmp_path, maps):
     ax = ballbal.basins.plot_basins(maps[1.35], title="Omega 1.35")
     ax.figure.savefig(tmp_path / "b.png")
     assert (tmp_path / "b.png").stat().st_size > 1000
+
+
+def test_ctrl_c_stops_a_grid_within_a_second():
+    # A real SIGINT to a child computing a grid that takes about a minute.
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    code = ("import sys, time, ballbal\nfrom ballbal.basins import basins\n"
+            "m = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50, Omega=1.2, "
+            "eta=(0.7, 0.7))\nprint('ready', flush=True)\n"
+            "try:\n    basins(m, n=100, execution=ballbal.Execution(threads=2))\n"
+            "except KeyboardInterrupt:\n    print('interrupted', time.monotonic(), "
+            "flush=True)\n    sys.exit(7)\n")
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    assert p.stdout is not None and p.stdout.readline().strip() == "ready"
+    time.sleep(0.5)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 7, (out, err)
+    assert float(out.split()[1]) - sent < 1.0
