@@ -152,3 +152,26 @@ def test_ctrl_c_stops_a_grid_within_a_second():
     out, err = p.communicate(timeout=60)
     assert p.returncode == 7, (out, err)
     assert float(out.split()[1]) - sent < 1.0
+
+
+def test_resume_from_a_directory_redoes_only_a_damaged_chunk(tmp_path):
+    import os
+    import warnings
+
+    from ballbal.exceptions import ScanStoreError, ScanStoreWarning
+
+    m = thesis(1.35)
+    ex = ballbal.Execution(threads=2, chunk=4, out=tmp_path / "b")
+    full = basins(m, n=4, execution=ex)
+    files = sorted((tmp_path / "b").glob("chunk-*.parquet"))
+    assert len(files) == 4
+    files[1].write_bytes(files[1].read_bytes()[:40])  # a crash mid-write, say
+    before = {f: os.stat(f).st_mtime_ns for f in files if f != files[1]}
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        again = basins(m, n=4, execution=ex)
+    assert any(issubclass(x.category, ScanStoreWarning) for x in w)
+    assert again.table.equals(full.table)
+    assert {f: os.stat(f).st_mtime_ns for f in before} == before
+    with pytest.raises(ScanStoreError):
+        basins(m, n=5, execution=ex)

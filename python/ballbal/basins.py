@@ -19,17 +19,20 @@ nothing about its neighbourhood.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import os
+import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 import polars as pl
 
 from . import _check, _native
-from .exceptions import ParameterError, ParameterTypeError
+from .exceptions import ParameterError, ParameterTypeError, ScanStoreError
 from .model import Balancer
 from .options import Execution
 from .scene import Scene
@@ -153,6 +156,73 @@ class Basins:
         return periodic(m, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N)
 
 
+class _BasinStore:
+    """Finished chunks of a basin grid as Parquet files in a directory (``execution.
+    out``), with the scan store's guarantees (:class:`ballbal.scan._Store`, whose
+    locking, atomic writes and setting aside of damaged files it reuses): a later call
+    with the same arguments skips the chunks on disk; a chunk file that is unreadable,
+    of another grid or short is set aside as ``<name>.damaged`` with a
+    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed."""
+
+    def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any]) -> None:
+        from .scan import _Store
+
+        class Store(_Store):
+            def _open(self, job: Any, chunk_given: bool) -> Any:
+                mfile = self.dir / "meta.json"
+                want = json.loads(json.dumps(meta))
+                if mfile.exists():
+                    try:
+                        old = json.loads(mfile.read_text())
+                    except (OSError, ValueError):
+                        old = None
+                    if old is None:
+                        self._set_aside(mfile, "unreadable", "rewritten")
+                    elif old != want:
+                        raise ScanStoreError(f"out: {self.dir} holds a different basin grid; "
+                                             "choose another directory or delete it")
+                if not mfile.exists():
+                    from .scan import _write_atomic
+
+                    _write_atomic(mfile, lambda fh: fh.write(
+                        json.dumps(want, indent=1).encode()))
+                self.meta = want
+                self.fingerprint = hashlib.sha256(json.dumps(want).encode()).hexdigest()
+                return job
+
+        self.store = Store(path, None, False)  # type: ignore[arg-type]
+
+    def done(self, sizes: dict[int, int]) -> set[int]:
+        from .scan import _FINGERPRINT, _chunk_index
+
+        st = self.store
+        ok = set()
+        for f in sorted(st.dir.glob("chunk-*.parquet")):
+            c = _chunk_index(f)
+            why = None
+            try:
+                if pl.read_parquet_metadata(f).get(_FINGERPRINT) != st.fingerprint:
+                    why = "it was not written by this grid"
+                elif c not in sizes or pl.read_parquet(f).height != sizes[c]:
+                    why = "it misses starts of its chunk"
+            except Exception as e:  # noqa: BLE001 - any failure to read: damaged
+                why = f"unreadable: {type(e).__name__}"
+            if why is None and c is not None:
+                ok.add(c)
+            else:
+                st._set_aside(f, why or "", "recomputed")
+        return ok
+
+    def write(self, c: int, df: pl.DataFrame) -> None:
+        self.store.write(c, df)
+
+    def read(self, c: int) -> pl.DataFrame:
+        return pl.read_parquet(self.store.file(c))
+
+    def close(self) -> None:
+        self.store.close()
+
+
 def _axis(name: str, v: Any) -> np.ndarray:
     a = _check.array(name, v)
     if a.size == 0:
@@ -189,8 +259,11 @@ def basins(
     ``t_end``: time simulated per start (the thesis: 1000; overrides ``options``).
     ``settle_check``: simulate every start again for ``3 t_end`` (``options.
     settle_factor``) and report ``long_label`` and ``settled`` (the labels agree).
-    ``execution``: ``threads`` (default all cores) and ``chunk`` (starts per task,
-    default 256); Ctrl-C stops the work (``KeyboardInterrupt``).
+    ``execution``: ``threads`` (default all cores), ``chunk`` (starts per task,
+    default 256) and ``out`` (a directory the finished chunks are written to as
+    Parquet and resumed from, with the scan store's checks: see :class:`_BasinStore`);
+    Ctrl-C stops the work (``KeyboardInterrupt``; with ``out`` the finished chunks are
+    kept). ``executor`` is not used (yet).
     """
     _check.model("model", model)
     if model.n_balls != 2:
@@ -238,25 +311,54 @@ def basins(
         raise ParameterError("chunk", f"must be >= 1, got {chunk}", allowed=">= 1",
                              value=chunk)
     n_chunks = -(-len(starts) // chunk)
-    parts: dict[int, dict[str, Any]] = {}
+    sizes = {c: min(len(starts), (c + 1) * chunk) - c * chunk for c in range(n_chunks)}
+    parts: dict[int, pl.DataFrame] = {}
 
-    def keep(c: int, cols: dict[str, Any]) -> None:
-        parts[c] = cols
+    def frame(c: int, cols: dict[str, Any]) -> pl.DataFrame:
+        lo, hi = c * chunk, c * chunk + sizes[c]
+        return pl.DataFrame({
+            "b1": s1[lo:hi], "b2": s2[lo:hi], "label": pl.Series(cols["label"], dtype=pl.Utf8),
+            "pattern": pl.Series(cols["pattern"], dtype=pl.Utf8),
+            "omega": pl.Series(cols["omega"], dtype=pl.Float64),
+            "period": pl.Series(cols["period"], dtype=pl.Float64),
+            "rate1": pl.Series(cols["rate1"], dtype=pl.Float64),
+            "rate2": pl.Series(cols["rate2"], dtype=pl.Float64),
+            "t_stop": pl.Series(cols["t_stop"], dtype=pl.Float64),
+            "long_label": pl.Series(cols["long_label"], dtype=pl.Utf8),
+        })
 
-    _native.basins(model, starts, options, threads, chunk, list(range(n_chunks)), keep)
-    cols: dict[str, list[Any]] = {}
-    for c in range(n_chunks):
-        for name, vals in parts[c].items():
-            cols.setdefault(name, []).extend(vals)
-    df = pl.DataFrame({
-        "b1": s1, "b2": s2, "label": cols["label"], "pattern": cols["pattern"],
-        "omega": pl.Series(cols["omega"], dtype=pl.Float64),
-        "period": pl.Series(cols["period"], dtype=pl.Float64),
-        "rate1": pl.Series(cols["rate1"], dtype=pl.Float64),
-        "rate2": pl.Series(cols["rate2"], dtype=pl.Float64),
-        "t_stop": pl.Series(cols["t_stop"], dtype=pl.Float64),
-        "long_label": pl.Series(cols["long_label"], dtype=pl.Utf8),
-    })
+    store = None
+    if execution.out is not None:
+        meta = {"ballbal": _native.__version__, "basins": {
+            "model": model.to_dict() if isinstance(model, Scene) else asdict(model),
+            "starts": hashlib.sha256(np.stack([s1, s2]).tobytes()).hexdigest(),
+            "count": len(starts), "options": asdict(options), "chunk": chunk}}
+        store = _BasinStore(execution.out, meta)
+    try:
+        done = store.done(sizes) if store is not None else set()
+
+        def keep(c: int, cols: dict[str, Any]) -> None:
+            df = frame(c, cols)
+            if store is not None:
+                store.write(c, df)
+            parts[c] = df
+
+        todo = [c for c in range(n_chunks) if c not in done]
+        if todo:
+            _native.basins(model, starts, options, threads, chunk, todo, keep)
+        for c in done:
+            assert store is not None
+            parts[c] = store.read(c)
+    except KeyboardInterrupt:
+        if store is not None:
+            warnings.warn(f"basins interrupted: {len(parts) + len(done)} of {n_chunks} "
+                          f"chunks kept in {execution.out}; run the same call again to "
+                          "resume", stacklevel=2)
+        raise
+    finally:
+        if store is not None:
+            store.close()
+    df = pl.concat([parts[c] for c in range(n_chunks)], how="vertical")
     if settle_check:
         df = df.with_columns((pl.col("label") == pl.col("long_label")).alias("settled"))
     else:
