@@ -175,3 +175,14 @@ def test_resume_from_a_directory_redoes_only_a_damaged_chunk(tmp_path):
     assert {f: os.stat(f).st_mtime_ns for f in before} == before
     with pytest.raises(ScanStoreError):
         basins(m, n=5, execution=ex)
+
+
+def test_an_executor_gives_the_same_table():
+    from concurrent.futures import ThreadPoolExecutor
+
+    m = thesis(1.2)
+    here = basins(m, samples=6, seed=5, execution=ballbal.Execution(threads=1))
+    with ThreadPoolExecutor(2) as ex:
+        there = basins(m, samples=6, seed=5,
+                       execution=ballbal.Execution(chunk=2, executor=ex))
+    assert there.table.equals(here.table)

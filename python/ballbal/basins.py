@@ -223,6 +223,15 @@ class _BasinStore:
         self.store.close()
 
 
+def _run_chunk(model: Balancer | Scene, starts: list[list[float]], options: BasinOptions,
+               threads: int) -> dict[str, Any]:
+    """One chunk's columns: what an executor's workers run."""
+    out: list[dict[str, Any]] = []
+    _native.basins(model, starts, options, threads, len(starts), [0],
+                   lambda _c, cols: out.append(cols))
+    return out[0]
+
+
 def _axis(name: str, v: Any) -> np.ndarray:
     a = _check.array(name, v)
     if a.size == 0:
@@ -263,7 +272,9 @@ def basins(
     default 256) and ``out`` (a directory the finished chunks are written to as
     Parquet and resumed from, with the scan store's checks: see :class:`_BasinStore`);
     Ctrl-C stops the work (``KeyboardInterrupt``; with ``out`` the finished chunks are
-    kept). ``executor`` is not used (yet).
+    kept); ``executor``: a ``concurrent.futures`` executor or Dask ``Client`` running
+    the chunks as tasks (``threads`` per task, default 1). None of it changes the
+    table.
     """
     _check.model("model", model)
     if model.n_balls != 2:
@@ -344,7 +355,21 @@ def basins(
             parts[c] = df
 
         todo = [c for c in range(n_chunks) if c not in done]
-        if todo:
+        if todo and execution.executor is not None:
+            from .scan import _as_completed
+
+            per_task = 1 if execution.threads is None else threads
+            futures = {execution.executor.submit(
+                _run_chunk, model, starts[c * chunk:c * chunk + sizes[c]], options,
+                per_task): c for c in todo}
+            try:
+                for f in _as_completed(list(futures)):
+                    keep(futures[f], f.result())
+            except KeyboardInterrupt:
+                for f in futures:
+                    f.cancel()
+                raise
+        elif todo:
             _native.basins(model, starts, options, threads, chunk, todo, keep)
         for c in done:
             assert store is not None
