@@ -107,12 +107,33 @@ def seed004(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "seed004.png"]
 
 
+def thesis_ch4(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # The thesis' own numbers: omega 0.32 (fig. 4-12), 0.09 (4-27), 0.30 (4-28), the
+    # largest line at Omega - omega (k = -1) in all three.
+    figs = re.findall(r"fig\. (4-\d\d) \S+: omega (\S+), largest line k = (-?\d+) at (\S+) "
+                      r"\(Omega - omega = (\S+)\)", stdout)
+    assert [f[0] for f in figs] == ["4-12", "4-27", "4-28"], stdout
+    for (_, om, k, f, main), want in zip(figs, (0.32, 0.09, 0.30), strict=True):
+        assert abs(float(om) - want) < 0.01 and k == "-1" and f == main
+    # Figure 4-13: the model's main frequency lies in the thesis' MIHB band 460-510 rpm.
+    lo, hi = (float(v) for v in re.search(r"main frequency (\S+) to (\S+) rpm", stdout)
+              .groups())
+    assert 455 <= lo <= hi <= 515
+    fr = [float(v) for v in re.findall(r"rotating fraction (\S+)", stdout)]
+    assert len(fr) == 2 and fr[0] > 0.5 > fr[1]
+    up, down = (float(v) for v in re.search(r"up-transition Omega ([\d.]+), "
+                                             r"down-transition Omega ([\d.]+)", stdout).groups())
+    assert up > down
+    return [out / "thesis_ch4.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
     "accuracy_cost.py": accuracy_cost,
     "thesis_maps.py": thesis_maps,
     "scene_maps.py": scene_maps,
     "transients.py": transients,
     "seed004.py": seed004,
+    "thesis_ch4.py": thesis_ch4,
 }
 
 
