@@ -399,12 +399,12 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
     if ax is None:
         _, ax = plt.subplots(figsize=(5, 5))
     colours = {"perfect_balance": "white", "other_equilibrium": "tab:green",
-               "merged_R-R": "black", "separated_R-R": "tab:gray", "R-O": "tab:orange",
+               "merged_R-R": "black", "separated_R-R": "0.45", "R-O": "tab:orange",
                "O-O": "tab:blue", "other": "tab:purple", "not_settled": "tab:red",
                "failed": "magenta"}
     t = result.table
     present = [lab for lab in LABELS if lab in set(t["label"].to_list())]
-    size = max(2.0, 4000.0 / max(t.height, 1))
+    size = (250.0 / np.sqrt(max(t.height, 1))) ** 2  # squares that tile the map
     for lab in present:
         s = t.filter(pl.col("label") == lab)
         ax.scatter(s["b1"], s["b2"], s=size, c=colours[lab], edgecolors="0.6",
