@@ -121,6 +121,37 @@ def seed002(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "seed002.png"]
 
 
+def thesis_ch4(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # The thesis' own numbers: omega 0.32 (fig. 4-12), 0.09 (4-27), 0.30 (4-28), the
+    # largest line at Omega - omega (k = -1) in all three.
+    figs = re.findall(r"fig\. (4-\d\d) \S+: omega (\S+), largest line k = (-?\d+) at (\S+) "
+                      r"\(Omega - omega = (\S+)\)", stdout)
+    assert [f[0] for f in figs] == ["4-12", "4-27", "4-28"], stdout
+    for (_, om, k, f, main), want in zip(figs, (0.32, 0.09, 0.30), strict=True):
+        assert abs(float(om) - want) < 0.01 and k == "-1" and f == main
+    # Figure 4-13: the model's main frequency lies in the thesis' MIHB band 460-510 rpm.
+    lo, hi = (float(v) for v in re.search(r"main frequency (\S+) to (\S+) rpm", stdout)
+              .groups())
+    assert 455 <= lo <= hi <= 515
+    fr = [float(v) for v in re.findall(r"rotating fraction (\S+)", stdout)]
+    assert len(fr) == 2 and fr[0] > 0.5 > fr[1]
+    up, down = (float(v) for v in re.search(r"up-transition Omega ([\d.]+), "
+                                             r"down-transition Omega ([\d.]+)", stdout).groups())
+    assert up > down
+    return [out / "thesis_ch4.png"]
+
+
+def bearing_balancer(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # The plain film holds nothing at the centre (unstable at every speed, both film
+    # models); grooves on the journal (depth > 0) open a stable speed window, depth 0 none.
+    plain = re.findall(r"plain, .*: largest real part .* unstable at all \d+ speeds: (\w+)",
+                       stdout)
+    assert plain == ["True", "True"], stdout
+    spans = dict(re.findall(r"depth ratio (\S+): stable for (.*) \(", stdout))
+    assert spans["0.00"] == "nowhere" and spans["1.00"].startswith("Omega"), spans
+    return [out / "bearing_balancer.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
     "seed002.py": seed002,
     "accuracy_cost.py": accuracy_cost,
@@ -128,6 +159,8 @@ CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
     "scene_maps.py": scene_maps,
     "transients.py": transients,
     "seed004.py": seed004,
+    "thesis_ch4.py": thesis_ch4,
+    "bearing_balancer.py": bearing_balancer,
 }
 
 

@@ -1,6 +1,6 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
-from . import bearing, data, exceptions
+from . import basins, bearing, data, exceptions, sweep
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -61,6 +61,7 @@ __all__ = [
     "accuracy_cost",
     "balance_map",
     "balanced_state",
+    "basins",
     "bearing",
     "disturbance_response",
     "equilibria",
@@ -79,6 +80,7 @@ __all__ = [
     "scan_meta",
     "signal_spectrum",
     "simulate",
+    "sweep",
     "track_damping_study",
     "vibration",
     "zeta_from_log_decrement",

@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._rotor import RotorOnBearing
+from .basins import BasinOptions
 from .bearing import Bearing
 from .model import Balancer
 from .options import PeriodicOptions, ScanOptions
@@ -20,6 +21,7 @@ __all__ = [
     "balance_map", "scan", "default_chunk", "certificate_seconds", "validate_bearing",
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
+    "basins", "attractor_series", "classify_state",
     "__version__",
 ]
 
@@ -76,3 +78,16 @@ def simulate_rotor(
     t_eval: npt.NDArray[np.float64], rtol: float, atol: float, max_steps: int,
     eps_contact: float, stiff_steps: int, method: str, factor_reuse: float | None,
 ) -> dict[str, Any]: ...
+def basins(
+    model: Balancer | Scene, starts: list[list[float]], options: BasinOptions, threads: int,
+    chunk: int, chunks: list[int], on_chunk: Callable[[int, dict[str, Any]], None],
+) -> None: ...
+# (omega, coefficients, rotating) of the attractor reached from y0, or None
+def attractor_series(
+    model: Balancer | Scene, y0: npt.NDArray[np.float64], n_harm: int, settle: float,
+    window: float, rtol: float, atol: float,
+) -> tuple[float, npt.NDArray[np.float64], list[bool]] | None: ...
+# (one row of basins' columns, the state reached)
+def classify_state(
+    model: Balancer | Scene, y0: npt.NDArray[np.float64], options: BasinOptions,
+) -> tuple[dict[str, Any], npt.NDArray[np.float64]]: ...

@@ -5,6 +5,7 @@
 //! off the GIL, with panics contained and Ctrl-C working). This file only builds the
 //! module.
 
+mod basins;
 mod bearing;
 mod convert;
 mod entries;
@@ -69,6 +70,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bearing::bearing_equilibrium, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_coefficients, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_stability, m)?)?;
+    basins::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -248,54 +248,15 @@ fn classify_as<D: Dynamics + ?Sized>(
     }
     let r = detected.iter().position(|&b| b);
     let (t_c, period) = if let Some(r) = r {
-        let crossings = &crossings[r];
-        if crossings.len() < 3 {
-            return NotSettled;
-        }
-        let k = crossings.len();
-        let t1 = crossings[k - 1] - crossings[k - 2];
-        let t2 = crossings[k - 2] - crossings[k - 3];
-        if (t1 - t2).abs() > 0.02 * t1 {
-            return NotSettled; // not periodic (quasi-periodic or chaotic)
-        }
-        (crossings[k - 1], t1)
-    } else {
-        // Upward crossings of x through its mean.
-        let half = xs.len() / 2;
-        let mean = xs[half..].iter().map(|p| p.1).sum::<f64>() / (xs.len() - half) as f64;
-        let amp = xs[half..]
-            .iter()
-            .map(|p| (p.1 - mean).abs())
-            .fold(0.0, f64::max);
-        if amp < 1e-6 {
-            return Rest; // at rest: an equilibrium, not a periodic motion
-        }
-        let mut ups = vec![];
-        for w in xs[half..].windows(2) {
-            if w[0].1 < mean && w[1].1 >= mean {
-                let f = (mean - w[0].1) / (w[1].1 - w[0].1);
-                ups.push(w[0].0 + f * (w[1].0 - w[0].0));
-            }
-        }
-        if ups.len() < 4 {
-            return NotSettled;
-        }
-        let k = ups.len();
-        // Smallest multiple of the crossing spacing after which the motion repeats.
-        let mut found = None;
-        for m in 1..=3.min(k - 1) {
-            let t1 = ups[k - 1] - ups[k - 1 - m];
-            if k > 2 * m {
-                let t2 = ups[k - 1 - m] - ups[k - 1 - 2 * m];
-                if (t1 - t2).abs() < 0.01 * t1 {
-                    found = Some((ups[k - 1], t1));
-                    break;
-                }
-            }
-        }
-        match found {
-            Some(f) => f,
+        match turn_period(&crossings[r]) {
+            Some(p) => p,
             None => return NotSettled,
+        }
+    } else {
+        match oscillation_period(&xs) {
+            Oscillation::Rest => return Rest,
+            Oscillation::Irregular => return NotSettled,
+            Oscillation::Period(t, p) => (t, p),
         }
     };
     // Re-simulate one period at collocation times for the fit.
@@ -343,6 +304,72 @@ fn classify_as<D: Dynamics + ?Sized>(
         period,
         series: HbSolution::start(2.0 * PI / period, coeffs, winding, n_harm, Status::NoGuess),
     }
+}
+
+/// `(time of the last crossing, period)` of a rotating ball from the times it crossed
+/// whole turns: the last two intervals must agree to 2 % (else the motion is
+/// quasi-periodic, chaotic or not settled: `None`).
+pub(crate) fn turn_period(crossings: &[f64]) -> Option<(f64, f64)> {
+    if crossings.len() < 3 {
+        return None;
+    }
+    let k = crossings.len();
+    let t1 = crossings[k - 1] - crossings[k - 2];
+    let t2 = crossings[k - 2] - crossings[k - 3];
+    if (t1 - t2).abs() > 0.02 * t1 {
+        return None; // not periodic (quasi-periodic or chaotic)
+    }
+    Some((crossings[k - 1], t1))
+}
+
+/// What the samples `(t, x, x')` of an observation say about a motion without
+/// rotating balls.
+pub(crate) enum Oscillation {
+    /// `x` does not move (amplitude below 1e-6 over the second half).
+    Rest,
+    /// No period found from the upward crossings of `x` through its mean.
+    Irregular,
+    /// `(time of the last upward crossing, period)`.
+    Period(f64, f64),
+}
+
+/// The period of an oscillation from the upward crossings of `x` through its mean over
+/// the second half of the samples: the smallest multiple (1 to 3) of the crossing
+/// spacing after which the crossings repeat to 1 %.
+pub(crate) fn oscillation_period(xs: &[(f64, f64, f64)]) -> Oscillation {
+    let half = xs.len() / 2;
+    if xs.len() - half == 0 {
+        return Oscillation::Irregular;
+    }
+    let mean = xs[half..].iter().map(|p| p.1).sum::<f64>() / (xs.len() - half) as f64;
+    let amp = xs[half..]
+        .iter()
+        .map(|p| (p.1 - mean).abs())
+        .fold(0.0, f64::max);
+    if amp < 1e-6 {
+        return Oscillation::Rest; // at rest: an equilibrium, not a periodic motion
+    }
+    let mut ups = vec![];
+    for w in xs[half..].windows(2) {
+        if w[0].1 < mean && w[1].1 >= mean {
+            let f = (mean - w[0].1) / (w[1].1 - w[0].1);
+            ups.push(w[0].0 + f * (w[1].0 - w[0].0));
+        }
+    }
+    if ups.len() < 4 {
+        return Oscillation::Irregular;
+    }
+    let k = ups.len();
+    for m in 1..=3.min(k - 1) {
+        let t1 = ups[k - 1] - ups[k - 1 - m];
+        if k > 2 * m {
+            let t2 = ups[k - 1 - m] - ups[k - 1 - 2 * m];
+            if (t1 - t2).abs() < 0.01 * t1 {
+                return Oscillation::Period(ups[k - 1], t1);
+            }
+        }
+    }
+    Oscillation::Irregular
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 
 pub mod attractors;
 pub mod balanced;
+pub mod basins;
 pub mod equilibria;
 pub mod family;
 pub mod journal;

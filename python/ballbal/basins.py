@@ -1,0 +1,420 @@
+"""Basins of attraction in the plane of the initial ball angles (the thesis' figures
+4-15 and 4-16).
+
+Every start is at rest in the ground frame (``x = x' = y = y' = 0``, ``b_i' = -Omega``
+in the rotating frame) with given ball angles, simulated in the Rust core for ``t_end``
+time units (the thesis: 1000) and labelled by the motion over the last ``window``
+(:mod:`ballbal_core::analysis::basins`): ``perfect_balance`` (rest with ``|x + i y|``
+below ``rest_tol``), ``other_equilibrium``, ``merged_R-R`` (both balls rotate with
+their gap below ``merge_tol``), ``separated_R-R`` (both rotate apart: the gap
+oscillates or they pass each other), ``R-O``, ``O-O``, ``other`` (not two balls),
+``not_settled`` and ``failed``. A start is at rest early once every velocity is below
+1e-7 (the simulation stops there: ``t_stop``). Starts run in parallel, each on its own,
+so the table does not depend on the thread count.
+
+The default grid avoids the diagonal ``b1 = b2``: merged balls stay merged in
+simulation (the diagonal is invariant for identical balls), so a start on it says
+nothing about its neighbourhood.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import warnings
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+from . import _check, _native
+from .exceptions import ParameterError, ParameterTypeError, ScanStoreError
+from .model import Balancer
+from .options import Execution
+from .scene import Scene
+
+LABELS = ("perfect_balance", "other_equilibrium", "merged_R-R", "separated_R-R", "R-O",
+          "O-O", "other", "not_settled", "failed")
+#: Labels of rest (an equilibrium).
+REST = ("perfect_balance", "other_equilibrium")
+#: Labels of motions in which a ball rotates.
+ROTATING = ("merged_R-R", "separated_R-R", "R-O")
+
+
+@dataclass(frozen=True)
+class BasinOptions:
+    """How each start is simulated and judged (see the module's description).
+
+    ``t_end``: time simulated; ``window``: the final part of it the label is read from
+    (a rotating ball must turn at least once per half of it, so ``window`` bounds the
+    slowest rotation recognised: ``omega >= 4 pi / window``); ``rtol, atol``: the
+    integrator's tolerances; ``settle_factor``: with the settle check, the longer run's
+    length in units of ``t_end``.
+    """
+
+    t_end: float = 1000.0
+    window: float = 300.0
+    rtol: float = 1e-6
+    atol: float = 1e-8
+    rest_tol: float = 0.05
+    merge_tol: float = 0.5
+    settle_factor: float | None = None
+
+    def __post_init__(self) -> None:
+        for n in ("t_end", "window", "rtol", "atol", "rest_tol", "merge_tol"):
+            object.__setattr__(self, n, _check.real(n, getattr(self, n)))
+        if self.settle_factor is not None:
+            object.__setattr__(self, "settle_factor",
+                               _check.real("settle_factor", self.settle_factor))
+
+
+@dataclass(frozen=True)
+class Basins:
+    """The result of :func:`basins`.
+
+    ``table``: one row per start (``b1, b2, label, pattern, omega`` (mean ball rate of
+    the rotating balls), ``period`` (null unless regular), ``rate1, rate2`` (each
+    ball's mean rate), ``t_stop``, and with the settle check ``long_label`` and
+    ``settled``).
+    """
+
+    model: Balancer | Scene
+    table: pl.DataFrame
+    options: BasinOptions
+    random: bool = False
+    _links: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def fractions(self) -> pl.DataFrame:
+        """Fraction of the starts in each class with its standard error
+        ``sqrt(p (1 - p) / n)`` (binomial; for random starts it is the sampling error of
+        the basin's area fraction, for a grid an estimate of it)."""
+        n = self.table.height
+        return (self.table.group_by("label").agg(pl.len().alias("count"))
+                .with_columns((pl.col("count") / n).alias("fraction"))
+                .with_columns((pl.col("fraction") * (1 - pl.col("fraction")) / n)
+                              .sqrt().alias("standard_error"))
+                .sort("count", descending=True))
+
+    def rotating_fraction(self) -> tuple[float, float]:
+        """Fraction (and its standard error) of starts that end with a rotating ball."""
+        n = self.table.height
+        p = self.table.filter(pl.col("label").is_in(ROTATING)).height / n
+        return p, math.sqrt(p * (1 - p) / n)
+
+    def link(self, *, N: int = 8) -> pl.DataFrame:  # noqa: N803
+        """Each class found, linked to the solution it converges to: the perfect balance
+        to the ``equilibria()`` entry (omega 0 and its stability), every class with a
+        regular period (merged R-R, R-O, O-O, ...) to ``periodic()`` of its pattern,
+        solved from the series fitted to its first start's own simulated attractor.
+        Columns ``label, count, mean_rate`` (the class's mean ball rate), ``kind``,
+        ``omega``, ``stability``, ``status`` (null where nothing is linked)."""
+        from .analysis import equilibria, periodic
+
+        rows = []
+        for label in self.table["label"].unique(maintain_order=True).to_list():
+            cls = self.table.filter(pl.col("label") == label)
+            row: dict[str, Any] = {"label": label, "count": cls.height,
+                                   "mean_rate": float(np.mean(cls["omega"].to_numpy())),
+                                   "kind": None, "omega": None, "stability": None,
+                                   "status": None}
+            if label == "perfect_balance":
+                eq = [e for e in equilibria(self.model) if e.kind == "perfect_balance"]
+                if eq:
+                    row.update(kind="equilibrium", omega=0.0, stability=eq[0].stability,
+                               status="converged")
+            elif cls["period"].null_count() < cls.height and label != "not_settled":
+                first = cls.filter(pl.col("period").is_not_null()).row(0, named=True)
+                sol = self._periodic_of(first, N, periodic)
+                if sol is not None:
+                    row.update(kind=sol.type, omega=sol.omega, stability=sol.stability,
+                               status=sol.status)
+            rows.append(row)
+        return pl.DataFrame(rows, schema={
+            "label": pl.Utf8, "count": pl.Int64, "mean_rate": pl.Float64, "kind": pl.Utf8,
+            "omega": pl.Float64, "stability": pl.Utf8, "status": pl.Utf8})
+
+    def _periodic_of(self, row: dict[str, Any], N: int, periodic: Any) -> Any:  # noqa: N803
+        m = self.model
+        d = len(m.coordinates)
+        n = m.n_balls
+        y0 = np.zeros(2 * d)
+        balls = [row[f"b{i + 1}"] for i in range(n)]
+        y0[d - n:d] = balls
+        y0[2 * d - n:] = -m.Omega
+        o = self.options
+        got = _native.attractor_series(m, y0, N, o.t_end, max(o.window, 20 * row["period"]),
+                                       o.rtol * 1e-3, o.atol * 1e-3)
+        if got is None:
+            return None
+        omega, coeffs, rotating = got
+        pattern = "-".join("R" if r else "O" for r in rotating)
+        return periodic(m, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N)
+
+
+class _BasinStore:
+    """Finished chunks of a basin grid as Parquet files in a directory (``execution.
+    out``), with the scan store's guarantees (:class:`ballbal.scan._Store`, whose
+    locking, atomic writes and setting aside of damaged files it reuses): a later call
+    with the same arguments skips the chunks on disk; a chunk file that is unreadable,
+    of another grid or short is set aside as ``<name>.damaged`` with a
+    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed."""
+
+    def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any]) -> None:
+        from .scan import _Store
+
+        class Store(_Store):
+            def _open(self, job: Any, chunk_given: bool) -> Any:
+                mfile = self.dir / "meta.json"
+                want = json.loads(json.dumps(meta))
+                if mfile.exists():
+                    try:
+                        old = json.loads(mfile.read_text())
+                    except (OSError, ValueError):
+                        old = None
+                    if old is None:
+                        self._set_aside(mfile, "unreadable", "rewritten")
+                    elif old != want:
+                        raise ScanStoreError(f"out: {self.dir} holds a different basin grid; "
+                                             "choose another directory or delete it")
+                if not mfile.exists():
+                    from .scan import _write_atomic
+
+                    _write_atomic(mfile, lambda fh: fh.write(
+                        json.dumps(want, indent=1).encode()))
+                self.meta = want
+                self.fingerprint = hashlib.sha256(json.dumps(want).encode()).hexdigest()
+                return job
+
+        self.store = Store(path, None, False)  # type: ignore[arg-type]
+
+    def done(self, sizes: dict[int, int]) -> set[int]:
+        from .scan import _FINGERPRINT, _chunk_index
+
+        st = self.store
+        ok = set()
+        for f in sorted(st.dir.glob("chunk-*.parquet")):
+            c = _chunk_index(f)
+            why = None
+            try:
+                if pl.read_parquet_metadata(f).get(_FINGERPRINT) != st.fingerprint:
+                    why = "it was not written by this grid"
+                elif c not in sizes or pl.read_parquet(f).height != sizes[c]:
+                    why = "it misses starts of its chunk"
+            except Exception as e:  # noqa: BLE001 - any failure to read: damaged
+                why = f"unreadable: {type(e).__name__}"
+            if why is None and c is not None:
+                ok.add(c)
+            else:
+                st._set_aside(f, why or "", "recomputed")
+        return ok
+
+    def write(self, c: int, df: pl.DataFrame) -> None:
+        self.store.write(c, df)
+
+    def read(self, c: int) -> pl.DataFrame:
+        return pl.read_parquet(self.store.file(c))
+
+    def close(self) -> None:
+        self.store.close()
+
+
+def _run_chunk(model: Balancer | Scene, starts: list[list[float]], options: BasinOptions,
+               threads: int) -> dict[str, Any]:
+    """One chunk's columns: what an executor's workers run."""
+    out: list[dict[str, Any]] = []
+    _native.basins(model, starts, options, threads, len(starts), [0],
+                   lambda _c, cols: out.append(cols))
+    return out[0]
+
+
+def _axis(name: str, v: Any) -> np.ndarray:
+    a = _check.array(name, v)
+    if a.size == 0:
+        raise ParameterError(name, "give at least one angle")
+    return a
+
+
+def default_grid(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` values per axis over ``[0, 2 pi)``: ``b1`` at ``(i + 1/4) h``, ``b2`` at
+    ``(j + 3/4) h`` (``h = 2 pi / n``), so that no start lies on the diagonal."""
+    h = 2 * np.pi / n
+    return (np.arange(n) + 0.25) * h, (np.arange(n) + 0.75) * h
+
+
+def basins(
+    model: Balancer | Scene,
+    *,
+    b1: Sequence[float] | np.ndarray | None = None,
+    b2: Sequence[float] | np.ndarray | None = None,
+    n: int | None = None,
+    samples: int | None = None,
+    seed: int | None = None,
+    t_end: float = 1000.0,
+    settle_check: bool = False,
+    options: BasinOptions | None = None,
+    execution: Execution | None = None,
+) -> Basins:
+    """Label the starts of a grid (or random sample) of initial ball angles by the
+    attractor they reach; two balls.
+
+    Starts: ``b1`` and ``b2`` axis values (every pair of the product), or ``n`` per
+    axis on the default grid (:func:`default_grid`, offset from the diagonal; default
+    ``n = 20``), or ``samples`` uniform random starts in ``[0, 2 pi)^2`` from ``seed``.
+    ``t_end``: time simulated per start (the thesis: 1000; overrides ``options``).
+    ``settle_check``: simulate every start again for ``3 t_end`` (``options.
+    settle_factor``) and report ``long_label`` and ``settled`` (the labels agree).
+    ``execution``: ``threads`` (default all cores), ``chunk`` (starts per task,
+    default 256) and ``out`` (a directory the finished chunks are written to as
+    Parquet and resumed from, with the scan store's checks: see :class:`_BasinStore`);
+    Ctrl-C stops the work (``KeyboardInterrupt``; with ``out`` the finished chunks are
+    kept); ``executor``: a ``concurrent.futures`` executor or Dask ``Client`` running
+    the chunks as tasks (``threads`` per task, default 1). None of it changes the
+    table.
+    """
+    _check.model("model", model)
+    if model.n_balls != 2:
+        raise ParameterError("model", f"basins are drawn for two balls, got {model.n_balls}")
+    if options is None:
+        options = BasinOptions()
+    elif not isinstance(options, BasinOptions):
+        raise ParameterTypeError("options", f"must be a ballbal.basins.BasinOptions, got "
+                                 f"{type(options).__name__}", value=options)
+    if execution is None:
+        execution = Execution()
+    elif not isinstance(execution, Execution):
+        raise ParameterTypeError("execution", f"must be a ballbal.Execution, got "
+                                 f"{type(execution).__name__}", value=execution)
+    t_end = _check.real("t_end", t_end)
+    window = min(options.window, t_end)
+    factor = options.settle_factor
+    if _check.boolean("settle_check", settle_check) and factor is None:
+        factor = 3.0
+    options = BasinOptions(t_end, window, options.rtol, options.atol, options.rest_tol,
+                           options.merge_tol, factor if settle_check else None)
+    random = samples is not None
+    if random:
+        if b1 is not None or b2 is not None or n is not None:
+            raise ParameterError("samples", "give either samples (with seed) or a grid")
+        k = _check.integer("samples", samples, 1)
+        rng = np.random.default_rng(seed)
+        pts = rng.uniform(0.0, 2 * np.pi, size=(k, 2))
+        s1, s2 = pts[:, 0], pts[:, 1]
+    else:
+        if (b1 is None) != (b2 is None):
+            raise ParameterError("b1" if b1 is None else "b2", "give both axes, or n")
+        if b1 is not None and b2 is not None:
+            if n is not None:
+                raise ParameterError("n", "give either n or the axes b1, b2")
+            a1, a2 = _axis("b1", b1), _axis("b2", b2)
+        else:
+            a1, a2 = default_grid(_check.integer("n", 20 if n is None else n, 1))
+        g1, g2 = np.meshgrid(a1, a2, indexing="xy")
+        s1, s2 = g1.ravel(), g2.ravel()
+    starts = [[float(x), float(y)] for x, y in zip(s1, s2, strict=True)]
+    threads = (os.cpu_count() or 1) if execution.threads is None else execution.threads
+    chunk = 256 if execution.chunk is None else execution.chunk
+    if chunk < 1:
+        raise ParameterError("chunk", f"must be >= 1, got {chunk}", allowed=">= 1",
+                             value=chunk)
+    n_chunks = -(-len(starts) // chunk)
+    sizes = {c: min(len(starts), (c + 1) * chunk) - c * chunk for c in range(n_chunks)}
+    parts: dict[int, pl.DataFrame] = {}
+
+    def frame(c: int, cols: dict[str, Any]) -> pl.DataFrame:
+        lo, hi = c * chunk, c * chunk + sizes[c]
+        return pl.DataFrame({
+            "b1": s1[lo:hi], "b2": s2[lo:hi], "label": pl.Series(cols["label"], dtype=pl.Utf8),
+            "pattern": pl.Series(cols["pattern"], dtype=pl.Utf8),
+            "omega": pl.Series(cols["omega"], dtype=pl.Float64),
+            "period": pl.Series(cols["period"], dtype=pl.Float64),
+            "rate1": pl.Series(cols["rate1"], dtype=pl.Float64),
+            "rate2": pl.Series(cols["rate2"], dtype=pl.Float64),
+            "t_stop": pl.Series(cols["t_stop"], dtype=pl.Float64),
+            "long_label": pl.Series(cols["long_label"], dtype=pl.Utf8),
+        })
+
+    store = None
+    if execution.out is not None:
+        meta = {"ballbal": _native.__version__, "basins": {
+            "model": model.to_dict() if isinstance(model, Scene) else asdict(model),
+            "starts": hashlib.sha256(np.stack([s1, s2]).tobytes()).hexdigest(),
+            "count": len(starts), "options": asdict(options), "chunk": chunk}}
+        store = _BasinStore(execution.out, meta)
+    try:
+        done = store.done(sizes) if store is not None else set()
+
+        def keep(c: int, cols: dict[str, Any]) -> None:
+            df = frame(c, cols)
+            if store is not None:
+                store.write(c, df)
+            parts[c] = df
+
+        todo = [c for c in range(n_chunks) if c not in done]
+        if todo and execution.executor is not None:
+            from .scan import _as_completed
+
+            per_task = 1 if execution.threads is None else threads
+            futures = {execution.executor.submit(
+                _run_chunk, model, starts[c * chunk:c * chunk + sizes[c]], options,
+                per_task): c for c in todo}
+            try:
+                for f in _as_completed(list(futures)):
+                    keep(futures[f], f.result())
+            except KeyboardInterrupt:
+                for f in futures:
+                    f.cancel()
+                raise
+        elif todo:
+            _native.basins(model, starts, options, threads, chunk, todo, keep)
+        for c in done:
+            assert store is not None
+            parts[c] = store.read(c)
+    except KeyboardInterrupt:
+        if store is not None:
+            warnings.warn(f"basins interrupted: {len(parts) + len(done)} of {n_chunks} "
+                          f"chunks kept in {execution.out}; run the same call again to "
+                          "resume", stacklevel=2)
+        raise
+    finally:
+        if store is not None:
+            store.close()
+    df = pl.concat([parts[c] for c in range(n_chunks)], how="vertical")
+    if settle_check:
+        df = df.with_columns((pl.col("label") == pl.col("long_label")).alias("settled"))
+    else:
+        df = df.drop("long_label")
+    return Basins(model, df, options, random)
+
+
+def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> Any:
+    """A categorical map of the labels over the starts (matplotlib, imported here)."""
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5, 5))
+    colours = {"perfect_balance": "white", "other_equilibrium": "tab:green",
+               "merged_R-R": "black", "separated_R-R": "0.45", "R-O": "tab:orange",
+               "O-O": "tab:blue", "other": "tab:purple", "not_settled": "tab:red",
+               "failed": "magenta"}
+    t = result.table
+    present = [lab for lab in LABELS if lab in set(t["label"].to_list())]
+    size = (250.0 / np.sqrt(max(t.height, 1))) ** 2  # squares that tile the map
+    for lab in present:
+        s = t.filter(pl.col("label") == lab)
+        ax.scatter(s["b1"], s["b2"], s=size, c=colours[lab], edgecolors="0.6",
+                   linewidths=0.2, marker="s")
+    ax.set_xlabel("b1 (rad)")
+    ax.set_ylabel("b2 (rad)")
+    ax.set_aspect("equal")
+    ax.legend(handles=[Line2D([], [], marker="s", ls="", mfc=colours[lab], mec="0.6",
+                              label=lab) for lab in present],
+              loc="upper left", fontsize="small", framealpha=0.8)
+    if title is not None:
+        ax.set_title(title)
+    return ax

@@ -1,0 +1,174 @@
+"""Speed sweeps as an experiment is run (the thesis' section 4-2): the speed is stepped
+up, then down, with a dwell at each step, the state carried over from step to step, and
+the motion at each step labelled by the basins' classifier
+(:func:`ballbal.basins.basins`' labels).
+
+Carrying the state over a speed step
+------------------------------------
+The state lives in the frame rotating with the disk at ``Omega``. A step changes the
+disk's speed from ``Omega_a`` to ``Omega_b`` at an instant; what is continuous there is
+the ground-frame state: the disk centre ``Z = (x + i y) e^(i theta)`` and its velocity
+``Z' = (x' + i y' + i Omega (x + i y)) e^(i theta)``, and each ball's absolute angle
+``theta + b_i`` and rate ``Omega + b_i'`` (the disk's angle ``theta`` is continuous;
+only its rate jumps). Hence, with ``D = Omega_a - Omega_b``::
+
+    x, y, b_i  unchanged
+    x' -> x' - D y,    y' -> y' + D x,    b_i' -> b_i' + D
+
+(at the perfect balance, ``x = y = 0`` and the balls at rest on the disk, the balls
+keep their absolute speed and so slip by ``D`` relative to the new disk speed).
+
+The symmetry-breaking kick
+--------------------------
+Merged balls (``b1 = b2``) stay merged for ever in a simulation of identical balls (the
+diagonal is invariant), which no rig does. ``kick`` (default 1e-3 rad) moves ball 1 by
+``+kick`` and ball 2 by ``-kick`` at the start of every step, as a tap on the rig
+would; ``kick=0`` switches it off.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any, Literal
+
+import numpy as np
+import polars as pl
+
+from . import _check, _native
+from .basins import REST, ROTATING, BasinOptions
+from .exceptions import ParameterError
+from .model import Balancer
+
+
+def carry_over(y: np.ndarray, omega_from: float, omega_to: float, n_balls: int,
+               d: int) -> np.ndarray:
+    """The rotating-frame state after a speed step from ``omega_from`` to ``omega_to``
+    with the ground-frame state continuous (see the module's description)."""
+    y = np.array(y, dtype=float)
+    dd = omega_from - omega_to
+    x, yy = y[0], y[1]
+    y[d] -= dd * yy
+    y[d + 1] += dd * x
+    y[2 * d - n_balls:] += dd
+    return y
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """The result of :func:`speed_sweep`: ``table`` (one row per step: ``step,
+    direction, Omega, label, omega`` (mean ball rate), ``period``, ``rotating``, and
+    ``vibration`` (mean ``|Z''|`` over the last ``record`` time units of the dwell) when
+    recorded); ``up`` and ``down``: the transition speeds (the thesis' critical speeds:
+    the first speed going up at which the motion is at rest on an equilibrium after
+    moving, the first speed going down at which it moves again; ``None`` if none)."""
+
+    table: pl.DataFrame
+    up: float | None
+    down: float | None
+
+    @property
+    def hysteresis(self) -> float | None:
+        """``up - down``: the width of the speed range where both motions are seen."""
+        if self.up is None or self.down is None:
+            return None
+        return self.up - self.down
+
+
+def speed_sweep(
+    model: Balancer,
+    speeds: Sequence[float] | np.ndarray,
+    *,
+    dwell: float = 1000.0,
+    direction: Literal["up-down", "up", "down"] = "up-down",
+    kick: float = 1e-3,
+    record: float | None = 100.0,
+    y0: Sequence[float] | np.ndarray | None = None,
+    options: BasinOptions | None = None,
+) -> Sweep:
+    """Step the speed through ``speeds`` (ascending) up, then back down (``"up-down"``:
+    the top speed is not repeated), dwelling ``dwell`` time units at each step, and
+    label the motion at each (the basins' classifier over the last ``options.window``
+    of the dwell).
+
+    ``y0``: the state at the first step (default: at rest in the ground frame, the balls
+    together at angle 0.3 of the disk, as a rig is started). ``kick``: see the module's
+    description. ``record``: simulate that long more after each step's dwell, without
+    changing the state carried on, for the vibration indicator
+    (:func:`ballbal.spectrum.vibration`); ``None`` skips it.
+    """
+    from .analysis import simulate
+    from .spectrum import vibration
+
+    _check.model("model", model)
+    if not isinstance(model, Balancer):
+        raise ParameterError("model", "speed sweeps take a Balancer")
+    sp = _check.array("speeds", speeds)
+    if sp.size < 1 or np.any(np.diff(sp) <= 0):
+        raise ParameterError("speeds", "give ascending speeds")
+    if direction not in ("up-down", "up", "down"):
+        raise ParameterError("direction", f"must be 'up-down', 'up' or 'down', got "
+                             f"{direction!r}", allowed="up-down, up, down")
+    dwell = _check.real("dwell", dwell)
+    kick = _check.real("kick", kick)
+    o = BasinOptions() if options is None else options
+    o = replace(o, t_end=dwell, window=min(o.window, dwell), settle_factor=None)
+    if direction == "up":
+        path = [(float(s), "up") for s in sp]
+    elif direction == "down":
+        path = [(float(s), "down") for s in sp[::-1]]
+    else:
+        path = [(float(s), "up") for s in sp] + [(float(s), "down") for s in sp[-2::-1]]
+    n = model.n_balls
+    d = len(model.coordinates)
+    if y0 is None:
+        y = np.zeros(2 * d)
+        y[d - n:d] = 0.3
+        y[2 * d - n:] = -path[0][0]
+    else:
+        y = _check.array("y0", y0).copy()
+        if y.size != 2 * d:
+            raise ParameterError("y0", f"needs {2 * d} values")
+    prev = path[0][0]
+    rows: list[dict[str, Any]] = []
+    for k, (om, dirn) in enumerate(path):
+        y = carry_over(y, prev, om, n, d)
+        if kick:
+            y[d - n] += kick
+            y[d - n + 1] -= kick
+        m = model.replace(Omega=om)
+        cols, y = _native.classify_state(m, np.ascontiguousarray(y), o)
+        row: dict[str, Any] = {"step": k, "direction": dirn, "Omega": om,
+                               "label": cols["label"][0], "omega": cols["omega"][0],
+                               "period": cols["period"][0]}
+        row["rotating"] = row["label"] in ROTATING
+        row["at_rest"] = row["label"] in REST
+        if record is not None:
+            rec = simulate(m, y, t_eval=np.linspace(0.0, record, int(record * 20) + 1),
+                           rtol=o.rtol, atol=o.atol)
+            row["vibration"] = vibration(rec).mean
+        rows.append(row)
+        prev = om
+    table = pl.DataFrame(rows)
+    return Sweep(table, *_transitions(table, direction))
+
+
+def _transitions(table: pl.DataFrame, direction: str) -> tuple[float | None, float | None]:
+    """Going up, the first speed at rest (an equilibrium) after a moving step; going
+    down, the first moving step after rest (a transient, ``not_settled``, counts as
+    moving: the balls have left the equilibrium)."""
+    up = down = None
+    was: bool | None = None
+    for r in table.filter(pl.col("direction") == "up").iter_rows(named=True):
+        if was is False and r["at_rest"]:
+            up = r["Omega"]
+            break
+        was = r["at_rest"]
+    ups = table.filter(pl.col("direction") == "up")
+    was = bool(ups["at_rest"][-1]) if direction == "up-down" and ups.height else None
+    for r in table.filter(pl.col("direction") == "down").iter_rows(named=True):
+        if was is True and not r["at_rest"]:
+            down = r["Omega"]
+            break
+        was = r["at_rest"]
+    return up, down
