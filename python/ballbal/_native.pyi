@@ -17,7 +17,7 @@ from .scene import Scene
 __all__ = [
     "simulate", "validate", "equilibria", "balanced_states", "periodic", "orbit_closure",
     "balance_map", "scan", "default_chunk", "certificate_seconds", "validate_bearing",
-    "__version__",
+    "groove_study", "__version__",
 ]
 
 __version__: str
@@ -29,6 +29,11 @@ def simulate(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
 def validate(model: Balancer | Scene) -> None: ...
 def validate_bearing(bearing: Bearing) -> None: ...
+def groove_study(
+    bearing: Bearing, angle: Sequence[float], depth_ratio: Sequence[float],
+    width_ratio: Sequence[float], length_ratio: Sequence[float], count: Sequence[int],
+    eccentricity: float, threads: int | None = None,
+) -> dict[str, list[Any]]: ...
 def equilibria(model: Balancer | Scene) -> list[dict[str, Any]]: ...
 def balanced_states(models: Sequence[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
 # (status, equilibrium dict or None) per point: "ok", "no_balance" or "not_converged"

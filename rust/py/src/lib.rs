@@ -9,6 +9,7 @@ mod bearing;
 mod convert;
 mod entries;
 mod errors;
+mod groove;
 mod run;
 mod tables;
 
@@ -63,6 +64,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::default_chunk, m)?)?;
     m.add_function(wrap_pyfunction!(entries::certificate_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::validate_bearing, m)?)?;
+    m.add_function(wrap_pyfunction!(groove::groove_study, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -23,6 +23,7 @@ pub mod finite;
 pub mod linear;
 pub mod long;
 pub mod short;
+pub mod study;
 #[cfg(test)]
 mod tests;
 
