@@ -586,15 +586,13 @@ impl FiniteSolver {
                 + pb.y * (self.cf[i + 1] - self.cf[i]) / self.dth;
             cz[i] = hc * hc * hc * czf;
         }
-        let r: Vec<f64> = (0..nt)
-            .map(|i| {
-                let sq = -12.0
-                    * self.dz
-                    * (pb.vx * (self.sf[i + 1] - self.sf[i])
-                        - pb.vy * (self.cf[i + 1] - self.cf[i]));
-                -(6.0 * self.dz * (q[(i + 1) % nt] - q[i]) + sq)
-            })
-            .collect();
+        let mut r = vec![0.0; nt];
+        for (i, ri) in r.iter_mut().enumerate() {
+            let sq = -12.0
+                * self.dz
+                * (pb.vx * (self.sf[i + 1] - self.sf[i]) - pb.vy * (self.cf[i + 1] - self.cf[i]));
+            *ri = -(6.0 * self.dz * (q[(i + 1) % nt] - q[i]) + sq);
+        }
         let half = nz / 2;
         let mut p = vec![0.0; nt * nz];
         let mut diag = vec![0.0; nt];
