@@ -22,7 +22,7 @@ __all__ = [
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
-    "__version__",
+    "groove_study", "__version__",
 ]
 
 __version__: str
@@ -44,6 +44,11 @@ def bearing_coefficients(
     bearing: Bearing, position: tuple[float, float],
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def bearing_stability(bearing: Bearing, load: tuple[float, float]) -> dict[str, Any]: ...
+def groove_study(
+    bearing: Bearing, angle: Sequence[float], depth_ratio: Sequence[float],
+    width_ratio: Sequence[float], length_ratio: Sequence[float], count: Sequence[int],
+    eccentricity: float, threads: int | None = None,
+) -> dict[str, list[Any]]: ...
 def equilibria(model: Balancer | Scene) -> list[dict[str, Any]]: ...
 def balanced_states(models: Sequence[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
 # (status, equilibrium dict or None) per point: "ok", "no_balance" or "not_converged"

@@ -45,7 +45,7 @@ __all__ = [
     "Bearing", "BearingEquilibrium", "Coefficients", "Dimensions", "FilmForce", "Grooves",
     "RotorImpulse", "RotorOnBearing", "RotorTrajectory", "Stability", "coefficients",
     "default_grid", "equilibrium", "film_force", "plot_pressure", "plot_trajectory",
-    "rotor_equilibrium", "simulate_rotor", "stability",
+    "rotor_equilibrium", "simulate_rotor", "stability", "groove_study", "plot_groove_study",
 ]
 
 MODELS = ("short", "long", "finite", "narrow_groove")
@@ -443,3 +443,6 @@ from ._rotor import (  # noqa: E402
     rotor_equilibrium,
     simulate_rotor,
 )
+
+# The groove study: a parallel scan over groove parameters (imported last, as above).
+from ._groove_study import groove_study, plot_groove_study  # noqa: E402

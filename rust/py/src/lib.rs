@@ -10,6 +10,7 @@ mod bearing;
 mod convert;
 mod entries;
 mod errors;
+mod groove;
 mod rotor;
 mod run;
 mod tables;
@@ -71,6 +72,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bearing::bearing_coefficients, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_stability, m)?)?;
     basins::register(m)?;
+    m.add_function(wrap_pyfunction!(groove::groove_study, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

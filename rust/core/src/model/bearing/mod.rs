@@ -25,6 +25,7 @@ pub mod linear;
 pub mod long;
 pub mod narrow;
 pub mod short;
+pub mod study;
 #[cfg(test)]
 mod tests;
 
