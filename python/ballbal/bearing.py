@@ -433,8 +433,10 @@ def plot_pressure(force_or_bearing: FilmForce | Bearing, position: Any = None,
     return fig
 
 
-# A rigid rotor on the bearing (fixed frame, no balls): trajectories, seed 002's scenarios.
-# Imported last: ``_rotor`` needs :class:`Bearing`, defined above.
+# Imported last (they need :class:`Bearing`, defined above): a rigid rotor on the bearing
+# (fixed frame, no balls; seed 002's scenarios) and the groove study (a parallel scan over
+# groove parameters).
+from ._groove_study import groove_study, plot_groove_study  # noqa: E402
 from ._rotor import (  # noqa: E402
     RotorImpulse,
     RotorOnBearing,
@@ -443,6 +445,3 @@ from ._rotor import (  # noqa: E402
     rotor_equilibrium,
     simulate_rotor,
 )
-
-# The groove study: a parallel scan over groove parameters (imported last, as above).
-from ._groove_study import groove_study, plot_groove_study  # noqa: E402
