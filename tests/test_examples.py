@@ -144,7 +144,7 @@ def thesis_ch4(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
 def bearing_balancer(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     # The plain film holds nothing at the centre (unstable at every speed, both film
     # models); grooves on the journal (depth > 0) open a stable speed window, depth 0 none.
-    plain = re.findall(r"plain, .*: largest real part .* unstable at all \d+ speeds: (\w+)",
+    plain = re.findall(r"plain, .*: largest real part .*unstable at all \d+ speeds: (\w+)",
                        stdout)
     assert plain == ["True", "True"], stdout
     spans = dict(re.findall(r"depth ratio (\S+): stable for (.*) \(", stdout))
