@@ -263,3 +263,50 @@ def test_oil_whirl_orbit_by_harmonic_balance_is_what_simulation_reaches():
     r_sim = np.hypot(x, df["y"].to_numpy()[late])
     assert r_hb.min() == pytest.approx(r_sim.min(), abs=1e-4)
     assert r_hb.max() == pytest.approx(r_sim.max(), abs=1e-4)
+
+
+def test_lab_quantities_give_the_classical_mass_parameter():
+    # w_ref = mu_oil L R^3 / (c^3 M), so Omega = M c^3 w / (mu_oil L R^3), written out.
+    from ballbal.bearing import Dimensions
+    from ballbal.scene import BearingSupport
+
+    dims = Dimensions(radius=0.02, length=0.02, clearance=50e-6, viscosity=0.03)
+    disk, other, balls, e, r_t, w = 0.5, 2.0, (0.01, 0.01), 2e-5, 0.03, 300.0
+    sc = BearingSupport.from_lab(Bearing(length_ratio=0.5, model="short"), dims,
+                                 disk_mass=disk, eccentricity=e, ball_masses=balls,
+                                 track_radius=r_t, track_damping=1e-4, spin=w,
+                                 other_mass=other, external_damping=3.0)
+    m = disk + other + sum(balls)
+    w_ref = 0.03 * 0.02 * 0.02**3 / (50e-6**3 * m)
+    assert sc.balancer.Omega == pytest.approx(m * 50e-6**3 * w / (0.03 * 0.02 * 0.02**3))
+    assert sc.balancer.zeta == pytest.approx(3.0 / (2 * m * w_ref))
+    assert sc.balancer.zeta_b == pytest.approx(1e-4 / (2 * 0.01 * w_ref))
+    assert sc.balancer.eta == pytest.approx((0.01 * r_t / (disk * e),) * 2)
+    assert sc.support.rho == pytest.approx(e / 50e-6)
+    with pytest.raises(ParameterError) as err:
+        BearingSupport.from_lab(Bearing(length_ratio=1.0, model="short"), dims,
+                                disk_mass=disk, eccentricity=e, ball_masses=balls,
+                                track_radius=r_t, track_damping=1e-4, spin=w)
+    assert err.value.parameter == "bearing"
+
+
+def test_converting_a_spring_scene_keeps_the_lab_quantities():
+    # The same lab machine two ways: a spring scene converted with w_n / w_ref, and the
+    # bearing scene built from the lab quantities directly.
+    from ballbal.bearing import Dimensions
+    from ballbal.scene import BearingSupport
+
+    dims = Dimensions(radius=0.02, length=0.02, clearance=50e-6, viscosity=0.03)
+    lab = dict(disk_mass=0.5, eccentricity=2e-5, ball_masses=(0.01, 0.01), track_radius=0.03,
+               track_damping=1e-4, spin=300.0, other_mass=2.0)
+    k = 4e5
+    spring = ballbal.Scene(balancer=ballbal.Balancer.from_lab(stiffness=k, damping=5.0, **lab))
+    m = 2.52
+    support = BearingSupport(Bearing(length_ratio=0.5, model="short"), rho=2e-5 / 50e-6)
+    ratio = (k / m) ** 0.5 / BearingSupport.reference_frequency(dims, m)
+    conv, changes = ballbal.to_bearing(spring, support, natural_over_reference=ratio)
+    direct = BearingSupport.from_lab(support.bearing, dims, **lab)
+    for f in ("mu", "delta", "Omega", "zeta_b", "eta", "zeta"):
+        assert getattr(conv.balancer, f) == pytest.approx(getattr(direct.balancer, f)), f
+    assert set(changes) == {"Omega", "zeta_b", "zeta", "support"}
+    assert changes["zeta"] == (spring.balancer.zeta, 0.0)

@@ -22,7 +22,7 @@ from .options import (
     ScanOptions,
 )
 from .scan import read_scan, scan, scan_meta
-from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene
+from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene, to_bearing
 from .spectrum import (
     Vibration,
     label_peaks,
@@ -81,6 +81,7 @@ __all__ = [
     "signal_spectrum",
     "simulate",
     "sweep",
+    "to_bearing",
     "track_damping_study",
     "vibration",
     "zeta_from_log_decrement",

@@ -29,6 +29,10 @@ no spring, so the units change: time is over ``1 / w_ref`` with ``w_ref = C_S / 
 film, ``c_ext / (2 M w_ref)`` (0 for the film alone); ``zeta_b`` is ``c_b / (2 m_b w_ref)``.
 Converting a spring–damper scene keeps the numbers but not their meaning: a ratio over
 ``w_n`` becomes one over ``w_ref``, so the same lab ``zeta_b`` is ``zeta_b w_n / w_ref``.
+:meth:`BearingSupport.from_lab` builds a bearing scene from lab quantities (``w_ref`` is
+:meth:`BearingSupport.reference_frequency`); :func:`to_bearing` converts a spring–damper
+scene and returns what changed (``Omega`` and ``zeta_b`` times ``w_n / w_ref``, ``zeta``
+to 0).
 A plain bearing, grooves on the journal or narrow-groove theory keep the scene
 autonomous; resolved grooves (``model="finite"``) on the stationary sleeve make it
 time-periodic (effect ``"grooved_sleeve"``): simulation only.
@@ -51,11 +55,12 @@ from __future__ import annotations
 import math
 import os
 import sys
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
 from . import _check
-from .bearing import Bearing, Grooves
+from .bearing import Bearing, Dimensions, Grooves
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer, _is_number
 
@@ -164,6 +169,88 @@ class BearingSupport:
                 and self.bearing.model == "finite"):
             return "grooved_sleeve"
         return None
+
+    @staticmethod
+    def reference_frequency(dimensions: Dimensions, mass: float) -> float:
+        """``w_ref = C_S / M`` [rad/s] with ``C_S = mu_oil L R^3 / c^3``: the bearing
+        scene's time unit, in place of a spring's ``sqrt(k / M)``; ``mass`` is the
+        translating mass ``M`` [kg]."""
+        m = _check.real("mass", mass, 0.0, lo_open=True)
+        d = dimensions
+        return d.viscosity * d.length * d.radius**3 / (d.clearance**3 * m)
+
+    @classmethod
+    def from_lab(
+        cls,
+        bearing: Bearing,
+        dimensions: Dimensions,
+        *,
+        disk_mass: float,
+        eccentricity: float,
+        ball_masses: Sequence[float],
+        track_radius: float,
+        track_damping: float,
+        spin: float,
+        other_mass: float = 0.0,
+        external_damping: float = 0.0,
+    ) -> Scene:
+        """A balancer on this bearing from lab quantities (SI units, ``spin`` in rad/s).
+
+        As :meth:`Balancer.from_lab`, with the bearing's ``w_ref`` (:meth:`
+        reference_frequency`) in place of ``sqrt(k / M)``: ``Omega = spin / w_ref`` (the
+        mass parameter ``M c^3 w / (mu_oil L R^3)``), ``zeta = external_damping / (2 M
+        w_ref)`` (a damper beside the film, 0 for none), ``zeta_b = c_b / (2 m_b w_ref)``,
+        and ``rho = e / c``. The bearing's ``length_ratio`` must be the dimensions' ``L / D``.
+        """
+        if not isinstance(bearing, Bearing):
+            raise ParameterTypeError("bearing", "must be a ballbal.bearing.Bearing",
+                                     allowed="Bearing")
+        if not math.isclose(bearing.length_ratio, dimensions.length_ratio, rel_tol=1e-9):
+            raise ParameterError(
+                "bearing", f"length_ratio {bearing.length_ratio} is not the dimensions' L/D "
+                f"{dimensions.length_ratio}", allowed=f"{dimensions.length_ratio}")
+        ecc = _check.real("eccentricity", eccentricity, 0.0, lo_open=True)
+        mb = _check.reals("ball_masses", ball_masses)
+        total = (_check.real("other_mass", other_mass, 0.0)
+                 + _check.real("disk_mass", disk_mass, 0.0, lo_open=True) + sum(mb))
+        w_ref = cls.reference_frequency(dimensions, total)
+        # Balancer.from_lab with a stiffness giving sqrt(k / M) = w_ref
+        bal = Balancer.from_lab(
+            disk_mass=disk_mass, eccentricity=ecc, ball_masses=mb, track_radius=track_radius,
+            stiffness=w_ref**2 * total, damping=external_damping, track_damping=track_damping,
+            spin=spin, other_mass=other_mass)
+        return Scene(balancer=bal, support=cls(bearing, ecc / dimensions.clearance))
+
+
+def to_bearing(scene: Scene, support: BearingSupport, *,
+               natural_over_reference: float) -> tuple[Scene, dict[str, tuple[Any, Any]]]:
+    """The same machine with its spring–damper replaced by ``support``, and what changed.
+
+    A spring–damper scene's rates are over ``w_n = sqrt(k / M)``, a bearing scene's over
+    ``w_ref = C_S / M``; ``natural_over_reference = w_n / w_ref`` converts them: the
+    returned scene keeps the lab speed, track damping and masses, so ``Omega`` and
+    ``zeta_b`` are multiplied by the ratio; the support damping ``zeta`` has no film
+    counterpart and becomes 0 (give an external damper by replacing it). The dict maps each
+    changed parameter to ``(old, new)``; ``"support"`` is always in it.
+    """
+    r = _check.real("natural_over_reference", natural_over_reference, 0.0, lo_open=True,
+                    finite=True)
+    if not isinstance(scene, Scene) or scene.support is not None:
+        raise ParameterError("scene", "must be a Scene on the spring–damper support",
+                             allowed="Scene with support=None")
+    if not isinstance(support, BearingSupport):
+        raise ParameterTypeError("support", "must be a BearingSupport",
+                                 allowed="BearingSupport")
+    b = scene.balancer
+    zb = b.zeta_b * r if isinstance(b.zeta_b, float) else tuple(z * r for z in b.zeta_b)
+    new = scene.replace(Omega=b.Omega * r, zeta_b=zb, zeta=0.0, support=support)
+    changes: dict[str, tuple[Any, Any]] = {
+        "Omega": (b.Omega, new.balancer.Omega),
+        "zeta_b": (b.zeta_b, new.balancer.zeta_b),
+        "zeta": (b.zeta, 0.0),
+        "support": ("spring-damper", support),
+    }
+    return new, changes
 
 
 @dataclass(frozen=True)
