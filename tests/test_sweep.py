@@ -108,3 +108,17 @@ def test_errors():
     with pytest.raises(ParameterError) as e:
         speed_sweep(thesis(), [1.2, 1.3], direction="sideways")  # type: ignore[arg-type]
     assert e.value.parameter == "direction"
+
+
+def test_waterfall_puts_the_main_line_at_omega_minus_ball_rate(sweep):
+    # The thesis' main vibration frequency on R-R is Omega - omega (section 4-4-2): at
+    # every merged R-R step the largest line of the recorded spectrum sits there, within
+    # two bins (record 100: bins of 2 pi / 100 in rad per time; the flat-top window's
+    # main lobe is five bins wide) and forward (positive frequency).
+    wf = sweep.waterfall()
+    assert set(wf["step"].unique()) == set(sweep.table["step"])
+    rr = sweep.table.filter(pl.col("label") == "merged_R-R")
+    for r in rr.iter_rows(named=True):
+        sp = wf.filter(pl.col("step") == r["step"])
+        top = sp.sort("amplitude", descending=True).row(0, named=True)
+        assert abs(top["frequency"] - (r["Omega"] - r["omega"])) < 2 * (2 * np.pi / 100)

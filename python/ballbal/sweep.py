@@ -66,6 +66,24 @@ class Sweep:
     table: pl.DataFrame
     up: float | None
     down: float | None
+    #: One windowed ground-frame acceleration spectrum per step (flat-top, two-sided over
+    #: ``X + iY``, :func:`ballbal.spectrum.signal_spectrum`) of the recorded stretch; empty
+    #: when ``record`` was ``None``. Its resolution is ``1 / record`` cycles per time unit.
+    spectra: tuple[pl.DataFrame, ...] = ()
+
+    def waterfall(self) -> pl.DataFrame:
+        """The steps' spectra as one long table (:func:`ballbal.spectrum.waterfall`),
+        each row tagged with its ``step``, ``direction`` and ``Omega``: the thesis'
+        spectra over a speed sweep, forward and backward whirl apart."""
+        from .spectrum import waterfall
+
+        if not self.spectra:
+            raise ParameterError("record", "the sweep recorded no signal (record=None)",
+                                 allowed="record > 0")
+        steps = self.table.select("step", "direction", "Omega").rows()
+        parts = [(om, sp.with_columns(pl.lit(k).alias("step"), pl.lit(dirn).alias("direction")))
+                 for (k, dirn, om), sp in zip(steps, self.spectra, strict=True)]
+        return waterfall(parts)
 
     @property
     def hysteresis(self) -> float | None:
@@ -98,7 +116,7 @@ def speed_sweep(
     (:func:`ballbal.spectrum.vibration`); ``None`` skips it.
     """
     from .analysis import simulate
-    from .spectrum import vibration
+    from .spectrum import ground_signal, signal_spectrum, vibration
 
     _check.model("model", model)
     if not isinstance(model, Balancer):
@@ -131,6 +149,7 @@ def speed_sweep(
             raise ParameterError("y0", f"needs {2 * d} values")
     prev = path[0][0]
     rows: list[dict[str, Any]] = []
+    spectra: list[pl.DataFrame] = []
     for k, (om, dirn) in enumerate(path):
         y = carry_over(y, prev, om, n, d)
         if kick:
@@ -147,10 +166,11 @@ def speed_sweep(
             rec = simulate(m, y, t_eval=np.linspace(0.0, record, int(record * 20) + 1),
                            rtol=o.rtol, atol=o.atol)
             row["vibration"] = vibration(rec).mean
+            spectra.append(signal_spectrum(ground_signal(rec), window="flattop"))
         rows.append(row)
         prev = om
     table = pl.DataFrame(rows)
-    return Sweep(table, *_transitions(table, direction))
+    return Sweep(table, *_transitions(table, direction), spectra=tuple(spectra))
 
 
 def _transitions(table: pl.DataFrame, direction: str) -> tuple[float | None, float | None]:
