@@ -107,6 +107,16 @@ def string(name: str, v: Any) -> str:
     return v
 
 
+def option(name: str, v: Any, kind: type[_T], default: _T, shown: str) -> _T:
+    """An options object of type ``kind`` (``shown`` is its public name), or ``default``
+    for ``None``."""
+    if v is None:
+        return default
+    if not isinstance(v, kind):
+        raise ParameterTypeError(name, f"must be a {shown}, got {type(v).__name__}", value=v)
+    return v
+
+
 def model(name: str, v: Any) -> Any:
     """A :class:`Balancer` or :class:`Scene` (what every analysis takes first)."""
     from .model import Balancer
@@ -231,6 +241,7 @@ def sequence(name: str, v: Any, *, empty: bool = False) -> list[Any]:
     return items
 
 
+_T = TypeVar("_T")
 _P = ParamSpec("_P")
 _R = TypeVar("_R")
 

@@ -376,11 +376,8 @@ def periodic(
     """
     _check.model("model", model)
     _check.string("pattern", pattern)
-    if options is None:
-        options = PERIODIC_DEFAULTS
-    elif not isinstance(options, PeriodicOptions):
-        raise ParameterTypeError("options", f"must be a ballbal.PeriodicOptions, got "
-                                 f"{type(options).__name__}", value=options)
+    options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
+                            "ballbal.PeriodicOptions")
     options = with_keywords(options, "periodic", keywords, PERIODIC_KEYWORDS)
     go: float | None = None
     gc: np.ndarray | None = None

@@ -32,7 +32,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from .exceptions import ParameterError, ParameterTypeError, ScanStoreError
+from .exceptions import ParameterError, ScanStoreError
 from .model import Balancer
 from .options import Execution
 from .scene import Scene
@@ -279,16 +279,10 @@ def basins(
     _check.model("model", model)
     if model.n_balls != 2:
         raise ParameterError("model", f"basins are drawn for two balls, got {model.n_balls}")
-    if options is None:
-        options = BasinOptions()
-    elif not isinstance(options, BasinOptions):
-        raise ParameterTypeError("options", f"must be a ballbal.basins.BasinOptions, got "
-                                 f"{type(options).__name__}", value=options)
-    if execution is None:
-        execution = Execution()
-    elif not isinstance(execution, Execution):
-        raise ParameterTypeError("execution", f"must be a ballbal.Execution, got "
-                                 f"{type(execution).__name__}", value=execution)
+    options = _check.option("options", options, BasinOptions, BasinOptions(),
+                            "ballbal.basins.BasinOptions")
+    execution = _check.option("execution", execution, Execution, Execution(),
+                              "ballbal.Execution")
     t_end = _check.real("t_end", t_end)
     window = min(options.window, t_end)
     factor = options.settle_factor

@@ -546,16 +546,10 @@ def scan(  # noqa: E302 - overloads above
     table held in memory and 1e9 for one streamed to ``out=``.
     """
     _check.model("model", model)
-    if options is None:
-        options = SCAN_DEFAULTS
-    elif not isinstance(options, ScanOptions):
-        raise ParameterTypeError("options", f"must be a ballbal.ScanOptions, got "
-                                 f"{type(options).__name__}", value=options)
-    if execution is None:
-        execution = Execution()
-    elif not isinstance(execution, Execution):
-        raise ParameterTypeError("execution", f"must be a ballbal.Execution, got "
-                                 f"{type(execution).__name__}", value=execution)
+    options = _check.option("options", options, ScanOptions, SCAN_DEFAULTS,
+                            "ballbal.ScanOptions")
+    execution = _check.option("execution", execution, Execution, Execution(),
+                              "ballbal.Execution")
     given: dict[str, Any] = {k: v for k, v in (("chunk", chunk), ("threads", threads),
                                                ("out", out), ("executor", executor))
                              if v is not None}
