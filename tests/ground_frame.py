@@ -10,11 +10,12 @@ import ballbal
 
 NOT_STATE = ["t", "theta", "X", "Y"]  # simulate() columns besides the state
 
-def ground_rhs(scene, t, s):
+def ground_rhs(scene, t, s, support=None):
     """Equations of motion in the ground frame: rotor centre (X, Y), absolute ball angles
     phi_i, disk angle theta(t) prescribed. From T = sum of m |v|^2 / 2 over rotor, the
     eccentric disk and the balls; V = support spring + gravity + ball springs; track
-    damping on phi_i' - theta', support damping on (X', Y')."""
+    damping on phi_i' - theta', support damping on (X', Y'). ``support(t, X, Y, X', Y')``,
+    when given, is the support's force in place of the spring-damper's."""
     b = scene.balancer
     n = b.n_balls
     eta = np.asarray(b.eta)
@@ -46,9 +47,11 @@ def ground_rhs(scene, t, s):
     M[1, 2:] = M[2:, 1] = fb * dl * C
     M[2:, 2:] = np.diag(fb * dl**2)
     rhs = np.empty(n + 2)
-    rhs[0] = (fx - 2 * z * dX - X + mu * (math.sin(th) * dw + math.cos(th) * w0**2)
+    sx, sy = (-2 * z * dX - X, -2 * z * dY - Y) if support is None else support(
+        t, X, Y, dX, dY)
+    rhs[0] = (fx + sx + mu * (math.sin(th) * dw + math.cos(th) * w0**2)
               + np.sum(fb * dl * C * dphi**2))
-    rhs[1] = (fy - 2 * z * dY - Y - g - mu * (math.cos(th) * dw - math.sin(th) * w0**2)
+    rhs[1] = (fy + sy - g - mu * (math.cos(th) * dw - math.sin(th) * w0**2)
               + np.sum(fb * dl * S * dphi**2))
     # ball springs: V = k dl^2 / 2 sum (phi_{j+1} - phi_j - 2 pi / n)^2, a ring closed
     # by ball n to ball 1, or seed 004's chain without that last spring
