@@ -20,17 +20,13 @@
 //! 8 panels of 16-point Gauss–Legendre.
 
 use super::short::gauss_legendre16;
-use super::{Cavitation, FilmForce, JournalState, PressureField};
+use super::{Cavitation, FilmForce, JournalState, LineOfCentres, PressureField};
 use std::f64::consts::PI;
 
 /// Long-bearing film force (per unit length, i.e. in units `F_S`).
 pub fn force(lambda: f64, cav: Cavitation, s: &JournalState, want_field: bool) -> FilmForce {
-    let (a, b) = (6.0 * s.x - 12.0 * s.vy, -6.0 * s.y - 12.0 * s.vx);
-    let eps = s.x.hypot(s.y);
-    let phi = if eps > 0.0 { s.y.atan2(s.x) } else { 0.0 };
-    let (sp, cp) = phi.sin_cos();
-    let big_a = a * cp - b * sp;
-    let big_b = a * sp + b * cp;
+    let frame = LineOfCentres::of(s);
+    let (eps, phi, big_a, big_b) = (frame.eps, frame.phi, frame.big_a, frame.big_b);
     let p = |t: f64| pressure(eps, big_a, big_b, t);
     let n = 256;
     let dt = 2.0 * PI / n as f64;
@@ -86,8 +82,7 @@ pub fn force(lambda: f64, cav: Cavitation, s: &JournalState, want_field: bool) -
             }
         }
     }
-    let fx = fr_out * cp - ft * sp;
-    let fy = fr_out * sp + ft * cp;
+    let (fx, fy) = frame.to_fixed(fr_out, ft);
     let mut f = FilmForce::from_xy(s, fx, fy, p_max);
     if want_field {
         let (nt, nz) = (128, 32);

@@ -316,6 +316,42 @@ impl JournalState {
     }
 }
 
+/// The closed forms' line-of-centres frame (see [`short`]): `x + i y = eps e^{i phi}`, and
+/// the squeeze-plus-wedge right-hand side `g = A sin t + B cos t` in the angle `t = theta - phi`.
+pub(crate) struct LineOfCentres {
+    pub eps: f64,
+    pub phi: f64,
+    sin: f64,
+    cos: f64,
+    pub big_a: f64,
+    pub big_b: f64,
+}
+
+impl LineOfCentres {
+    pub fn of(s: &JournalState) -> Self {
+        let (a, b) = (6.0 * s.x - 12.0 * s.vy, -6.0 * s.y - 12.0 * s.vx);
+        let eps = s.x.hypot(s.y);
+        let phi = if eps > 0.0 { s.y.atan2(s.x) } else { 0.0 };
+        let (sp, cp) = phi.sin_cos();
+        LineOfCentres {
+            eps,
+            phi,
+            sin: sp,
+            cos: cp,
+            big_a: a * cp - b * sp,
+            big_b: a * sp + b * cp,
+        }
+    }
+
+    /// Radial and tangential components (along and across the line of centres) as fixed-frame `(x, y)`.
+    pub fn to_fixed(&self, radial: f64, tangential: f64) -> (f64, f64) {
+        (
+            radial * self.cos - tangential * self.sin,
+            radial * self.sin + tangential * self.cos,
+        )
+    }
+}
+
 /// The film pressure on the cell centres, `values[i * n_zeta + j]` at `(theta[i], zeta[j])`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PressureField {

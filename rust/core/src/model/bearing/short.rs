@@ -34,7 +34,7 @@
 //! `F_t = F0 pi eps/(4 (1-eps^2)^(3/2))`, `F0 = (2 lambda)^2 F_S`; the tests check both that
 //! and a direct quadrature of the pressure above.
 
-use super::{Cavitation, FilmForce, JournalState, PressureField};
+use super::{Cavitation, FilmForce, JournalState, LineOfCentres, PressureField};
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
@@ -42,12 +42,8 @@ const SMALL_EPS: f64 = 0.1;
 
 /// Short-bearing film force.
 pub fn force(lambda: f64, cav: Cavitation, s: &JournalState, want_field: bool) -> FilmForce {
-    let (a, b) = (6.0 * s.x - 12.0 * s.vy, -6.0 * s.y - 12.0 * s.vx);
-    let eps = s.x.hypot(s.y);
-    let phi = if eps > 0.0 { s.y.atan2(s.x) } else { 0.0 };
-    let (sp, cp) = phi.sin_cos();
-    let big_a = a * cp - b * sp;
-    let big_b = a * sp + b * cp;
+    let frame = LineOfCentres::of(s);
+    let (eps, big_a, big_b) = (frame.eps, frame.big_a, frame.big_b);
     let (s_cc, s_ss, s_sc) = if cav == Cavitation::None {
         full_period(eps)
     } else if big_a == 0.0 && big_b == 0.0 {
@@ -59,8 +55,7 @@ pub fn force(lambda: f64, cav: Cavitation, s: &JournalState, want_field: bool) -
     let k = lambda * lambda / 3.0;
     let fr_out = k * (big_a * s_sc + big_b * s_cc);
     let ft = k * (big_a * s_ss + big_b * s_sc);
-    let fx = fr_out * cp - ft * sp;
-    let fy = fr_out * sp + ft * cp;
+    let (fx, fy) = frame.to_fixed(fr_out, ft);
     let clip = cav != Cavitation::None;
     let p_mid = |t: f64| {
         let h = 1.0 - eps * t.cos();
