@@ -31,7 +31,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field, fields, replace
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 from . import _check
 from .exceptions import ParameterError, ParameterTypeError
@@ -95,14 +95,17 @@ class HarmonicBalance:
         _reals(self, "target", "tol", "step_tol")
         _counts(self, "N_max", "max_iter")
         object.__setattr__(self, "samples", _check.optional_integer("samples", self.samples))
+        # What the binding reads, stored rather than computed by properties: reading a
+        # property runs Python code, where a Ctrl-C raised during the binding's argument
+        # extraction surfaced as a TypeError instead of KeyboardInterrupt.
+        auto = self.N == "auto"
+        object.__setattr__(self, "_start", AUTO_START if auto else int(self.N))
+        object.__setattr__(self, "_auto_target", self.target if auto else None)
 
-    @property
-    def _start(self) -> int:
-        return AUTO_START if self.N == "auto" else int(self.N)
-
-    @property
-    def _auto_target(self) -> float | None:
-        return self.target if self.N == "auto" else None
+    # Instance attributes set above; declared as ClassVar so that they stay out of the
+    # dataclass' fields (its equality, asdict and the scan files' metadata).
+    _start: ClassVar[int]
+    _auto_target: ClassVar[float | None]
 
 
 @dataclass(frozen=True)
