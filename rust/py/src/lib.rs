@@ -7,6 +7,8 @@
 
 mod basins;
 mod bearing;
+#[allow(dead_code)] // used by the continuation entries being added (issue 15)
+mod continuation;
 mod convert;
 mod entries;
 mod errors;

@@ -5,13 +5,17 @@
 //! A strategy is an iterator of [`BranchPoint`]s. [`natural`] steps the parameter along
 //! a given sequence of values (secant predictor, the last solution as fallback);
 //! [`lattice`] runs the same step to the neighbours of every solution on a grid, wave
-//! after wave, as the scans do. Pseudo-arclength continuation, which steps along the
-//! branch and lets the parameter follow, joins them as a sibling strategy over the
+//! after wave, as the scans do. [`arclength`] (pseudo-arclength continuation) steps
+//! along the branch and lets the parameter follow, through folds; it works over the
 //! [`crate::numerics::problem::Problem`] trait (`jac_x`, `jac_p` give its tangent).
 
+pub mod arclength;
+pub mod curves;
 pub mod lattice;
 pub mod natural;
 
+pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
+pub use curves::{Extended, TestFunction, TwoParameter};
 pub use lattice::{waves, Lattice, Tally, Waves};
 pub use natural::{natural_step, Natural, Step};
 

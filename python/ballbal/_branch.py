@@ -1,0 +1,81 @@
+"""What continuation returns: a branch of solutions in one parameter, with its located
+events, and a curve of bifurcation points in two parameters. The options of the
+pseudo-arclength engine (``rust/core/src/continuation/arclength.rs``) are
+:class:`Continuation`; the binding reads its fields by name.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import polars as pl
+
+from ballbal import _check
+
+
+@dataclass(frozen=True)
+class Continuation:
+    """Step control of pseudo-arclength continuation.
+
+    ``ds`` is the first step, between ``ds_min`` and ``ds_max``, measured in the unknowns
+    and the parameter together (the harmonic coefficients, omega, the parameter);
+    ``max_points`` bounds the branch; Newton's corrector converges when the residual is
+    at most ``tol`` within ``max_newton`` iterations; the step grows by ``grow`` after an
+    easy correction and halves after a failed one or a turn sharper than
+    ``acos(min_cos)`` between successive tangents. ``forward`` starts towards increasing
+    parameter.
+    """
+
+    ds: float = 0.01
+    ds_min: float = 1e-6
+    ds_max: float = 0.05
+    max_points: int = 500
+    tol: float = 1e-10
+    max_newton: int = 8
+    grow: float = 1.5
+    min_cos: float = 0.9
+    forward: bool = True
+
+    def __post_init__(self) -> None:
+        for name in ("ds", "ds_min", "ds_max", "tol", "grow", "min_cos"):
+            object.__setattr__(self, name, _check.real(name, getattr(self, name)))
+        for name in ("max_points", "max_newton"):
+            object.__setattr__(self, name, _check.integer(name, getattr(self, name), 1))
+        object.__setattr__(self, "forward", _check.boolean("forward", self.forward))
+
+
+@dataclass(frozen=True)
+class Branch:
+    """A branch of equilibria or periodic solutions continued in ``parameter``.
+
+    ``table`` has one row per point, in order along the branch (the parameter, the
+    solution's summary, its stability with the evidence, the test functions, and an
+    ``event`` column naming the event located between this point and the previous one);
+    ``events`` has one row per located event (type, parameter value, the located
+    solution's summary, the test function's value there). ``stop`` says why the branch
+    ended (``"boundary"``, ``"max_points"``, ``"step_too_small"``,
+    ``"infinite_period"``, or ``"failed: ..."``).
+    """
+
+    kind: str
+    parameter: str
+    table: pl.DataFrame
+    events: pl.DataFrame
+    stop: str
+    start: Any = None
+    meta: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A curve of bifurcation points of type ``kind`` in ``parameters`` (two names),
+    one row per point in ``table``; ``points`` lists the codimension-two points found on
+    it (e.g. Bogdanov–Takens, cusp); ``stop`` as for :class:`Branch`."""
+
+    kind: str
+    parameters: tuple[str, str]
+    table: pl.DataFrame
+    points: pl.DataFrame
+    stop: str
+    meta: dict[str, Any] = field(default_factory=dict)

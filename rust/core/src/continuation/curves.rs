@@ -1,0 +1,217 @@
+//! Two-parameter curves of bifurcation points as continuation of an extended system.
+//!
+//! A codimension-one bifurcation of `F(x, p1, p2) = 0` is a zero of a scalar test
+//! function `g(x, p1, p2)` on the solution manifold (a determinant for a fold, a
+//! bialternate-product determinant for a Hopf point, a characteristic multiplier's
+//! distance from -1 for period doubling, ...). The curve is the solution set of
+//!
+//! ```text
+//!   F(x, p1, p2) = 0
+//!   g(x, p1, p2) = 0
+//! ```
+//!
+//! which [`Extended`] presents as an ordinary [`Problem`] with unknowns `(x, p1)` and
+//! parameter `p2`, so that [`super::Arclength`] follows it through folds of the curve.
+//! The test function need only be smooth and regular near the curve; its derivatives are
+//! taken by central differences (minimally augmented systems supply `g` by one bordered
+//! solve, which is what makes this cheap).
+
+use crate::error::{Error, Result};
+use crate::numerics::problem::Problem;
+
+/// A square system in `x` with two scalar parameters.
+pub trait TwoParameter {
+    fn size(&self) -> usize;
+    fn residual(&mut self, x: &[f64], p: [f64; 2], r: &mut [f64]) -> Result<()>;
+    /// `F` into `r` and the row-major `dF/dx` into `jac`.
+    fn jac_x(&mut self, x: &[f64], p: [f64; 2], r: &mut [f64], jac: &mut [f64]) -> Result<()>;
+    /// `dF/dp_k` (k = 0, 1) into `out`; by default a central difference.
+    fn jac_p(&mut self, x: &[f64], p: [f64; 2], k: usize, out: &mut [f64]) -> Result<()> {
+        let h = 1e-6 * (1.0 + p[k].abs());
+        let (mut pp, mut pm) = (p, p);
+        pp[k] += h;
+        pm[k] -= h;
+        let mut rm = vec![0.0; self.size()];
+        self.residual(x, pp, out)?;
+        self.residual(x, pm, &mut rm)?;
+        for (o, m) in out.iter_mut().zip(&rm) {
+            *o = (*o - m) / (2.0 * h);
+        }
+        Ok(())
+    }
+}
+
+/// A scalar test function on a [`TwoParameter`] system.
+pub trait TestFunction<T: TwoParameter + ?Sized> {
+    fn value(&mut self, system: &mut T, x: &[f64], p: [f64; 2]) -> Result<f64>;
+}
+
+impl<T: TwoParameter + ?Sized, G: FnMut(&mut T, &[f64], [f64; 2]) -> Result<f64>> TestFunction<T>
+    for G
+{
+    fn value(&mut self, system: &mut T, x: &[f64], p: [f64; 2]) -> Result<f64> {
+        self(system, x, p)
+    }
+}
+
+/// `[F; g] = 0` as a [`Problem`] in `(x, p1)` with parameter `p2`.
+pub struct Extended<T, G> {
+    pub system: T,
+    pub test: G,
+    /// The `p2` value `param()` reports (the curve's start).
+    pub p2: f64,
+    /// Relative step of the test function's central differences.
+    pub fd_step: f64,
+}
+
+impl<T: TwoParameter, G: TestFunction<T>> Extended<T, G> {
+    pub fn new(system: T, test: G, p2: f64) -> Self {
+        Extended {
+            system,
+            test,
+            p2,
+            fd_step: 1e-6,
+        }
+    }
+
+    fn g(&mut self, x: &[f64], p: [f64; 2]) -> Result<f64> {
+        let v = self.test.value(&mut self.system, x, p)?;
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(Error::param(
+                "test_function",
+                format!("not finite at p = ({}, {})", p[0], p[1]),
+            ))
+        }
+    }
+
+    /// Central difference of `g` in unknown `j` of `(x, p1)` (`j == n` is `p1`) or, with
+    /// `j == n + 1`, in `p2`.
+    fn g_diff(&mut self, x: &[f64], p: [f64; 2], j: usize) -> Result<f64> {
+        let n = x.len();
+        let mut xp = x.to_vec();
+        let mut xm = x.to_vec();
+        let (mut pp, mut pm) = (p, p);
+        let v = match j {
+            j if j < n => x[j],
+            j if j == n => p[0],
+            _ => p[1],
+        };
+        let h = self.fd_step * (1.0 + v.abs());
+        match j {
+            j if j < n => {
+                xp[j] += h;
+                xm[j] -= h;
+            }
+            j if j == n => {
+                pp[0] += h;
+                pm[0] -= h;
+            }
+            _ => {
+                pp[1] += h;
+                pm[1] -= h;
+            }
+        }
+        Ok((self.g(&xp, pp)? - self.g(&xm, pm)?) / (2.0 * h))
+    }
+}
+
+impl<T: TwoParameter, G: TestFunction<T>> Problem for Extended<T, G> {
+    fn size(&self) -> usize {
+        self.system.size() + 1
+    }
+    fn param(&self) -> f64 {
+        self.p2
+    }
+    fn residual(&mut self, y: &[f64], p2: f64, r: &mut [f64]) -> Result<()> {
+        let n = self.system.size();
+        let p = [y[n], p2];
+        self.system.residual(&y[..n], p, &mut r[..n])?;
+        r[n] = self.g(&y[..n], p)?;
+        Ok(())
+    }
+    fn jac_x(&mut self, y: &[f64], p2: f64, r: &mut [f64], jac: &mut [f64]) -> Result<()> {
+        let n = self.system.size();
+        let n1 = n + 1;
+        let p = [y[n], p2];
+        let mut jx = vec![0.0; n * n];
+        let mut fp = vec![0.0; n];
+        self.system.jac_x(&y[..n], p, &mut r[..n], &mut jx)?;
+        self.system.jac_p(&y[..n], p, 0, &mut fp)?;
+        for i in 0..n {
+            jac[i * n1..i * n1 + n].copy_from_slice(&jx[i * n..(i + 1) * n]);
+            jac[i * n1 + n] = fp[i];
+        }
+        r[n] = self.g(&y[..n], p)?;
+        for j in 0..n1 {
+            jac[n * n1 + j] = self.g_diff(&y[..n], p, j)?;
+        }
+        Ok(())
+    }
+    fn jac_p(&mut self, y: &[f64], p2: f64, out: &mut [f64]) -> Result<()> {
+        let n = self.system.size();
+        let p = [y[n], p2];
+        self.system.jac_p(&y[..n], p, 1, &mut out[..n])?;
+        out[n] = self.g_diff(&y[..n], p, n + 1)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::continuation::{ArcOptions, Arclength};
+
+    /// `x^3 - a x + b = 0` (the cusp): folds where `3 x^2 = a`, i.e. on the curve
+    /// `27 b^2 = 4 a^3`.
+    struct Cusp;
+    impl TwoParameter for Cusp {
+        fn size(&self) -> usize {
+            1
+        }
+        fn residual(&mut self, x: &[f64], p: [f64; 2], r: &mut [f64]) -> Result<()> {
+            r[0] = x[0].powi(3) - p[0] * x[0] + p[1];
+            Ok(())
+        }
+        fn jac_x(&mut self, x: &[f64], p: [f64; 2], r: &mut [f64], j: &mut [f64]) -> Result<()> {
+            self.residual(x, p, r)?;
+            j[0] = 3.0 * x[0] * x[0] - p[0];
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn fold_curve_of_the_cusp() {
+        // Fold test function det F_x; start on the curve at a = 3, x = 1, b = 2.
+        let ext = Extended::new(
+            Cusp,
+            |s: &mut Cusp, x: &[f64], p: [f64; 2]| {
+                let (mut r, mut j) = ([0.0], [0.0]);
+                s.jac_x(x, p, &mut r, &mut j)?;
+                Ok(j[0])
+            },
+            2.0,
+        );
+        let mut ext = ext;
+        let opts = ArcOptions {
+            ds: 0.05,
+            ds_max: 0.2,
+            max_points: 30,
+            p_max: 6.0,
+            forward: false,
+            ..Default::default()
+        };
+        let pts: Vec<_> = Arclength::new(&mut ext, &[1.0, 3.0], 2.0, None, opts)
+            .unwrap()
+            .collect();
+        assert!(pts.len() > 10);
+        for pt in &pts {
+            let (x, a, b) = (pt.x[0], pt.x[1], pt.p);
+            assert!((27.0 * b * b - 4.0 * a.powi(3)).abs() < 1e-8 * (1.0 + a.powi(3).abs()));
+            assert!((3.0 * x * x - a).abs() < 1e-8);
+        }
+        // It passes the cusp point (a, b) = (0, 0) onto the other fold (x changes sign).
+        assert!(pts.first().unwrap().x[0] > 0.0 && pts.last().unwrap().x[0] < 0.0);
+    }
+}
