@@ -55,7 +55,10 @@ class Branch:
     ``events`` has one row per located event (type, parameter value, the located
     solution's summary, the test function's value there). ``stop`` says why the branch
     ended (``"boundary"``, ``"max_points"``, ``"step_too_small"``,
-    ``"infinite_period"``, or ``"failed: ..."``).
+    ``"infinite_period"``, or ``"failed: ..."``). ``solutions`` holds the solution
+    objects (:class:`~ballbal.Equilibrium` / :class:`~ballbal.PeriodicSolution`, each
+    with its model at that parameter value) row for row, ``event_solutions`` one per
+    event row: what branch switching starts from.
     """
 
     kind: str
@@ -63,7 +66,8 @@ class Branch:
     table: pl.DataFrame
     events: pl.DataFrame
     stop: str
-    start: Any = None
+    solutions: tuple[Any, ...] = ()
+    event_solutions: tuple[Any, ...] = ()
     meta: dict[str, Any] = field(default_factory=dict)
 
 
