@@ -6,7 +6,8 @@ use super::waves::{accept, orbit_key};
 use super::{Family, Found, Origin, ScanSpec};
 use crate::continuation::Lattice;
 use crate::hb::{solve, Status};
-use crate::periodic::{finish, guess_from_state, initial_states};
+use crate::analysis::attractors::seed_guess;
+use crate::periodic::{finish, initial_states};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -84,7 +85,7 @@ pub(super) fn run_seeds<D: Family>(
             let model = &params[p];
             // This point's own states: "at rest in the ground frame" depends on its spin.
             let y0 = &initial_states(model)[starts[s]];
-            let g = guess_from_state(model, y0, None, n_harm, &spec.opts.guess)?;
+            let g = seed_guess(model, y0, n_harm, &spec.opts.guess)?;
             let rot: Vec<bool> = g.winding[model.layout().balls()]
                 .iter()
                 .map(|w| *w != 0.0)
