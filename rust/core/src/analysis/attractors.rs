@@ -482,6 +482,61 @@ mod tests {
     }
 
     #[test]
+    fn rest_watch_tells_integration_jitter_from_a_small_oscillation() {
+        // Jitter of the size seen at rtol 1e-5 (velocities ~4e-7, x within 1e-7) is rest
+        // once a whole window has passed; an oscillation of x with amplitude 1e-5 (above
+        // the 1e-6 that oscillation_period calls rest) and speed 1e-5 is not.
+        let d = 2;
+        let mut w = RestWatch::new(0.0);
+        let mut rest_at = None;
+        for i in 0..400 {
+            let t = 0.5 * i as f64;
+            let s = if i % 2 == 0 { 1.0 } else { -1.0 };
+            if w.at_rest(t, &[1e-7 * s, 0.3, 4e-7 * s, -4e-7 * s], d) {
+                rest_at.get_or_insert(t);
+            }
+        }
+        assert_eq!(rest_at, Some(RestWatch::WINDOW));
+        let mut w = RestWatch::new(0.0);
+        assert!((0..2000).all(|i| {
+            let t = 0.5 * i as f64;
+            !w.at_rest(t, &[1e-5 * t.sin(), 0.3, 1e-5 * t.cos(), 0.0], d)
+        }));
+    }
+
+    #[test]
+    fn seed_guesses_match_the_full_search_and_stop_at_rest() {
+        // At the scan's loose tolerances: the standard case's R-R start gives the very
+        // series of the full search, and a start beside the stable perfect balance is
+        // at rest (the full search calls it rest only after the whole window).
+        let g = GuessOptions {
+            settle: 1000.0,
+            window: 2000.0,
+            rtol: 1e-5,
+            atol: 1e-8,
+        };
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let y0 = &initial_states(&p)[0];
+        let a = guess_from_state(&p, y0, None, 3, &g).unwrap();
+        let b = seed_guess(&p, y0, 3, &g).unwrap();
+        assert_eq!(a.omega.to_bits(), b.omega.to_bits());
+        assert_eq!(a.coeffs, b.coeffs);
+        let q = Planar::new(0.2, 0.05, &[0.05], 50.0, 3.0, &[1.0, 1.0]).unwrap();
+        let pb = equilibria(&q)
+            .into_iter()
+            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+            .unwrap();
+        let mut y1 = vec![0.0; 8];
+        y1[..4].copy_from_slice(&pb.q);
+        y1[2] += 0.05;
+        y1[3] -= 0.05;
+        assert!(matches!(
+            classify_with(&q, &y1, None, 3, &g, true),
+            Attractor::Rest
+        ));
+    }
+
+    #[test]
     fn a_start_near_a_stable_perfect_balance_comes_to_rest() {
         // Supercritical, heavy balls: the perfect balance is stable (its eigenvalues
         // say so); a start next to it must settle there.
