@@ -4,51 +4,124 @@
   two-ball types, at the standard point (zeta = zeta_b = 0.05) and at zeta_b = 0.1;
 * the fine grid (101 x 111, step 0.01) for R-R.
 
-Each at N = 3 and N = 8. Targets (issue 4): thesis grid, all three types, under 1 s;
-fine grid R-R under 30 s; 1-to-2-thread speed-up at least 1.8.
+Each at N = 3 and N = 8 (the fine grid at N = 3 with ``--quick``). Targets (issue 17):
+thesis grid, all three types, at most 0.35 s on 1 thread and 0.2 s on 2; 1-to-2-thread
+speed-up at least 1.85.
 
-    python benchmarks/bench_scan.py            # everything (about 3 minutes)
-    python benchmarks/bench_scan.py --quick    # thesis grid only
+Per-stage costs (one thread, from ``_native.scan_stage_seconds``): perfect-balance
+checks, seed simulations with their solves, continuation waves (harmonic balance and
+Floquet of every continued solution), row building, and table building (columns and
+Python per chunk); Floquet's share is the difference to a run with ``floquet=False``,
+Hill's the extra of ``hill=True``.
+
+``--old PATH``: also run every row with an older build (a directory holding the
+``ballbal`` package, put first on ``PYTHONPATH`` in a subprocess), printed beside.
+
+    python benchmarks/bench_scan.py                       # everything (minutes)
+    python benchmarks/bench_scan.py --quick               # thesis grids, N = 3
+    python benchmarks/bench_scan.py --quick --old /work/ref/before_pkg
 """
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
 import sys
 import time
-
-import ballbal
 
 THESIS = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
 FINE = {"Omega": (1.0, 2.0, 0.01), "eta": (0.4, 1.5, 0.01)}
 ALL = ("R-R", "O-O", "R-O")
 
-
-def run(label: str, b: ballbal.Balancer, grid: dict, pats: tuple[str, ...], N: int) -> None:
-    times = {}
-    for threads in (1, 2):
+CHILD = r"""
+import json, sys, time
+import ballbal
+from ballbal import _native
+grid, pats, N, zb, repeat = json.loads(sys.argv[1])
+grid = {k: tuple(v) for k, v in grid.items()}
+b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=zb, delta=50.0)
+out = {}
+ballbal.scan(b, patterns=pats, N=N, threads=1, Omega=(1.0, 1.1, 0.1), eta=(1.0, 1.1, 0.1))
+for threads in (1, 2):
+    best = float("inf")
+    for _ in range(repeat):
         t = time.perf_counter()
         df = ballbal.scan(b, patterns=pats, N=N, threads=threads, **grid)
-        times[threads] = time.perf_counter() - t
-    pts = df.select(list(grid)).unique().height
-    sols = df.filter(df["status"] == "converged")
-    stable = int((sols["stability"] == "stable").sum())
-    print(f"{label:<24} {'/'.join(pats):<12} {N:>2} {pts:>6} {sols.height:>6} {stable:>6} "
-          f"{times[1]:>8.2f} {times[2]:>8.2f} {pts / times[2]:>9.0f} "
-          f"{times[1] / times[2]:>8.2f}")
+        best = min(best, time.perf_counter() - t)
+    out[threads] = best
+sols = df.filter(df["status"] == "converged")
+out["points"] = df.select(list(grid)).unique().height
+out["sols"] = sols.height
+out["stable"] = int((sols["stability"] == "stable").sum())
+stages = getattr(_native, "scan_stage_seconds", None)
+if stages is not None:
+    s0 = stages()
+    t = time.perf_counter()
+    ballbal.scan(b, patterns=pats, N=N, threads=1, **grid)
+    total = time.perf_counter() - t
+    s1 = stages()
+    out["stages"] = [y - x for x, y in zip(s0, s1)] + [total]
+    t = time.perf_counter()
+    ballbal.scan(b, patterns=pats, N=N, threads=1, floquet=False, **grid)
+    out["no_floquet"] = time.perf_counter() - t
+    t = time.perf_counter()
+    ballbal.scan(b, patterns=pats, N=N, threads=1, hill=True, **grid)
+    out["hill"] = time.perf_counter() - t
+print(json.dumps(out))
+"""
+
+
+def measure(grid: dict, pats: tuple[str, ...], N: int, zb: float, repeat: int,
+            path: str | None = None) -> dict:
+    env = dict(os.environ)
+    if path is not None:
+        env["PYTHONPATH"] = path + os.pathsep + env.get("PYTHONPATH", "")
+    r = subprocess.run([sys.executable, "-c", CHILD,
+                        json.dumps([grid, list(pats), N, zb, repeat])],
+                       capture_output=True, text=True, check=True, env=env)
+    return json.loads(r.stdout)
 
 
 def main() -> None:
     quick = "--quick" in sys.argv
-    std = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
-    zb1 = std.replace(zeta_b=0.1)
-    print(f"{'grid':<24} {'types':<12} {'N':>2} {'points':>6} {'sols':>6} {'stable':>6} "
-          f"{'1 thr s':>8} {'2 thr s':>8} {'pts/s(2)':>9} {'speed-up':>8}")
-    for N in (3, 8):
-        run("thesis, zeta_b 0.05", std, THESIS, ALL, N)
-        run("thesis, zeta_b 0.1", zb1, THESIS, ALL, N)
+    old = sys.argv[sys.argv.index("--old") + 1] if "--old" in sys.argv else None
+    rows = [("thesis, zeta_b 0.05", THESIS, ALL, 3, 0.05, 3),
+            ("thesis, zeta_b 0.1", THESIS, ALL, 3, 0.1, 3)]
     if not quick:
-        for N in (3, 8):
-            run("fine 101x111, zb 0.05", std, FINE, ("R-R",), N)
+        rows += [("thesis, zeta_b 0.05", THESIS, ALL, 8, 0.05, 3),
+                 ("thesis, zeta_b 0.1", THESIS, ALL, 8, 0.1, 3),
+                 ("fine 101x111, zb 0.05", FINE, ("R-R",), 3, 0.05, 1)]
+    print(f"{'grid':<24} {'types':<12} {'N':>2} {'points':>6} {'sols':>5} {'stable':>6} "
+          f"{'1 thr s':>8} {'2 thr s':>8} {'speed-up':>8}"
+          + (f" {'old 1 thr':>9} {'old 2 thr':>9} {'old s-up':>8} {'new/old 1':>9}"
+             if old else ""))
+    stage_lines = []
+    for label, grid, pats, N, zb, repeat in rows:
+        t0 = time.perf_counter()
+        new = measure(grid, pats, N, zb, repeat)
+        line = (f"{label:<24} {'/'.join(pats):<12} {N:>2} {new['points']:>6} "
+                f"{new['sols']:>5} {new['stable']:>6} {new['1']:>8.3f} {new['2']:>8.3f} "
+                f"{new['1'] / new['2']:>8.2f}")
+        if old:
+            o = measure(grid, pats, N, zb, repeat, old)
+            line += (f" {o['1']:>9.3f} {o['2']:>9.3f} {o['1'] / o['2']:>8.2f} "
+                     f"{new['1'] / o['1']:>9.2f}")
+            if (o["sols"], o["stable"]) != (new["sols"], new["stable"]):
+                line += f"  (old: {o['sols']} sols, {o['stable']} stable)"
+        print(line, flush=True)
+        if "stages" in new:
+            pb, seeds, waves, rows_, table, total = new["stages"]
+            stage_lines.append(
+                f"{label:<24} N {N}: total {total:.3f} s = balance {pb:.3f} + seeds "
+                f"{seeds:.3f} + continuation {waves:.3f} + rows {rows_:.3f} + table "
+                f"{table:.3f} + rest {total - pb - seeds - waves - rows_ - table:.3f}; "
+                f"Floquet ~{total - new['no_floquet']:.3f}, Hill would add "
+                f"{new['hill'] - total:.3f}")
+        del t0
+    if stage_lines:
+        print("\nper stage, one thread (seconds):")
+        print("\n".join(stage_lines))
 
 
 if __name__ == "__main__":

@@ -16,10 +16,17 @@ settings:
   the setting that lets 10^6 points run in minutes. A row's size on disk and in memory
   hardly depends on the setting; the time does.
 
+* ``floquet`` (the scan's defaults, N = 3, Floquet on; zeta_b 0.05): the issue-17 case,
+  a 10^6-point R-R scan with multipliers, streamed; target under 5 minutes on 2
+  cores and under 1 GiB. Only with ``--full`` at 10^6 (it occupies the machine for
+  minutes); without it, 10^4 and 10^5 points and the 10^6 time extrapolated from 10^5.
+
 The target is under 1 GiB at 10^6 points.
 
-    python benchmarks/bench_scan_memory.py            # 10^4, 10^5, 10^6
+    python benchmarks/bench_scan_memory.py            # 10^4, 10^5 (cheap also 10^6)
     python benchmarks/bench_scan_memory.py --quick    # 10^4, 10^5
+    python benchmarks/bench_scan_memory.py --floquet  # only the floquet setting, to 10^5
+    python benchmarks/bench_scan_memory.py --floquet --full   # ... and the 10^6 run
 """
 
 from __future__ import annotations
@@ -36,14 +43,18 @@ side, mode, setting, out = int(sys.argv[1]), sys.argv[2], sys.argv[3], sys.argv[
 grid = dict(Omega=np.linspace(1.0, 2.0, side), eta=np.linspace(0.4, 1.5, side))
 seeds = 2 if setting == "solved" else 1
 kw = dict(patterns=["R-R"], floquet=False, seeds=seeds, starts=seeds, threads=2, **grid)
+model = ballbal.Balancer(zeta_b=0.1)
+if setting == "floquet":
+    kw = dict(patterns=["R-R"], N=3, threads=2, **grid)
+    model = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 t = time.perf_counter()
 if mode == "streamed":
-    lf = ballbal.scan(ballbal.Balancer(zeta_b=0.1), out=out, lazy=True, **kw)
+    lf = ballbal.scan(model, out=out, lazy=True, **kw)
     n = lf.select(pl.len()).collect().item()
     found = lf.filter(pl.col("status") == "converged").select(pl.len()).collect().item()
 else:
-    df = ballbal.scan(ballbal.Balancer(zeta_b=0.1), **kw)
+    df = ballbal.scan(model, **kw)
     n, found = df.height, df.filter(pl.col("status") == "converged").height
 dt = time.perf_counter() - t
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
@@ -62,6 +73,9 @@ def run(side: int, mode: str, setting: str) -> dict:
 
 def main() -> None:
     quick = "--quick" in sys.argv
+    if "--floquet" in sys.argv:
+        floquet("--full" in sys.argv)
+        return
     print(f"{'setting':<8} {'mode':<10} {'points':>9} {'rows':>9} {'found':>9} "
           f"{'seconds':>8} {'peak MiB':>9} {'after import':>12}")
     runs = [("solved", 100, "streamed"), ("solved", 100, "memory"),
@@ -74,6 +88,22 @@ def main() -> None:
         print(f"{setting:<8} {mode:<10} {r['points']:>9} {r['rows']:>9} {r['found']:>9} "
               f"{r['seconds']:>8.1f} {r['peak_mib']:>9.0f} {r['import_mib']:>12.0f}",
               flush=True)
+
+
+def floquet(full: bool) -> None:
+    print(f"{'points':>9} {'rows':>9} {'found':>9} {'seconds':>8} {'us/point':>9} "
+          f"{'peak MiB':>9} {'after import':>12}")
+    sides = [100, 316] + ([1000] if full else [])
+    last = None
+    for side in sides:
+        r = run(side, "streamed", "floquet")
+        last = r
+        print(f"{r['points']:>9} {r['rows']:>9} {r['found']:>9} {r['seconds']:>8.1f} "
+              f"{1e6 * r['seconds'] / r['points']:>9.0f} {r['peak_mib']:>9.0f} "
+              f"{r['import_mib']:>12.0f}", flush=True)
+    if not full and last is not None:
+        print(f"10^6 points at the 10^5 rate: about "
+              f"{1e6 * last['seconds'] / last['points'] / 60:.1f} minutes")
 
 
 if __name__ == "__main__":

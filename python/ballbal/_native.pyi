@@ -18,7 +18,8 @@ from .scene import Scene
 
 __all__ = [
     "simulate", "validate", "equilibria", "balanced_states", "periodic", "orbit_closure",
-    "balance_map", "scan", "default_chunk", "certificate_seconds", "validate_bearing",
+    "balance_map", "scan", "default_chunk", "certificate_seconds", "scan_stage_seconds",
+    "validate_bearing",
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
@@ -70,6 +71,7 @@ def scan(
 ) -> None: ...
 def default_chunk(lens: list[int]) -> int: ...
 def certificate_seconds() -> float: ...
+def scan_stage_seconds() -> list[float]: ...
 
 # rust/py/src/rotor.rs: a rigid rotor on one journal bearing (ballbal._rotor)
 def validate_rotor(rotor: RotorOnBearing) -> None: ...

@@ -395,8 +395,26 @@ fn run_scan<D: Family>(
                 let _ = tx.send((c, rows));
             })
         },
-        |(c, rows)| scan_columns(py, cols, &rows).and_then(|d| on_chunk.call1((c, d)).map(|_| ())),
+        |(c, rows)| {
+            let t = std::time::Instant::now();
+            let r = scan_columns(py, cols, &rows).and_then(|d| on_chunk.call1((c, d)).map(|_| ()));
+            TABLE_NS.fetch_add(t.elapsed().as_nanos() as u64, std::sync::atomic::Ordering::Relaxed);
+            r
+        },
     )
+}
+
+static TABLE_NS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Seconds this process's scans spent per stage: perfect-balance checks, seeds,
+/// continuation and rows in the core (summed over blocks, see the core's
+/// `stage_seconds`), then the columns and the Python callback per chunk (table
+/// building, on the calling thread). A benchmark's measure.
+#[pyfunction]
+pub fn scan_stage_seconds() -> Vec<f64> {
+    let mut v = ballbal_core::scan::stage_seconds().to_vec();
+    v.push(TABLE_NS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9);
+    v
 }
 
 /// Seconds this process has spent in certificate checks (all threads; a benchmark's

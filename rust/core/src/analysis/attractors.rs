@@ -159,6 +159,63 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     classify_as(model, y0, rotating, n_harm, g).into_series()
 }
 
+/// [`guess_from_state`] without a pattern filter, as a scan's seeds use it: the same
+/// attractors, reached for less. A motion that has come to rest to within the
+/// integration's noise (see [`RestWatch`]) stops there instead of running through the
+/// whole settling time and observation window. Periodic guesses are those of
+/// [`guess_from_state`], bit for bit; starts that end at rest give no guess either way.
+pub fn seed_guess<D: Dynamics + ?Sized>(
+    model: &D,
+    y0: &[f64],
+    n_harm: usize,
+    g: &GuessOptions,
+) -> Option<HbSolution> {
+    classify_with(model, y0, None, n_harm, g, true).into_series()
+}
+
+/// Watches a simulation for rest at loose tolerances, where the explicit integrator's
+/// error control keeps the velocities jittering at a few 1e-7 around an equilibrium
+/// (the 1e-7 test of [`classify`] never fires, and the start is only recognised as at
+/// rest after settling and a whole observation window). At rest: over a window of
+/// `WINDOW` time units, every velocity stayed below `MAX_SPEED` (no ball can make the
+/// 1.5 turns of a rotation) and `x` stayed in a band narrower than the 1e-6 amplitude
+/// below which [`oscillation_period`] calls a motion rest.
+struct RestWatch {
+    start: f64,
+    speed: f64,
+    x_lo: f64,
+    x_hi: f64,
+}
+
+impl RestWatch {
+    const WINDOW: f64 = 100.0;
+    const MAX_SPEED: f64 = 1e-4;
+    const X_BAND: f64 = 1e-6;
+
+    fn new(t: f64) -> Self {
+        RestWatch {
+            start: t,
+            speed: 0.0,
+            x_lo: f64::INFINITY,
+            x_hi: f64::NEG_INFINITY,
+        }
+    }
+
+    /// Takes the state `y` (positions, then `d` velocities) at the end of a step at `t`;
+    /// true once a whole window was at rest.
+    fn at_rest(&mut self, t: f64, y: &[f64], d: usize) -> bool {
+        self.speed = y[d..].iter().fold(self.speed, |a, v| a.max(v.abs()));
+        self.x_lo = self.x_lo.min(y[0]);
+        self.x_hi = self.x_hi.max(y[0]);
+        if t - self.start < Self::WINDOW {
+            return false;
+        }
+        let rest = self.speed < Self::MAX_SPEED && self.x_hi - self.x_lo < Self::X_BAND;
+        *self = RestWatch::new(t);
+        rest
+    }
+}
+
 /// [`classify`], stopping early (as `OtherPattern`) when `want` is given and the
 /// rotation pattern differs.
 fn classify_as<D: Dynamics + ?Sized>(
@@ -167,6 +224,18 @@ fn classify_as<D: Dynamics + ?Sized>(
     want: Option<&[bool]>,
     n_harm: usize,
     g: &GuessOptions,
+) -> Attractor {
+    classify_with(model, y0, want, n_harm, g, false)
+}
+
+/// [`classify_as`]; `quick`: as for [`seed_guess`].
+fn classify_with<D: Dynamics + ?Sized>(
+    model: &D,
+    y0: &[f64],
+    want: Option<&[bool]>,
+    n_harm: usize,
+    g: &GuessOptions,
+    quick: bool,
 ) -> Attractor {
     use Attractor::{Failed, NotSettled, Rest};
     let d = model.ndof();
@@ -179,8 +248,10 @@ fn classify_as<D: Dynamics + ?Sized>(
     // periodic motion cannot appear from rest in an autonomous system): stop there
     // rather than settle for the whole time.
     let mut at_rest = false;
+    let mut watch = RestWatch::new(0.0);
     let Ok((_, ys, _)) = solver.integrate(rhs, 0.0, y0, g.settle, &opts, |_, tb, dense| {
-        at_rest = tb > 50.0 && dense.end()[d..].iter().all(|v| v.abs() < 1e-7);
+        at_rest = tb > 50.0 && dense.end()[d..].iter().all(|v| v.abs() < 1e-7)
+            || quick && watch.at_rest(tb, dense.end(), d);
         !at_rest
     }) else {
         return Failed;
@@ -198,6 +269,8 @@ fn classify_as<D: Dynamics + ?Sized>(
     let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
     let mut tmp = vec![0.0; 2 * d];
     let need = 6;
+    let mut watch = RestWatch::new(g.settle);
+    let mut rested = false;
     let mut solver = Dopri5::new(2 * d);
     let res = solver.integrate(
         |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
@@ -227,12 +300,16 @@ fn classify_as<D: Dynamics + ?Sized>(
                 t += dt;
             }
             end_b.copy_from_slice(&y_prev[o..d]);
+            rested = quick && watch.at_rest(tb, dense.end(), d);
             // Enough turns of some ball to measure a period: a rotating motion.
-            crossings.iter().all(|c| c.len() < need)
+            !rested && crossings.iter().all(|c| c.len() < need)
         },
     );
     if res.is_err() {
         return Failed;
+    }
+    if rested {
+        return Rest;
     }
     let span = t_prev - g.settle;
     if span <= 0.0 {
@@ -265,6 +342,9 @@ fn classify_as<D: Dynamics + ?Sized>(
     let times: Vec<f64> = (0..=s).map(|i| t0 + period * i as f64 / s as f64).collect();
     let mut all_t = vec![g.settle];
     all_t.extend(times.iter().copied());
+    // From t = 0 even when quick: re-simulating from the observation's start instead
+    // perturbs the guess at the integration tolerance, enough to send the harmonic
+    // balance to another of the coexisting O-O orbits on the thesis maps.
     let Ok((traj, _)) = solve_at(
         |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
         0.0,
@@ -399,6 +479,61 @@ mod tests {
         assert!(
             matches!(filtered, Attractor::OtherPattern { ref rotating } if rotating == &[true, true])
         );
+    }
+
+    #[test]
+    fn rest_watch_tells_integration_jitter_from_a_small_oscillation() {
+        // Jitter of the size seen at rtol 1e-5 (velocities ~4e-7, x within 1e-7) is rest
+        // once a whole window has passed; an oscillation of x with amplitude 1e-5 (above
+        // the 1e-6 that oscillation_period calls rest) and speed 1e-5 is not.
+        let d = 2;
+        let mut w = RestWatch::new(0.0);
+        let mut rest_at = None;
+        for i in 0..400 {
+            let t = 0.5 * i as f64;
+            let s = if i % 2 == 0 { 1.0 } else { -1.0 };
+            if w.at_rest(t, &[1e-7 * s, 0.3, 4e-7 * s, -4e-7 * s], d) {
+                rest_at.get_or_insert(t);
+            }
+        }
+        assert_eq!(rest_at, Some(RestWatch::WINDOW));
+        let mut w = RestWatch::new(0.0);
+        assert!((0..2000).all(|i| {
+            let t = 0.5 * i as f64;
+            !w.at_rest(t, &[1e-5 * t.sin(), 0.3, 1e-5 * t.cos(), 0.0], d)
+        }));
+    }
+
+    #[test]
+    fn seed_guesses_match_the_full_search_and_stop_at_rest() {
+        // At the scan's loose tolerances: the standard case's R-R start gives the very
+        // series of the full search, and a start beside the stable perfect balance is
+        // at rest (the full search calls it rest only after the whole window).
+        let g = GuessOptions {
+            settle: 1000.0,
+            window: 2000.0,
+            rtol: 1e-5,
+            atol: 1e-8,
+        };
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let y0 = &initial_states(&p)[0];
+        let a = guess_from_state(&p, y0, None, 3, &g).unwrap();
+        let b = seed_guess(&p, y0, 3, &g).unwrap();
+        assert_eq!(a.omega.to_bits(), b.omega.to_bits());
+        assert_eq!(a.coeffs, b.coeffs);
+        let q = Planar::new(0.2, 0.05, &[0.05], 50.0, 3.0, &[1.0, 1.0]).unwrap();
+        let pb = equilibria(&q)
+            .into_iter()
+            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+            .unwrap();
+        let mut y1 = vec![0.0; 8];
+        y1[..4].copy_from_slice(&pb.q);
+        y1[2] += 0.05;
+        y1[3] -= 0.05;
+        assert!(matches!(
+            classify_with(&q, &y1, None, 3, &g, true),
+            Attractor::Rest
+        ));
     }
 
     #[test]

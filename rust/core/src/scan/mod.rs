@@ -46,6 +46,20 @@ use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// Seconds spent per stage of the scans this process ran, summed over blocks (on one
+/// thread: the stages' cost; on more, block stages that overlap are counted each):
+/// `[perfect-balance checks, seed simulations and their solves, continuation waves,
+/// row building]`. A benchmark's measure; nothing reads it back.
+pub fn stage_seconds() -> [f64; 4] {
+    std::array::from_fn(|i| STAGE_NS[i].load(Ordering::Relaxed) as f64 * 1e-9)
+}
+
+static STAGE_NS: [std::sync::atomic::AtomicU64; 4] = [const { std::sync::atomic::AtomicU64::new(0) }; 4];
+
+fn add_stage(i: usize, since: std::time::Instant) {
+    STAGE_NS[i].fetch_add(since.elapsed().as_nanos() as u64, Ordering::Relaxed);
+}
+
 /// Runs the chunks `which` (indices into `spec.chunks()`) and hands each finished
 /// chunk's rows to `on_chunk` (from a worker thread, in completion order). Stops early,
 /// with `Error::Cancelled`, once `cancel` is set; chunks already handed over are kept.
@@ -127,6 +141,7 @@ fn scan_chunk<D: Family>(
             Ok(q)
         })
         .collect::<Result<_>>()?;
+    let t = std::time::Instant::now();
     let pb: Vec<(bool, bool)> = params
         .par_iter()
         .map(|p| {
@@ -141,27 +156,27 @@ fn scan_chunk<D: Family>(
             Ok(())
         }
     };
+    add_stage(0, t);
     check()?;
 
+    let t = std::time::Instant::now();
     let (tasks, starts) = seeding::seed_tasks(spec, &geo, &range, &pb);
-    let seeded = seeding::run_seeds(spec, &params, &tasks, &starts, cancel);
+    let (mut sols, frontier) = seeding::run_seeds(spec, &params, &tasks, &starts, cancel);
+    add_stage(1, t);
     check()?;
-    let mut sols: Vec<Vec<Found>> = vec![vec![]; npts];
-    let mut frontier: Vec<(usize, usize)> = vec![];
-    for (p, f) in seeded.into_iter().flatten() {
-        if waves::admit(&sols[p], f.pattern, &f.key) {
-            sols[p].push(f);
-            frontier.push((p, sols[p].len() - 1));
-        }
-    }
 
     let mut tally = Tally::new(npts, np);
     let block = waves::BlockWaves {
         spec,
         params: &params,
     };
+    let t = std::time::Instant::now();
     continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
-    Ok(rows::rows(&geo, np, &sols, &tally, &tasks, &pb))
+    add_stage(2, t);
+    let t = std::time::Instant::now();
+    let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &pb);
+    add_stage(3, t);
+    Ok(rows)
 }
 
 /// Floquet tolerances suited to many points (see the periodic benchmark).

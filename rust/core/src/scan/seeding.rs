@@ -2,11 +2,12 @@
 //! rotation pattern read off the simulation and the harmonic balance solved from it.
 
 use super::grid::Local;
-use super::waves::{accept, orbit_key};
+use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
 use super::{Family, Found, Origin, ScanSpec};
 use crate::continuation::Lattice;
-use crate::hb::{solve, Status};
-use crate::periodic::{finish, guess_from_state, initial_states};
+use crate::hb::{solve, HbSolution, Status};
+use crate::analysis::attractors::seed_guess;
+use crate::periodic::{finish, initial_states};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -64,17 +65,28 @@ pub(super) fn seed_tasks<D: Family>(
     (tasks, starts)
 }
 
+/// A seed's solved series before its Floquet analysis: (point, type, series, key,
+/// seconds so far).
+type Candidate = (usize, usize, HbSolution, Vec<f64>, f64);
+
 /// Runs the seed tasks in parallel: each simulated start that settles on a periodic
 /// motion of a requested type, solved, resolved and certified, is a found solution.
+/// Returns the solutions kept per point (in task order, duplicates of an orbit already
+/// kept there dropped) and their `(point, solution)` indices.
+///
+/// Several starts often settle on the same orbit; only the first of them in task order
+/// needs `finish` (its Floquet analysis), which therefore runs after the duplicate test
+/// rather than for every start. A first that fails there leaves its place to the next
+/// duplicate, exactly as when every start was finished before the test.
 pub(super) fn run_seeds<D: Family>(
     spec: &ScanSpec<'_, D>,
     params: &[D],
     tasks: &[(usize, usize)],
     starts: &[usize],
     cancel: &AtomicBool,
-) -> Vec<Option<(usize, Found)>> {
+) -> (Vec<Vec<Found>>, Vec<(usize, usize)>) {
     let n_harm = spec.opts.hb.n_harm;
-    tasks
+    let cands: Vec<Candidate> = tasks
         .par_iter()
         .map(|&(p, s)| {
             if cancel.load(Ordering::Relaxed) {
@@ -84,7 +96,7 @@ pub(super) fn run_seeds<D: Family>(
             let model = &params[p];
             // This point's own states: "at rest in the ground frame" depends on its spin.
             let y0 = &initial_states(model)[starts[s]];
-            let g = guess_from_state(model, y0, None, n_harm, &spec.opts.guess)?;
+            let g = seed_guess(model, y0, n_harm, &spec.opts.guess)?;
             let rot: Vec<bool> = g.winding[model.layout().balls()]
                 .iter()
                 .map(|w| *w != 0.0)
@@ -95,23 +107,80 @@ pub(super) fn run_seeds<D: Family>(
                 return None;
             }
             let key = orbit_key(&sol, model.layout().support());
-            let res = finish(model, sol, &spec.opts);
-            if res.sol.status != Status::Converged {
-                return None;
+            Some((p, k, sol, key, t.elapsed().as_secs_f64()))
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .flatten()
+        .collect();
+    // finished[i]: None = not analysed yet, Some(None) = refused by `finish`.
+    let mut finished: Vec<Option<Option<Found>>> = (0..cands.len()).map(|_| None).collect();
+    loop {
+        // Admission in task order, counting the orbits not analysed yet as kept.
+        let mut kept: Vec<Vec<(usize, &[f64])>> = vec![vec![]; params.len()];
+        let mut todo = vec![];
+        for (i, (p, k, _, key, _)) in cands.iter().enumerate() {
+            if !new_orbit(&kept[*p], *k, key) {
+                continue;
             }
-            Some((
-                p,
-                Found {
-                    pattern: k,
+            match &finished[i] {
+                Some(None) => {}
+                Some(Some(_)) => kept[*p].push((*k, key)),
+                None => {
+                    todo.push(i);
+                    kept[*p].push((*k, key));
+                }
+            }
+        }
+        if todo.is_empty() {
+            break;
+        }
+        let done: Vec<Option<Found>> = todo
+            .par_iter()
+            .map(|&i| {
+                let (p, k, sol, key, secs) = &cands[i];
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let t = Instant::now();
+                let res = finish(&params[*p], sol.clone(), &spec.opts);
+                (res.sol.status == Status::Converged).then(|| Found {
+                    pattern: *k,
                     res,
                     origin: Origin::Seed,
                     parent: None,
-                    key,
-                    seconds: t.elapsed().as_secs_f64(),
-                },
-            ))
-        })
-        .collect()
+                    key: key.clone(),
+                    seconds: secs + t.elapsed().as_secs_f64(),
+                })
+            })
+            .collect();
+        for (i, f) in todo.into_iter().zip(done) {
+            finished[i] = Some(f);
+        }
+    }
+    let mut sols: Vec<Vec<Found>> = vec![vec![]; params.len()];
+    let mut frontier = vec![];
+    for (i, (p, k, _, key, _)) in cands.iter().enumerate() {
+        if admit(&sols[*p], *k, key) {
+            if let Some(Some(f)) = finished[i].take() {
+                sols[*p].push(f);
+                frontier.push((*p, sols[*p].len() - 1));
+            }
+        }
+    }
+    (sols, frontier)
+}
+
+/// [`admit`] on (type, key) pairs.
+fn new_orbit(have: &[(usize, &[f64])], pattern: usize, key: &[f64]) -> bool {
+    let mut n = 0;
+    for (_, h) in have.iter().filter(|(k, _)| *k == pattern) {
+        if same_orbit(h, key) {
+            return false;
+        }
+        n += 1;
+    }
+    n < MAX_PER_TYPE
 }
 
 /// Seed positions along one parameter of length `len`: spacing `ceil(len / seeds)`,

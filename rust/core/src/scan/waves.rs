@@ -10,7 +10,7 @@ use std::time::Instant;
 
 /// Most solutions of one type kept at one point: a guard against a duplicate test
 /// that a pathological orbit family might slip through.
-const MAX_PER_TYPE: usize = 4;
+pub(super) const MAX_PER_TYPE: usize = 4;
 
 /// A block's models and options, as the continuation sees them.
 pub(super) struct BlockWaves<'s, 'a, D: Family> {
