@@ -1083,4 +1083,64 @@ mod tests {
             assert!((a - b).abs() < 1e-13);
         }
     }
+
+    /// Warm-started solves at N = 3, 6, 8, 12 for callgrind (`--ignored --exact
+    /// numerics::hb::tests::hb_profile`): per N, a `hb_profile_nN` frame.
+    #[test]
+    #[ignore]
+    fn hb_profile() {
+        use crate::periodic::{periodic, PeriodicOptions};
+        let p = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let near = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.19, &[1.0, 1.0]).unwrap();
+        let seed = periodic(&near, &[true, true], None, &PeriodicOptions::default()).sol;
+        let opts = |n_harm| PeriodicOptions {
+            hb: HbOptions {
+                n_harm,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let seed12 = periodic(&near, &[true, true], Some(&seed), &opts(12)).sol;
+        let mut acc = 0.0;
+        for _ in 0..20 {
+            acc += hb_profile_n3(&p, &seed12, &opts(3));
+            acc += hb_profile_n6(&p, &seed12, &opts(6));
+            acc += hb_profile_n8(&p, &seed12, &opts(8));
+            acc += hb_profile_n12(&p, &seed12, &opts(12));
+        }
+        println!("{acc}");
+    }
+
+    #[inline(never)]
+    fn hb_profile_n3(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+    }
+    #[inline(never)]
+    fn hb_profile_n6(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+    }
+    #[inline(never)]
+    fn hb_profile_n8(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+    }
+    #[inline(never)]
+    fn hb_profile_n12(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+    }
 }
