@@ -61,9 +61,10 @@ def accuracy_cost(
     harmonics, default samples, Newton tol 1e-10, RK45 rtol 1e-9): ``N``; ``samples``
     per period as a multiple of N (at ``base_N``); the Newton ``tol``; the RK45 ``rtol``
     of the monodromy (atol = rtol / 100); ``magnus_rtol``, the multiplier accuracy asked
-    of the Magnus monodromy (``Floquet(method="magnus")``), the curve beside RK45's. Every setting is solved from the same warm
-    start, the solution at ``Omega - neighbour`` (what a scan does), ``repeats`` times;
-    ``seconds`` is the median wall time of harmonic balance plus Floquet.
+    of the Magnus monodromy (``Floquet(method="magnus")``), the curve beside RK45's.
+    Every setting is solved from the same warm start, the solution at
+    ``Omega - neighbour`` (what a scan does), ``repeats`` times; ``seconds`` is the
+    median wall time of harmonic balance plus Floquet.
 
     Errors are against a reference with ``reference_N`` harmonics and tight tolerances
     (rtol 1e-11), whose own orbit closure after one period of time simulation is in the

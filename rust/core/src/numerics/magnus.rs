@@ -137,8 +137,8 @@ pub fn expm(a: &[f64], out: &mut [f64], w: &mut ExpmWork) {
     // p(X) = B0 + X4 (B1 + X4 (B2 + c12 X4)), B_j = sum_{i<4} c_{4j+i} X^i.
     let block = |j: usize, w: &ExpmWork, dst: &mut [f64]| {
         let c = &INV_FACT[4 * j..4 * j + 4];
-        for idx in 0..n * n {
-            dst[idx] = c[1] * w.x[idx] + c[2] * w.x2[idx] + c[3] * w.x3[idx];
+        for (idx, o) in dst.iter_mut().enumerate().take(n * n) {
+            *o = c[1] * w.x[idx] + c[2] * w.x2[idx] + c[3] * w.x3[idx];
         }
         for i in 0..n {
             dst[i * n + i] += c[0];
@@ -215,6 +215,7 @@ impl MagnusWork {
         let r15 = 15f64.sqrt();
         // alpha_1 = h A2, alpha_2 = sqrt(15) h / 3 (A3 - A1),
         // alpha_3 = 10 h / 3 (A3 - 2 A2 + A1).
+        #[allow(clippy::needless_range_loop)]
         for i in 0..n * n {
             let (x1, x2, x3) = (at[0][i], at[1][i], at[2][i]);
             self.a1[i] = h * x2;
