@@ -47,7 +47,7 @@ def accuracy_cost(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     # The reference orbit closes after one period of an independent time simulation.
     closure = float(re.search(r"reference closure by simulation (\S+)", stdout).group(1))
     assert np.isclose(closure, df["reference_closure"][0], rtol=0.01) and closure < 1e-6
-    assert set(df["knob"]) == {"N", "samples", "tol", "rtol"}
+    assert set(df["knob"]) == {"N", "samples", "tol", "rtol", "magnus"}
     assert df["verdict_ok"].all()
     # Harmonic balance converges in N: 4 harmonics are far closer than 2.
     n = df.filter(pl.col("knob") == "N").sort("value")["omega_error"].to_list()

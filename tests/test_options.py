@@ -102,7 +102,8 @@ def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
 def test_scan_with_options_equals_scan_with_keywords(tmp_path):
     grid = {"Omega": [1.2, 1.25], "eta": [1.0]}
     flat = ballbal.scan(B, threads=1, seeds=2, starts=2, max_steps=10_000, **grid)
-    opts = ScanOptions(floquet=Floquet(rtol=1e-6, atol=1e-9, max_steps=10_000, hill=False),
+    opts = ScanOptions(floquet=Floquet(rtol=1e-6, atol=1e-9, max_steps=10_000, hill=False,
+                                       method="magnus"),
                        guess=GuessSearch(settle=1000.0, window=2000.0, rtol=1e-5,
                                          atol=1e-5 * 1e-3, seeds=2, starts=2))
     new = ballbal.scan(B, options=opts, execution=Execution(threads=1, out=tmp_path / "s"),

@@ -47,6 +47,7 @@ def accuracy_cost(
     samples: Sequence[int] = (4, 6, 8, 16, 32),
     tol: Sequence[float] = (1e-3, 1e-5, 1e-7, 1e-9, 1e-11),
     rtol: Sequence[float] = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+    magnus_rtol: Sequence[float] = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
     base_N: int = 12,
     reference_N: int = 32,
     neighbour: float = 0.01,
@@ -59,9 +60,11 @@ def accuracy_cost(
     Knobs, each varied with the others at a high-accuracy baseline (``base_N``
     harmonics, default samples, Newton tol 1e-10, RK45 rtol 1e-9): ``N``; ``samples``
     per period as a multiple of N (at ``base_N``); the Newton ``tol``; the RK45 ``rtol``
-    of the monodromy (atol = rtol / 100). Every setting is solved from the same warm
-    start, the solution at ``Omega - neighbour`` (what a scan does), ``repeats`` times;
-    ``seconds`` is the median wall time of harmonic balance plus Floquet.
+    of the monodromy (atol = rtol / 100); ``magnus_rtol``, the multiplier accuracy asked
+    of the Magnus monodromy (``Floquet(method="magnus")``), the curve beside RK45's.
+    Every setting is solved from the same warm start, the solution at
+    ``Omega - neighbour`` (what a scan does), ``repeats`` times; ``seconds`` is the
+    median wall time of harmonic balance plus Floquet.
 
     Errors are against a reference with ``reference_N`` harmonics and tight tolerances
     (rtol 1e-11), whose own orbit closure after one period of time simulation is in the
@@ -81,6 +84,8 @@ def accuracy_cost(
                  for m in _check.sequence("samples", samples, empty=True)]
     tol = [_check.real("tol", t) for t in _check.sequence("tol", tol, empty=True)]
     rtol = [_check.real("rtol", r) for r in _check.sequence("rtol", rtol, empty=True)]
+    magnus_rtol = [_check.real("magnus_rtol", r)
+                   for r in _check.sequence("magnus_rtol", magnus_rtol, empty=True)]
     base_N = _check.integer("base_N", base_N, 1, 256)
     reference_N = _check.integer("reference_N", reference_N, 1, 256)
     neighbour = _check.real("neighbour", neighbour, finite=True)
@@ -115,6 +120,9 @@ def accuracy_cost(
         settings.append(("tol", t, {**base, "tol": t, "step_tol": max(t * 100, 1e-8)}))
     for r in rtol:
         settings.append(("rtol", r, {**base, "rtol": r, "atol": r / 100}))
+    for r in magnus_rtol:
+        settings.append(("magnus", r, {**base, "rtol": r, "atol": r / 100,
+                                       "floquet_method": "magnus"}))
 
     rows = []
     for knob, value, kw in settings:
@@ -157,10 +165,12 @@ def plot_accuracy_cost(df: pl.DataFrame, *, error: str = "multiplier_error", ax:
     if ax is None:
         _, ax = plt.subplots(figsize=(6.5, 4.5))
     ok = df.filter(pl.col(error).is_not_null() & (pl.col(error) > 0))
-    for knob, mark in (("N", "o-"), ("samples", "s-"), ("tol", "^-"), ("rtol", "v-")):
+    for knob, mark in (("N", "o-"), ("samples", "s-"), ("tol", "^-"), ("rtol", "v-"),
+                       ("magnus", "D-")):
         part = ok.filter(pl.col("knob") == knob).sort("value")
         if part.height:
-            ax.loglog(part["seconds"] * 1e3, part[error], mark, ms=4, label=knob)
+            label = {"rtol": "rtol (RK45)", "magnus": "rtol (Magnus)"}.get(knob, knob)
+            ax.loglog(part["seconds"] * 1e3, part[error], mark, ms=4, label=label)
             if knob == "N":
                 for n, sx, e in part.select("N", "seconds", error).iter_rows():
                     ax.annotate(f"N={n}", (sx * 1e3, e), fontsize=6, xytext=(3, 3),

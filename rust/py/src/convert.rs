@@ -4,7 +4,7 @@
 
 use crate::bearing::BearingArgs;
 use crate::errors::CoreResult;
-use ballbal_core::floquet::FloquetOptions;
+use ballbal_core::floquet::{FloquetMethod, FloquetOptions};
 use ballbal_core::hb::HbOptions;
 use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
@@ -230,6 +230,7 @@ pub struct HarmonicBalanceArgs {
 /// `ballbal.options.Floquet`.
 #[derive(FromPyObject)]
 pub struct FloquetArgs {
+    method: String,
     rtol: f64,
     atol: f64,
     margin: f64,
@@ -268,6 +269,7 @@ impl PeriodicArgs {
         let f = &self.floquet;
         let g = &self.guess;
         let fo = FloquetOptions {
+            method: FloquetMethod::parse(&f.method).py()?,
             rtol: f.rtol,
             atol: f.atol,
             margin: f.margin,

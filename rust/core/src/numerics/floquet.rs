@@ -32,8 +32,42 @@ impl Stability {
     }
 }
 
+/// How the monodromy matrix is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FloquetMethod {
+    /// Adaptive Dormand–Prince RK45 of the `2d x 2d` variational equations.
+    Rk45,
+    /// Sixth-order Magnus steps on a fixed grid ([`crate::numerics::magnus`]), the grid
+    /// doubled until two successive monodromies' multipliers agree to `rtol`.
+    Magnus,
+}
+
+impl FloquetMethod {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            FloquetMethod::Rk45 => "rk45",
+            FloquetMethod::Magnus => "magnus",
+        }
+    }
+
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "rk45" => Ok(FloquetMethod::Rk45),
+            "magnus" => Ok(FloquetMethod::Magnus),
+            _ => Err(crate::Error::param_range(
+                "method",
+                format!("must be 'rk45' or 'magnus', got {name:?}"),
+                "'rk45' or 'magnus'",
+            )),
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct FloquetOptions {
+    pub method: FloquetMethod,
+    /// RK45: the integration tolerances. Magnus: `rtol` is the multipliers' accuracy
+    /// asked for (relative to the larger of 1 and their modulus); `atol` is unused.
     pub rtol: f64,
     pub atol: f64,
     /// Least margin around modulus 1 for a definite verdict; the trivial multiplier's
@@ -65,6 +99,7 @@ pub const MAX_TRIVIAL: f64 = 0.1;
 impl Default for FloquetOptions {
     fn default() -> Self {
         FloquetOptions {
+            method: FloquetMethod::Rk45,
             rtol: 1e-8,
             atol: 1e-10,
             margin: 1e-6,
@@ -112,6 +147,9 @@ pub struct Floquet {
     pub stability: Stability,
     pub steps: usize,
     pub rhs_evals: usize,
+    /// Magnus: the estimated error of the multipliers (relative to the larger of 1 and
+    /// their modulus), which widens the verdict's margin like the trivial error does.
+    pub method_error: Option<f64>,
 }
 
 /// The verdict on a set of multipliers (largest modulus first).
@@ -210,19 +248,174 @@ pub fn monodromy<D: Dynamics + ?Sized>(
     Ok((phi, stats.accepted, stats.rhs_evals))
 }
 
+/// `A(t)` of the linearisation along the series, as a closure filling a row-major
+/// `2d x 2d` matrix.
+fn orbit_state_matrix<'a, D: Dynamics + ?Sized>(
+    model: &'a D,
+    sol: &'a HbSolution,
+) -> impl FnMut(f64, &mut [f64]) + 'a {
+    let d = model.ndof();
+    let om = sol.omega;
+    let (mut q, mut v, mut a) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    let mut cols = vec![0.0; 2 * d * d];
+    move |t: f64, out: &mut [f64]| {
+        sol.eval_rates(om * t, &mut q, &mut v, &mut a);
+        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        crate::linalg::state_matrix(model, t, &q, &k, &c, &mut cols, out);
+    }
+}
+
+/// Largest distance between two sets of multipliers, each of `b` paired with the
+/// nearest unused one of `a`, relative to the larger of 1 and its modulus.
+pub fn multiplier_distance(a: &[(f64, f64)], b: &[(f64, f64)]) -> f64 {
+    let mut left: Vec<(f64, f64)> = a.to_vec();
+    let mut worst = 0.0f64;
+    for z in b {
+        let Some((i, dist)) = left
+            .iter()
+            .enumerate()
+            .map(|(i, w)| (i, (w.0 - z.0).hypot(w.1 - z.1)))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+        else {
+            return f64::INFINITY;
+        };
+        left.swap_remove(i);
+        worst = worst.max(dist / z.0.hypot(z.1).max(1.0));
+    }
+    if worst.is_nan() {
+        f64::INFINITY
+    } else {
+        worst
+    }
+}
+
+/// Largest 1-norm of `A(t)` over `samples` equispaced times of one period: the rate
+/// that sets the Magnus step (the error constants grow with powers of `h ||A||`).
+fn state_norm(a_at: &mut impl FnMut(f64, &mut [f64]), n2: usize, period: f64) -> f64 {
+    let samples = 8;
+    let mut a = vec![0.0; n2 * n2];
+    let mut worst = 0.0f64;
+    for i in 0..samples {
+        a_at(period * (i as f64 + 0.5) / samples as f64, &mut a);
+        let norm = (0..n2)
+            .map(|j| (0..n2).map(|r| a[r * n2 + j].abs()).sum::<f64>())
+            .fold(0.0, f64::max);
+        worst = worst.max(norm);
+    }
+    worst
+}
+
+/// Fewest Magnus steps per period.
+const MAGNUS_MIN_STEPS: usize = 8;
+
+/// `h ||A||_1` of the finer of the first two grids, divided by `rtol^(1/6)`. Measured on
+/// the thesis maps' R-R, O-O and R-O orbits (N = 3 and 8, periods 21 to 107; the ignored
+/// test `magnus_study`): the multipliers' error is `(h ||A||_1 / C)^6` with C between 25
+/// and 28 once `h ||A||_1 < 5`, so 20 leaves the error near rtol / 4 and the first
+/// check passes.
+const MAGNUS_STEP: f64 = 20.0;
+
+/// Safety factor on Richardson's estimate: two grids' multipliers differing by `d`,
+/// the finer one (`r` times as many steps) is taken to be off by `SAFETY d / (r^6 - 1)`.
+const MAGNUS_SAFETY: f64 = 2.0;
+
+/// Monodromy by sixth-order Magnus steps on a fixed grid, refined until two grids'
+/// multipliers agree to `opts.rtol` by Richardson's estimate of the finer one's error.
+/// The first pair of grids comes from `||A||` (the finer one is expected to suffice);
+/// a failed check predicts the next grid from the estimate. Returns the finest
+/// monodromy, its multipliers (unsorted), the steps taken over all grids, the
+/// evaluations of `A` and the estimated multiplier error.
+#[allow(clippy::type_complexity)]
+pub fn monodromy_magnus<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    opts: &FloquetOptions,
+) -> Result<(Vec<f64>, Vec<(f64, f64)>, usize, usize, f64)> {
+    use crate::numerics::magnus::monodromy_fixed;
+    let n2 = 2 * model.ndof();
+    let period = sol.period();
+    let mut a_at = orbit_state_matrix(model, sol);
+    let eig = |phi: &[f64]| {
+        eigenvalues(phi, n2).ok_or_else(|| {
+            crate::Error::Eigen("eigenvalues of the monodromy matrix did not converge".into())
+        })
+    };
+    let rho = state_norm(&mut a_at, n2, period);
+    if !rho.is_finite() {
+        return Err(crate::Error::Integration(
+            "the linearisation along the series is not finite".into(),
+        ));
+    }
+    let h = MAGNUS_STEP * opts.rtol.powf(1.0 / 6.0) / rho.max(1e-300);
+    let guess = (period / h).ceil().min(1e9) as usize;
+    let mut k_prev = guess.div_ceil(2).max(MAGNUS_MIN_STEPS / 2);
+    let mut evals = 8;
+    let budget = |total: usize| {
+        if total > opts.max_steps {
+            Err(crate::Error::Integration(format!(
+                "the Magnus monodromy did not reach rtol {:e} within max_steps = {} steps",
+                opts.rtol, opts.max_steps
+            )))
+        } else {
+            Ok(())
+        }
+    };
+    budget(k_prev)?;
+    let mut prev_ev = eig(&monodromy_fixed(&mut a_at, n2, period, k_prev))?;
+    let mut total = k_prev;
+    evals += 3 * k_prev;
+    let mut k = (2 * k_prev).max(MAGNUS_MIN_STEPS);
+    loop {
+        budget(total + k)?;
+        if crate::cancel::cancelled() {
+            return Err(crate::Error::Cancelled);
+        }
+        let phi = monodromy_fixed(&mut a_at, n2, period, k);
+        total += k;
+        evals += 3 * k;
+        let ev = eig(&phi)?;
+        let r = k as f64 / k_prev as f64;
+        let est = MAGNUS_SAFETY * multiplier_distance(&ev, &prev_ev) / (r.powi(6) - 1.0);
+        if est <= opts.rtol {
+            return Ok((phi, ev, total, evals, est));
+        }
+        // Sixth order: the step that meets rtol, with 20 % to spare, between 1.5 and 4
+        // times as many steps (an estimate far from the asymptotic regime misleads).
+        let grow = (1.2 * (est / opts.rtol).powf(1.0 / 6.0)).clamp(1.5, 4.0);
+        k_prev = k;
+        prev_ev = ev;
+        k = (k as f64 * grow).ceil() as usize;
+    }
+}
+
 /// Floquet multipliers and the stability verdict of a harmonic-balance solution.
 pub fn floquet<D: Dynamics + ?Sized>(
     model: &D,
     sol: &HbSolution,
     opts: &FloquetOptions,
 ) -> Result<Floquet> {
-    let (phi, steps, evals) = monodromy(model, sol, opts)?;
     let n2 = 2 * model.ndof();
-    let mut ev = eigenvalues(&phi, n2).ok_or_else(|| {
-        crate::Error::Eigen("eigenvalues of the monodromy matrix did not converge".into())
-    })?;
+    let (phi, mut ev, steps, evals, method_error) = match opts.method {
+        FloquetMethod::Rk45 => {
+            let (phi, steps, evals) = monodromy(model, sol, opts)?;
+            let ev = eigenvalues(&phi, n2).ok_or_else(|| {
+                crate::Error::Eigen("eigenvalues of the monodromy matrix did not converge".into())
+            })?;
+            (phi, ev, steps, evals, None)
+        }
+        FloquetMethod::Magnus => {
+            let (phi, ev, steps, evals, est) = monodromy_magnus(model, sol, opts)?;
+            (phi, ev, steps, evals, Some(est))
+        }
+    };
     ev.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
-    let v = judge(&ev, opts.margin, opts.max_trivial);
+    // The estimated integration error widens the margin as the trivial multiplier's does.
+    let v = judge(
+        &ev,
+        opts.margin.max(method_error.unwrap_or(0.0)),
+        opts.max_trivial,
+    );
     let separation_error = crate::hb::timed_certificate(|| separation_error(model, sol, &phi));
     let stability = match separation_error {
         Some(e) if !(e <= opts.max_trivial) => Stability::Undetermined,
@@ -237,6 +430,7 @@ pub fn floquet<D: Dynamics + ?Sized>(
         stability,
         steps,
         rhs_evals: evals,
+        method_error,
     })
 }
 
@@ -489,5 +683,148 @@ mod tests {
         }
         // The spec's shooting value of the leading non-trivial modulus.
         assert!((b[1] - 0.8637).abs() < 2e-4, "{b:?}");
+    }
+
+    /// Cost and error of RK45 and Magnus monodromies at thesis points (run with
+    /// `--ignored --nocapture`): the calibration behind the Magnus defaults.
+    #[test]
+    #[ignore]
+    fn magnus_study() {
+        use std::time::Instant;
+        let cases: [(&str, f64, f64, [bool; 2]); 5] = [
+            ("std R-R", 1.2, 1.0, [true, true]),
+            ("hard R-R", 1.0, 0.7, [true, true]),
+            ("O-O", 1.1, 0.4, [false, false]),
+            ("R-O stable", 1.3, 0.7, [true, false]),
+            ("R-O unstable", 1.1, 0.6, [true, false]),
+        ];
+        for n_harm in [3, 8] {
+            for (name, om, eta, pat) in cases {
+                let p = Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap();
+                let opts = PeriodicOptions {
+                    hb: HbOptions {
+                        n_harm,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let r = periodic(&p, &pat, None, &opts);
+                if r.sol.status != crate::hb::Status::Converged {
+                    println!("{name} N={n_harm}: {:?}", r.sol.status);
+                    continue;
+                }
+                let sol = r.sol;
+                let tight = FloquetOptions {
+                    rtol: 1e-12,
+                    atol: 1e-14,
+                    max_steps: 10_000_000,
+                    ..Default::default()
+                };
+                let reference = floquet(&p, &sol, &tight).unwrap();
+                let time = |f: &dyn Fn() -> Floquet| {
+                    let t = Instant::now();
+                    let mut out = f();
+                    for _ in 0..19 {
+                        out = f();
+                    }
+                    (t.elapsed().as_secs_f64() / 20.0 * 1e6, out)
+                };
+                println!(
+                    "{name} N={n_harm} T={:.1} mults {:?}",
+                    sol.period(),
+                    reference
+                        .multipliers
+                        .iter()
+                        .map(|z| z.0.hypot(z.1))
+                        .collect::<Vec<_>>()
+                );
+                for rtol in [1e-5, 1e-6, 1e-7, 1e-8] {
+                    let o = FloquetOptions {
+                        rtol,
+                        atol: rtol * 1e-3,
+                        ..Default::default()
+                    };
+                    let (us, f) = time(&|| floquet(&p, &sol, &o).unwrap());
+                    let e = multiplier_distance(&f.multipliers, &reference.multipliers);
+                    println!("  rk45   rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e}", f.steps);
+                }
+                let n2 = 8;
+                let rho = state_norm(&mut orbit_state_matrix(&p, &sol), n2, sol.period());
+                println!("  ||A||_1 {rho:.2}");
+                for k in [8, 16, 32, 64, 128, 256] {
+                    let t = Instant::now();
+                    let mut phi = vec![];
+                    for _ in 0..20 {
+                        phi = crate::numerics::magnus::monodromy_fixed(
+                            orbit_state_matrix(&p, &sol),
+                            n2,
+                            sol.period(),
+                            k,
+                        );
+                    }
+                    let us = t.elapsed().as_secs_f64() / 20.0 * 1e6;
+                    let ev = eigenvalues(&phi, n2).unwrap();
+                    let e = multiplier_distance(&ev, &reference.multipliers);
+                    let hr = sol.period() / k as f64 * rho;
+                    println!("  magnus K {k:4}: {us:8.0} us err {e:.1e} h||A|| {hr:.2} C(1e-6) {:.1}", hr / e.powf(1.0 / 6.0));
+                }
+                for rtol in [1e-5, 1e-6, 1e-7, 1e-8] {
+                    let o = FloquetOptions {
+                        method: FloquetMethod::Magnus,
+                        rtol,
+                        ..Default::default()
+                    };
+                    let (us, f) = time(&|| floquet(&p, &sol, &o).unwrap());
+                    let e = multiplier_distance(&f.multipliers, &reference.multipliers);
+                    println!(
+                        "  magnus rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e} est {:.1e}",
+                        f.steps,
+                        f.method_error.unwrap()
+                    );
+                }
+            }
+        }
+    }
+
+    /// Instruction counts under callgrind: `valgrind --tool=callgrind <test binary>
+    /// --ignored --exact numerics::floquet::tests::magnus_profile`.
+    #[test]
+    #[ignore]
+    fn magnus_profile() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let sol = periodic(&p, &[true, true], None, &PeriodicOptions::default()).sol;
+        assert_eq!(sol.status, crate::hb::Status::Converged, "{sol:?}");
+        let rk = FloquetOptions {
+            rtol: 1e-6,
+            atol: 1e-9,
+            ..Default::default()
+        };
+        let mg = FloquetOptions {
+            method: FloquetMethod::Magnus,
+            rtol: 1e-6,
+            ..Default::default()
+        };
+        let mut acc = 0.0;
+        for _ in 0..10 {
+            acc += profile_rk45(&p, &sol, &rk);
+            acc += profile_magnus(&p, &sol, &mg);
+            acc += profile_hill(&p, &sol);
+        }
+        println!("{acc}");
+    }
+
+    #[inline(never)]
+    fn profile_rk45(p: &Planar, sol: &HbSolution, o: &FloquetOptions) -> f64 {
+        floquet(p, sol, o).unwrap().max_modulus
+    }
+
+    #[inline(never)]
+    fn profile_hill(p: &Planar, sol: &HbSolution) -> f64 {
+        hill_multipliers(p, sol, 8).unwrap()[0].0
+    }
+
+    #[inline(never)]
+    fn profile_magnus(p: &Planar, sol: &HbSolution, o: &FloquetOptions) -> f64 {
+        floquet(p, sol, o).unwrap().max_modulus
     }
 }

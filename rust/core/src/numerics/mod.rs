@@ -5,6 +5,7 @@
 pub mod floquet;
 pub mod hb;
 pub mod linalg;
+pub mod magnus;
 pub mod ode;
 pub mod problem;
 pub mod rosenbrock;
