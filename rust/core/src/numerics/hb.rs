@@ -27,11 +27,6 @@ pub struct Basis {
     /// Galerkin weights `S x L`: basis times 1/S (mean) or 2/S (harmonics).
     wgt: Vec<f64>,
     tau: Vec<f64>,
-    /// Row-major `S x (2N + 1)` tables of `cos q tau_i / S` and `sin q tau_i / S`,
-    /// `q = 0..=2N`: the discrete Fourier coefficients of the Jacobians' samples, from
-    /// which the Galerkin blocks follow by product-to-sum identities.
-    cq: Vec<f64>,
-    sq: Vec<f64>,
 }
 
 impl Basis {
@@ -43,17 +38,6 @@ impl Basis {
         let mut ddphi = vec![0.0; s * l];
         let mut wgt = vec![0.0; s * l];
         let mut tau = vec![0.0; s];
-        let nq = 2 * n_harm + 1;
-        let mut cq = vec![0.0; s * nq];
-        let mut sq = vec![0.0; s * nq];
-        for i in 0..s {
-            let t = 2.0 * PI * i as f64 / s as f64;
-            for q in 0..nq {
-                let (sn, cs) = (q as f64 * t).sin_cos();
-                cq[i * nq + q] = cs / s as f64;
-                sq[i * nq + q] = sn / s as f64;
-            }
-        }
         for i in 0..s {
             let t = 2.0 * PI * i as f64 / s as f64;
             tau[i] = t;
@@ -81,8 +65,6 @@ impl Basis {
             ddphi,
             wgt,
             tau,
-            cq,
-            sq,
         }
     }
 
@@ -371,9 +353,7 @@ pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     k: Vec<f64>,
     c: Vec<f64>,
     m: Vec<f64>,
-    /// Fourier coefficients of one Jacobian block's samples: cos and sin series of K,
-    /// omega C, omega^2 M (`6 x (2N + 1)`).
-    fourier: Vec<f64>,
+    g: Vec<f64>,
 }
 
 impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
@@ -397,7 +377,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             k: vec![0.0; s * d * d],
             c: vec![0.0; s * d * d],
             m: vec![0.0; s * d * d],
-            fourier: vec![0.0; 6 * (2 * n_harm + 1)],
+            g: vec![0.0; s * (2 * n_harm + 1)],
         }
     }
 
@@ -497,7 +477,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let Some(jac) = jac else { return };
         let n = self.size();
         jac.fill(0.0);
-        let om2 = om * om;
+        let (om2, g) = (om * om, &mut self.g);
         for j in 0..d {
             for k in 0..d {
                 // A block takes a fraction of a second at hundreds of harmonics; a
@@ -514,99 +494,31 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                 if !any {
                     continue;
                 }
-                // Discrete Fourier coefficients (q = 0..=2N) of the samples of K,
-                // omega C and omega^2 M; the block W^T (K Phi + omega C Phi' +
-                // omega^2 M Phi'') is then a sum of two of them per entry
-                // (cos a cos b = (cos(a - b) + cos(a + b)) / 2 and so on): the same
-                // discrete sums as the direct product, with S (2N + 1) instead of
-                // S (2N + 1)^2 operations per block. Series that vanish (no damping or
-                // mass coupling between the two coordinates) are skipped.
-                let (has_c, has_m) = (0..s).fold((false, false), |(hc, hm), i| {
-                    let o = i * d * d + idx;
-                    (hc || self.c[o] != 0.0, hm || self.m[o] != 0.0)
-                });
-                let nq = 2 * self.basis.n_harm + 1;
-                let f = &mut self.fourier;
-                f.fill(0.0);
-                let (kc, rest) = f.split_at_mut(nq);
-                let (ks, rest) = rest.split_at_mut(nq);
-                let (cc, rest) = rest.split_at_mut(nq);
-                let (cs, rest) = rest.split_at_mut(nq);
-                let (mc, ms) = rest.split_at_mut(nq);
+                // G = K Phi + omega C Phi' + omega^2 M Phi''  (S x L)
                 for i in 0..s {
                     let o = i * d * d + idx;
-                    let ct = &self.basis.cq[i * nq..(i + 1) * nq];
-                    let st = &self.basis.sq[i * nq..(i + 1) * nq];
-                    let kv = self.k[o];
-                    for q in 0..nq {
-                        kc[q] += kv * ct[q];
-                        ks[q] += kv * st[q];
-                    }
-                    if has_c {
-                        let cv = om * self.c[o];
-                        for q in 0..nq {
-                            cc[q] += cv * ct[q];
-                            cs[q] += cv * st[q];
-                        }
-                    }
-                    if has_m {
-                        let mv = om2 * self.m[o];
-                        for q in 0..nq {
-                            mc[q] += mv * ct[q];
-                            ms[q] += mv * st[q];
-                        }
+                    let (kv, cv, mv) = (self.k[o], om * self.c[o], om2 * self.m[o]);
+                    let b = i * l;
+                    for p in 0..l {
+                        g[b + p] = kv * self.basis.phi[b + p]
+                            + cv * self.basis.dphi[b + p]
+                            + mv * self.basis.ddphi[b + p];
                     }
                 }
-                let (kc, ks, cc, cs, mc, ms) = (&*kc, &*ks, &*cc, &*cs, &*mc, &*ms);
-                let even = |v: &[f64], q: i64| v[q.unsigned_abs() as usize];
-                let odd = |v: &[f64], q: i64| q.signum() as f64 * v[q.unsigned_abs() as usize];
-                let nh = self.basis.n_harm as i64;
-                let at = |jac: &mut [f64], r: usize, p: usize, v: f64| {
-                    jac[(j * l + r) * n + k * l + p] = v;
-                };
-                // Column of the constant: g = K.
-                at(jac, 0, 0, kc[0]);
-                for nn in 1..=nh {
-                    let r = 2 * nn as usize;
-                    at(jac, r - 1, 0, 2.0 * kc[nn as usize]);
-                    at(jac, r, 0, 2.0 * ks[nn as usize]);
-                }
-                for m in 1..=nh {
-                    let (mf, m2) = (m as f64, (m * m) as f64);
-                    let xc = |q: i64| even(kc, q) - m2 * even(mc, q);
-                    let xs = |q: i64| odd(ks, q) - m2 * odd(ms, q);
-                    let (pc, ps) = (2 * m as usize - 1, 2 * m as usize);
-                    // cos m tau column: g = X cos m - m C sin m; sin m tau column:
-                    // g = X sin m + m C cos m, with X = K - m^2 M.
-                    at(jac, 0, pc, xc(m) - mf * odd(cs, m));
-                    at(jac, 0, ps, xs(m) + mf * even(cc, m));
-                    for nn in 1..=nh {
-                        let (dm, sm) = (nn - m, nn + m);
-                        let r = 2 * nn as usize;
-                        at(
-                            jac,
-                            r - 1,
-                            pc,
-                            xc(dm) + xc(sm) - mf * (odd(cs, sm) - odd(cs, dm)),
-                        );
-                        at(
-                            jac,
-                            r,
-                            pc,
-                            xs(sm) + xs(dm) - mf * (even(cc, dm) - even(cc, sm)),
-                        );
-                        at(
-                            jac,
-                            r - 1,
-                            ps,
-                            xs(sm) - xs(dm) + mf * (even(cc, dm) + even(cc, sm)),
-                        );
-                        at(
-                            jac,
-                            r,
-                            ps,
-                            xc(dm) - xc(sm) + mf * (odd(cs, sm) + odd(cs, dm)),
-                        );
+                // J block = W^T G
+                for i in 0..s {
+                    let w = &self.basis.wgt[i * l..(i + 1) * l];
+                    let gi = &g[i * l..(i + 1) * l];
+                    for rr in 0..l {
+                        let wr = w[rr];
+                        if wr == 0.0 {
+                            continue;
+                        }
+                        let row =
+                            &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
+                        for p in 0..l {
+                            row[p] += wr * gi[p];
+                        }
                     }
                 }
             }
@@ -1172,19 +1084,15 @@ mod tests {
         }
     }
 
-    /// Warm-started solves for callgrind (`BALLBAL_HB_N=8 ... --ignored --exact
-    /// numerics::hb::tests::hb_profile`): 20 solves at N = BALLBAL_HB_N from the
-    /// neighbour Omega = 1.19, as a scan's continuation does.
+    /// Warm-started solves at N = 3, 6, 8, 12 for callgrind (`--ignored --exact
+    /// numerics::hb::tests::hb_profile`): per N, a `hb_profile_nN` frame.
     #[test]
     #[ignore]
     fn hb_profile() {
         use crate::periodic::{periodic, PeriodicOptions};
-        let n: usize = std::env::var("BALLBAL_HB_N")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(3);
         let p = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
         let near = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.19, &[1.0, 1.0]).unwrap();
+        let seed = periodic(&near, &[true, true], None, &PeriodicOptions::default()).sol;
         let opts = |n_harm| PeriodicOptions {
             hb: HbOptions {
                 n_harm,
@@ -1192,13 +1100,47 @@ mod tests {
             },
             ..Default::default()
         };
-        let seed = periodic(&near, &[true, true], None, &opts(n)).sol;
+        let seed12 = periodic(&near, &[true, true], Some(&seed), &opts(12)).sol;
         let mut acc = 0.0;
-        let t = std::time::Instant::now();
         for _ in 0..20 {
-            let r = periodic(&p, &[true, true], Some(&seed), &opts(n));
-            acc += r.sol.omega + r.sol.iterations as f64;
+            acc += hb_profile_n3(&p, &seed12, &opts(3));
+            acc += hb_profile_n6(&p, &seed12, &opts(6));
+            acc += hb_profile_n8(&p, &seed12, &opts(8));
+            acc += hb_profile_n12(&p, &seed12, &opts(12));
         }
-        println!("N {n}: {acc} {:.1} us", t.elapsed().as_secs_f64() / 20.0 * 1e6);
+        println!("{acc}");
+    }
+
+    #[inline(never)]
+    fn hb_profile_n3(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+    }
+    #[inline(never)]
+    fn hb_profile_n6(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+    }
+    #[inline(never)]
+    fn hb_profile_n8(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+    }
+    #[inline(never)]
+    fn hb_profile_n12(
+        p: &crate::Planar,
+        g: &HbSolution,
+        o: &crate::periodic::PeriodicOptions,
+    ) -> f64 {
+        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
     }
 }
