@@ -54,7 +54,11 @@ def test_labels_agree_with_an_independent_long_simulation(maps):
             if r["label"] in ballbal.basins.ROTATING:
                 assert turns > 5, (om, r)
                 rate = -(df["b1"][-1] - df["b1"][0]) / 300
-                assert abs(rate - r["rate1"]) < 0.02 * abs(rate)
+                # A torus (separated R-R) has no single rate: its mean over a window
+                # moves by a few per cent with the window (the early stop reads it
+                # from an earlier one); a periodic class's is exact.
+                tol = 0.03 if r["label"] == "separated_R-R" else 0.02
+                assert abs(rate - r["rate1"]) < tol * abs(rate)
             else:
                 assert r["label"] == "perfect_balance", (om, r)
                 assert turns < 0.01
@@ -130,28 +134,74 @@ def test_plot(tmp_path, maps):
     assert (tmp_path / "b.png").stat().st_size > 1000
 
 
-def test_ctrl_c_stops_a_grid_within_a_second():
-    # A real SIGINT to a child computing a grid that takes about a minute.
+INTERRUPTED = """
+import sys, time, warnings, ballbal
+from ballbal.basins import basins
+m = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50, Omega=1.2, eta=(0.7, 0.7))
+out = sys.argv[2] if len(sys.argv) > 2 else None
+print("ready", flush=True)
+with warnings.catch_warnings(record=True) as w:
+    warnings.simplefilter("always")
+    r = basins(m, n=int(sys.argv[1]), execution=ballbal.Execution(threads=2, chunk=16, out=out))
+print("ROWS", r.table.height, "WARNED",
+      sum(issubclass(x.category, ballbal.ScanInterrupted) for x in w),
+      "INTERRUPTED", r.interrupted, "AT", time.monotonic(), flush=True)
+"""
+
+
+def _sigint(args: list[str], ready) -> tuple[str, str, float]:
+    """Runs INTERRUPTED with `args`, sends SIGINT once `ready()` holds; returns (stdout,
+    stderr, seconds from the signal to the returned table)."""
     import signal
     import subprocess
     import sys
     import time
 
-    code = ("import sys, time, ballbal\nfrom ballbal.basins import basins\n"
-            "m = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50, Omega=1.2, "
-            "eta=(0.7, 0.7))\nprint('ready', flush=True)\n"
-            "try:\n    basins(m, n=100, execution=ballbal.Execution(threads=2))\n"
-            "except KeyboardInterrupt:\n    print('interrupted', time.monotonic(), "
-            "flush=True)\n    sys.exit(7)\n")
-    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+    p = subprocess.Popen([sys.executable, "-c", INTERRUPTED, *args], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
     assert p.stdout is not None and p.stdout.readline().strip() == "ready"
-    time.sleep(0.5)
+    deadline = time.time() + 120
+    while not ready() and time.time() < deadline:
+        time.sleep(0.005)
     sent = time.monotonic()
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=60)
-    assert p.returncode == 7, (out, err)
-    assert float(out.split()[1]) - sent < 1.0
+    assert p.returncode == 0, (out, err)
+    assert "PanicException" not in err and "panicked" not in err, err
+    return out, err, float(out.split()[-1]) - sent
+
+
+def test_ctrl_c_returns_the_finished_starts_within_a_second():
+    # A real SIGINT to a child computing a grid that takes far longer than the delay:
+    # the call returns the finished chunks (whole chunks of 16 starts, in order) with a
+    # ScanInterrupted warning, as scans do, instead of raising KeyboardInterrupt.
+    import time
+
+    t0 = time.time()
+    out, err, lag = _sigint(["100"], lambda: time.time() - t0 > 3.0)
+    words = out.split()
+    rows, warned, flag = int(words[1]), int(words[3]), words[5]
+    assert warned == 1 and flag == "True", out
+    assert rows % 16 == 0 and rows < 100 * 100, rows
+    assert lag < 1.0, lag
+
+
+def test_ctrl_c_keeps_chunks_on_disk_and_a_rerun_resumes(tmp_path):
+    d = tmp_path / "b"
+    out, err, _ = _sigint(["16", str(d)], lambda: len(list(d.glob("chunk-*.parquet"))) >= 3)
+    words = out.split()
+    kept = len(list(d.glob("chunk-*.parquet")))
+    assert int(words[3]) == 1 and words[5] == "True", out
+    assert 3 <= kept < 16, kept
+    assert int(words[1]) == 16 * kept  # the table returned is what is on disk
+    m = thesis(1.2)
+    before = {f: f.stat().st_mtime_ns for f in d.glob("chunk-*.parquet")}
+    resumed = basins(m, n=16, execution=ballbal.Execution(threads=2, chunk=16, out=d))
+    assert not resumed.interrupted
+    # the kept chunks were not recomputed, and the table is the uninterrupted one
+    assert {f: f.stat().st_mtime_ns for f in before} == before
+    whole = basins(m, n=16, execution=ballbal.Execution(threads=2, chunk=16))
+    assert resumed.table.equals(whole.table)
 
 
 def test_resume_from_a_directory_redoes_only_a_damaged_chunk(tmp_path):
@@ -186,3 +236,46 @@ def test_an_executor_gives_the_same_table():
         there = basins(m, samples=6, seed=5,
                        execution=ballbal.Execution(chunk=2, executor=ex))
     assert there.table.equals(here.table)
+
+
+def _label_by_simulation(m: ballbal.Balancer, b1: float, b2: float) -> str:
+    """The label of a start read from ballbal.simulate run to the full 1000 time
+    units at tight tolerances, over its last 300: both balls turning (at least once
+    per half) with their gap below merge_tol 0.5 = merged R-R, apart = separated R-R;
+    none turning = rest, the perfect balance if |x + i y| ends below rest_tol 0.05."""
+    om = m.Omega
+    df = ballbal.simulate(m, [0, 0, b1, b2, 0, 0, -om, -om], t_eval=np.arange(700, 1000.01, 0.1),
+                          t0=0.0, rtol=1e-9, atol=1e-11)
+    b = df.select("b1", "b2").to_numpy()
+    h = len(b) // 2
+    turning = [min(abs(b[h, i] - b[0, i]), abs(b[-1, i] - b[h, i])) >= 2 * np.pi
+               for i in range(2)]
+    if all(turning):
+        gap = np.abs(np.angle(np.exp(1j * (b[:, 0] - b[:, 1])))).max()
+        return "merged_R-R" if gap < 0.5 else "separated_R-R"
+    if not any(turning):
+        return "perfect_balance" if np.hypot(df["x"][-1], df["y"][-1]) < 0.05 else \
+            "other_equilibrium"
+    return "R-O"
+
+
+@pytest.mark.parametrize("omega", [1.2, 1.35])
+def test_early_stop_keeps_the_labels_of_full_runs(omega):
+    # The early stop ends most starts well before t_end (a converged Poincare section,
+    # a torus, a clean decay to rest) and must give the label the full 1000 time units
+    # give: against the classifier without early stopping on a 12 x 12 grid, and
+    # against fixed-horizon simulations read in this test on random starts.
+    m = thesis(omega)
+    early = basins(m, n=12).table
+    full = basins(m, n=12, options=BasinOptions(early_stop=False)).table
+    assert early["label"].to_list() == full["label"].to_list()
+    assert early["t_stop"].mean() < 0.7 * full["t_stop"].mean()
+    assert (full.filter(pl.col("label").is_in(ballbal.basins.ROTATING))["t_stop"] == 1000).all()
+    rot = early.filter(pl.col("label").is_in(ballbal.basins.ROTATING))
+    # a torus' windowed mean rate moves by a few per cent with the window
+    assert np.allclose(rot["rate1"], full.filter(
+        pl.col("label").is_in(ballbal.basins.ROTATING))["rate1"], rtol=0.03)
+    sample = basins(m, samples=24, seed=7).table
+    for r in sample.iter_rows(named=True):
+        assert r["label"] == _label_by_simulation(m, r["b1"], r["b2"]), r
+    assert sample["t_stop"].min() < 1000

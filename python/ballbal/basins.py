@@ -32,7 +32,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from .exceptions import ParameterError, ScanStoreError
+from .exceptions import ParameterError, ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .options import Execution
 from .scene import Scene
@@ -53,7 +53,11 @@ class BasinOptions:
     (a rotating ball must turn at least once per half of it, so ``window`` bounds the
     slowest rotation recognised: ``omega >= 4 pi / window``); ``rtol, atol``: the
     integrator's tolerances; ``settle_factor``: with the settle check, the longer run's
-    length in units of ``t_end``.
+    length in units of ``t_end``; ``early_stop``: end a start's simulation before
+    ``t_end`` once its attractor is clear — a periodic orbit whose Poincare section
+    (the whole turns of a rotating ball) has converged, or a clean decay to rest —
+    with the label the full run gives (``t_stop`` says where it stopped; the settle
+    check's longer run and speed sweeps always run to the end).
     """
 
     t_end: float = 1000.0
@@ -63,8 +67,10 @@ class BasinOptions:
     rest_tol: float = 0.05
     merge_tol: float = 0.5
     settle_factor: float | None = None
+    early_stop: bool = True
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "early_stop", _check.boolean("early_stop", self.early_stop))
         for n in ("t_end", "window", "rtol", "atol", "rest_tol", "merge_tol"):
             object.__setattr__(self, n, _check.real(n, getattr(self, n)))
         if self.settle_factor is not None:
@@ -86,6 +92,8 @@ class Basins:
     table: pl.DataFrame
     options: BasinOptions
     random: bool = False
+    #: Ctrl-C stopped the call: ``table`` holds only the finished chunks' starts.
+    interrupted: bool = False
     _links: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -103,6 +111,8 @@ class Basins:
     def rotating_fraction(self) -> tuple[float, float]:
         """Fraction (and its standard error) of starts that end with a rotating ball."""
         n = self.table.height
+        if n == 0:
+            return math.nan, math.nan
         p = self.table.filter(pl.col("label").is_in(ROTATING)).height / n
         return p, math.sqrt(p * (1 - p) / n)
 
@@ -271,9 +281,11 @@ def basins(
     ``execution``: ``threads`` (default all cores), ``chunk`` (starts per task,
     default 256) and ``out`` (a directory the finished chunks are written to as
     Parquet and resumed from, with the scan store's checks: see :class:`_BasinStore`);
-    Ctrl-C stops the work (``KeyboardInterrupt``; with ``out`` the finished chunks are
-    kept); ``executor``: a ``concurrent.futures`` executor or Dask ``Client`` running
-    the chunks as tasks (``threads`` per task, default 1). None of it changes the
+    Ctrl-C stops the work and returns the finished chunks' starts (in chunk order) with
+    a :class:`~ballbal.exceptions.ScanInterrupted` warning, as :func:`ballbal.scan`
+    does (with ``out`` they are also on disk, and the same call resumes);
+    ``executor``: a ``concurrent.futures`` executor or Dask ``Client`` running the
+    chunks as tasks (``threads`` per task, default 1). None of it changes the
     table.
     """
     _check.model("model", model)
@@ -289,7 +301,8 @@ def basins(
     if _check.boolean("settle_check", settle_check) and factor is None:
         factor = 3.0
     options = BasinOptions(t_end, window, options.rtol, options.atol, options.rest_tol,
-                           options.merge_tol, factor if settle_check else None)
+                           options.merge_tol, factor if settle_check else None,
+                           options.early_stop)
     random = samples is not None
     if random:
         if b1 is not None or b2 is not None or n is not None:
@@ -319,8 +332,9 @@ def basins(
     sizes = {c: min(len(starts), (c + 1) * chunk) - c * chunk for c in range(n_chunks)}
     parts: dict[int, pl.DataFrame] = {}
 
-    def frame(c: int, cols: dict[str, Any]) -> pl.DataFrame:
-        lo, hi = c * chunk, c * chunk + sizes[c]
+    def frame(c: int, cols: dict[str, Any], size: int | None = None) -> pl.DataFrame:
+        lo = c * chunk
+        hi = lo + (sizes[c] if size is None else size)
         return pl.DataFrame({
             "b1": s1[lo:hi], "b2": s2[lo:hi], "label": pl.Series(cols["label"], dtype=pl.Utf8),
             "pattern": pl.Series(cols["pattern"], dtype=pl.Utf8),
@@ -339,6 +353,9 @@ def basins(
             "starts": hashlib.sha256(np.stack([s1, s2]).tobytes()).hexdigest(),
             "count": len(starts), "options": asdict(options), "chunk": chunk}}
         store = _BasinStore(execution.out, meta)
+    done: set[int] = set()
+    todo: list[int] = []
+    interrupted = False
     try:
         done = store.done(sizes) if store is not None else set()
 
@@ -369,20 +386,34 @@ def basins(
             assert store is not None
             parts[c] = store.read(c)
     except KeyboardInterrupt:
+        interrupted = True
         if store is not None:
-            warnings.warn(f"basins interrupted: {len(parts) + len(done)} of {n_chunks} "
-                          f"chunks kept in {execution.out}; run the same call again to "
-                          "resume", stacklevel=2)
-        raise
+            # Ctrl-C can land between a chunk's atomic rename and `parts[c] = ...`: a
+            # file that exists is whole, so it belongs to the table returned now.
+            for c in todo:
+                if c not in parts and store.store.file(c).exists():
+                    parts[c] = store.read(c)
+            for c in done:
+                parts.setdefault(c, store.read(c))
+        warnings.warn(
+            ScanInterrupted(
+                f"basins interrupted: {len(parts)} of {n_chunks} chunks finished"
+                + (f" and kept in {execution.out}; run the same call again to resume"
+                   if store is not None else "; pass execution.out to keep chunks on disk")
+            ),
+            stacklevel=2,
+        )
     finally:
         if store is not None:
             store.close()
-    df = pl.concat([parts[c] for c in range(n_chunks)], how="vertical")
+    df = (pl.concat([parts[c] for c in sorted(parts)], how="vertical") if parts
+          else frame(0, {k: [] for k in ("label", "pattern", "omega", "period", "rate1",
+                                         "rate2", "t_stop", "long_label")}, 0))
     if settle_check:
         df = df.with_columns((pl.col("label") == pl.col("long_label")).alias("settled"))
     else:
         df = df.drop("long_label")
-    return Basins(model, df, options, random)
+    return Basins(model, df, options, random, interrupted)
 
 
 def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> Any:

@@ -21,6 +21,7 @@ pub struct BasinArgs {
     rest_tol: f64,
     merge_tol: f64,
     settle_factor: Option<f64>,
+    early_stop: bool,
 }
 
 impl BasinArgs {
@@ -33,6 +34,7 @@ impl BasinArgs {
             rest_tol: self.rest_tol,
             merge_tol: self.merge_tol,
             settle_factor: self.settle_factor,
+            early_stop: self.early_stop,
         }
     }
 }
@@ -194,7 +196,7 @@ pub fn attractor_series<'py>(
 }
 
 /// Classifies the motion from the state `y0` (simulated for `options.t_end`) as
-/// `basins` does; returns `(columns of one row, the state reached)`.
+/// `basins` does, without stopping early; returns `(columns of one row, the state reached)`.
 #[pyfunction]
 pub fn classify_state<'py>(
     py: Python<'py>,
@@ -203,7 +205,11 @@ pub fn classify_state<'py>(
     options: BasinArgs,
 ) -> PyResult<(Bound<'py, PyDict>, Bound<'py, PyArray1<f64>>)> {
     let m = build(&model)?;
-    let opts = options.to_core();
+    // A sweep carries the state after the whole dwell on to its next step.
+    let opts = BasinOptions {
+        early_stop: false,
+        ..options.to_core()
+    };
     opts.validate().py()?;
     let y0 = slice(&y0, "y0")?.to_vec();
     let dim = dispatch!(&m, d => 2 * d.ndof());

@@ -43,6 +43,10 @@ pub struct BasinOptions {
     /// Settle check: simulate again for `settle_factor * t_end` and report whether the
     /// label is the same.
     pub settle_factor: Option<f64>,
+    /// End a start's simulation before `t_end` once its attractor is clear (a
+    /// converged periodic orbit, a clean decay to rest); the label is the one the full
+    /// run gives. A speed sweep turns it off: its state must be the one after the dwell.
+    pub early_stop: bool,
 }
 
 impl Default for BasinOptions {
@@ -55,6 +59,7 @@ impl Default for BasinOptions {
             rest_tol: 0.05,
             merge_tol: 0.5,
             settle_factor: None,
+            early_stop: true,
         }
     }
 }
@@ -142,19 +147,418 @@ pub fn ground_rest_start<D: Dynamics + ?Sized>(model: &D, balls: &[f64]) -> Vec<
 
 /// Samples of the window, every `DT`.
 const DT: f64 = 0.1;
+/// Samples of the early stop's checks: coarser, they only have to see the motion's
+/// shape (the outcome's rates and period then come from whole-turn crossings
+/// interpolated between them).
+const PROBE_DT: f64 = 0.2;
 
 /// Classifies the start `y0` (with the settle check if asked). `Err` only when
-/// cancelled.
+/// cancelled. With `opts.early_stop` the simulation may end before `t_end` once the
+/// attractor is clear (see [`EarlyStop`]); the settle check's longer run never does.
 pub fn classify_start<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
     opts: &BasinOptions,
 ) -> Result<Outcome> {
-    let mut out = judge(model, y0, opts.t_end, opts)?;
+    let mut out = judge(model, y0, opts.t_end, opts, opts.early_stop)?;
     if let Some(f) = opts.settle_factor {
-        out.long_label = Some(judge(model, y0, f * opts.t_end, opts)?.label);
+        out.long_label = Some(judge(model, y0, f * opts.t_end, opts, false)?.label);
     }
     Ok(out)
+}
+
+/// Samples `(t, state)` every `DT`, flat (one allocation for the whole window).
+#[derive(Default)]
+struct Samples {
+    t: Vec<f64>,
+    y: Vec<f64>,
+    w: usize,
+}
+
+impl Samples {
+    fn new(w: usize) -> Self {
+        Samples {
+            t: vec![],
+            y: vec![],
+            w,
+        }
+    }
+    fn push(&mut self, t: f64, y: &[f64]) {
+        self.t.push(t);
+        self.y.extend_from_slice(y);
+    }
+    fn len(&self) -> usize {
+        self.t.len()
+    }
+    fn at(&self, k: usize) -> &[f64] {
+        &self.y[k * self.w..(k + 1) * self.w]
+    }
+    /// Drops the samples before `t0` once they are the larger part (moving the rest
+    /// down less often).
+    fn drop_before(&mut self, t0: f64) {
+        let k = self.t.partition_point(|&t| t < t0);
+        if 2 * k > self.t.len() {
+            self.t.drain(..k);
+            self.y.drain(..k * self.w);
+        }
+    }
+    /// The samples from index `k0` on.
+    fn from(&self, k0: usize) -> Window<'_> {
+        Window {
+            t: &self.t[k0..],
+            y: &self.y[k0 * self.w..],
+            w: self.w,
+        }
+    }
+}
+
+/// A run of samples the label is read from.
+#[derive(Clone, Copy)]
+struct Window<'a> {
+    t: &'a [f64],
+    y: &'a [f64],
+    w: usize,
+}
+
+impl Window<'_> {
+    fn len(&self) -> usize {
+        self.t.len()
+    }
+    fn at(&self, k: usize) -> &[f64] {
+        &self.y[k * self.w..(k + 1) * self.w]
+    }
+}
+
+/// Early stopping of a start whose attractor is already clear. At checkpoints every
+/// `CHECK_STEP` time units the motion over the last `check` time units is labelled as
+/// the final window would be, and the simulation stops when
+/// - that label is a rotating one (merged R-R, separated R-R, R-O, other), the same as
+///   at the previous checkpoint, and the Poincare section at the whole turns of a
+///   rotating ball has converged (the last two returns differ by less than
+///   `SECTION_TOL` in every coordinate and contract): the motion is on a periodic orbit,
+///   which every later window labels alike; the balls' turns per return must give the
+///   same rotation pattern, and the balls' largest gap over the last return must lie
+///   clear of `merge_tol`;
+/// - or it is a rest label, at this and the previous checkpoint, with the velocities
+///   over the second half of the window below `REST_DECAY` times those of the first
+///   (the final window's test is 0.8), no ball turning, and `|x + i y|` clear of
+///   `rest_tol` by twice its spread over the second half.
+///
+/// Anything else (not settled, O-O, a slow decay) runs to `t_end` as without early
+/// stopping. The tests compare the labels with full runs (and with long simulations).
+struct EarlyStop {
+    /// Length of the window judged at a checkpoint.
+    check: f64,
+    next_check: f64,
+    probe: Samples,
+    next_probe: u64,
+    /// Per ball, the last three returns to a whole turn: `(t, state)`.
+    returns: Vec<Vec<(f64, Vec<f64>)>>,
+    prev_label: Option<Label>,
+    /// Consecutive checkpoints with the same label.
+    runs: usize,
+    /// Consecutive checkpoints whose whole final window reads separated R-R.
+    torus_runs: usize,
+    y_prev: Vec<f64>,
+}
+
+const CHECK_STEP: f64 = 25.0;
+const SECTION_TOL: f64 = 1e-4;
+const REST_DECAY: f64 = 0.7;
+const TORUS_RUNS: usize = 5;
+const TORUS_RATE: f64 = 0.07;
+const TORUS_GAP: f64 = 0.1;
+
+impl EarlyStop {
+    fn new(check: f64, y0: &[f64]) -> Self {
+        EarlyStop {
+            check,
+            next_check: check,
+            probe: Samples::new(y0.len()),
+            next_probe: 0,
+            returns: vec![],
+            prev_label: None,
+            runs: 0,
+            torus_runs: 0,
+            y_prev: y0.to_vec(),
+        }
+    }
+
+    /// Records the step `[ta, tb]`'s samples and whole-turn returns.
+    fn observe(
+        &mut self,
+        tb: f64,
+        dense: &crate::ode::Dense<'_>,
+        d: usize,
+        o: usize,
+        tmp: &mut [f64],
+    ) {
+        let n = d - o;
+        if self.returns.is_empty() {
+            self.returns = vec![vec![]; n];
+        }
+        loop {
+            let t = self.next_probe as f64 * PROBE_DT;
+            if t > tb {
+                break;
+            }
+            dense.eval(t, tmp);
+            self.probe.push(t, tmp);
+            self.next_probe += 1;
+        }
+        let (ta, _) = dense.span();
+        let y1 = dense.end();
+        for i in 0..n {
+            let (a, b) = (self.y_prev[o + i], y1[o + i]);
+            let (ka, kb) = ((a / (2.0 * PI)).floor(), (b / (2.0 * PI)).floor());
+            if ka == kb {
+                continue;
+            }
+            // The crossing of the level between the two: Newton on the cubic Hermite
+            // interpolant of the angle and its rate at the step's ends (accurate to
+            // the step's fourth power, far below the section tolerance), then one dense
+            // evaluation of the whole state there.
+            let level = 2.0 * PI * ka.max(kb);
+            let h = tb - ta;
+            let (p0, p1) = (a - level, b - level);
+            let (m0, m1) = (h * self.y_prev[d + o + i], h * y1[d + o + i]);
+            let herm = |s: f64| {
+                let (s2, s3) = (s * s, s * s * s);
+                let v = (2.0 * s3 - 3.0 * s2 + 1.0) * p0
+                    + (s3 - 2.0 * s2 + s) * m0
+                    + (-2.0 * s3 + 3.0 * s2) * p1
+                    + (s3 - s2) * m1;
+                let dv = (6.0 * s2 - 6.0 * s) * p0
+                    + (3.0 * s2 - 4.0 * s + 1.0) * m0
+                    + (-6.0 * s2 + 6.0 * s) * p1
+                    + (3.0 * s2 - 2.0 * s) * m1;
+                (v, dv)
+            };
+            let mut sc = p0 / (p0 - p1);
+            for _ in 0..8 {
+                let (v, dv) = herm(sc);
+                if dv == 0.0 {
+                    break;
+                }
+                let next = (sc - v / dv).clamp(0.0, 1.0);
+                let done = (next - sc).abs() < 1e-13;
+                sc = next;
+                if done {
+                    break;
+                }
+            }
+            let tc = ta + sc * h;
+            dense.eval(tc, tmp);
+            let r = &mut self.returns[i];
+            if r.len() == 3 {
+                r.remove(0);
+            }
+            r.push((tc, tmp.to_vec()));
+        }
+        self.y_prev.copy_from_slice(y1);
+    }
+
+    /// At a checkpoint: the outcome to stop with, if the attractor is clear.
+    fn decide(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        d: usize,
+        o: usize,
+        t_end: f64,
+        opts: &BasinOptions,
+    ) -> Option<Outcome> {
+        let n = d - o;
+        let k0 = self.probe.t.partition_point(|&s| s < t - self.check);
+        let win = self.probe.from(k0);
+        let cand = label_window(win, PROBE_DT, y, t, n, d, o, opts);
+        let runs = if self.prev_label == Some(cand.label) {
+            self.runs + 1
+        } else {
+            1
+        };
+        let mut cand = cand;
+        let mut clear = runs >= 2
+            && match cand.label {
+                Label::PerfectBalance | Label::OtherEquilibrium => {
+                    match rest_is_clear(win, d, t_end, opts) {
+                        Some(l) => {
+                            cand.label = l;
+                            true
+                        }
+                        None => false,
+                    }
+                }
+                Label::MergedRR | Label::SeparatedRR | Label::RO | Label::Other
+                    if cand.pattern.contains('R') =>
+                {
+                    self.orbit_is_clear(&cand, t - self.check, win, d, o, opts)
+                }
+                _ => false,
+            };
+        self.prev_label = Some(cand.label);
+        self.runs = runs;
+        // A torus has no periodic orbit to converge to: it is judged over a whole
+        // final window, as the final judgement does.
+        if !clear && n == 2 && t >= opts.window && cand.pattern == "R-R" {
+            let k1 = self.probe.t.partition_point(|&s| s < t - opts.window);
+            let long = self.probe.from(k1);
+            let whole = label_window(long, PROBE_DT, y, t, n, d, o, opts);
+            self.torus_runs = if whole.label == Label::SeparatedRR {
+                self.torus_runs + 1
+            } else {
+                0
+            };
+            if self.torus_runs >= TORUS_RUNS && torus_is_clear(long, o, opts) {
+                cand = whole;
+                clear = true;
+            }
+        } else {
+            self.torus_runs = 0;
+        }
+        self.next_check += CHECK_STEP;
+        // The torus test looks at a whole final window.
+        self.probe.drop_before(self.next_check - opts.window - 1.0);
+        clear.then_some(cand)
+    }
+
+    fn orbit_is_clear(
+        &self,
+        cand: &Outcome,
+        since: f64,
+        win: Window<'_>,
+        d: usize,
+        o: usize,
+        opts: &BasinOptions,
+    ) -> bool {
+        let n = d - o;
+        let rot: Vec<bool> = cand.pattern.split('-').map(|p| p == "R").collect();
+        let Some(i) = rot.iter().position(|&r| r) else {
+            return false;
+        };
+        let r = &self.returns[i];
+        if r.len() < 3 || r[0].0 < since {
+            return false;
+        }
+        let dist = |p: &[f64], q: &[f64]| {
+            let mut m = 0.0f64;
+            for k in 0..o {
+                m = m.max((p[k] - q[k]).abs());
+            }
+            for k in d..2 * d {
+                m = m.max((p[k] - q[k]).abs());
+            }
+            for j in 0..n {
+                m = m.max(wrap((p[o + j] - p[o + i]) - (q[o + j] - q[o + i])).abs());
+            }
+            m
+        };
+        let (d1, d2) = (dist(&r[0].1, &r[1].1), dist(&r[1].1, &r[2].1));
+        if !(d2 < SECTION_TOL && (d2 <= d1 || d2 < 1e-9)) {
+            return false;
+        }
+        // Turns per return give the pattern of the orbit itself.
+        for (j, &rotates) in rot.iter().enumerate() {
+            let turns = ((r[2].1[o + j] - r[1].1[o + j]) / (2.0 * PI)).round();
+            if (turns != 0.0) != rotates {
+                return false;
+            }
+        }
+        if n == 2 && rot.iter().all(|&x| x) {
+            let (ta, tb) = (r[1].0, r[2].0);
+            let gap = (0..win.len())
+                .filter(|&k| win.t[k] >= ta - PROBE_DT && win.t[k] <= tb + PROBE_DT)
+                .map(|k| wrap(win.at(k)[o] - win.at(k)[o + 1]).abs())
+                .fold(0.0, f64::max);
+            let merged = cand.label == Label::MergedRR;
+            if merged != (gap < opts.merge_tol)
+                || (gap - opts.merge_tol).abs() < 0.05 * opts.merge_tol
+            {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// The rest test of [`EarlyStop`] and the rest label the full run ends with: the
+/// velocities decay clearly, and `|x + i y|` lies clear of `rest_tol`, or (the perfect
+/// balance) its envelope decays so that, continued at the rate measured between the
+/// window's halves, it is below `rest_tol / 2` at `t_end`.
+fn rest_is_clear(win: Window<'_>, d: usize, t_end: f64, opts: &BasinOptions) -> Option<Label> {
+    let m = win.len();
+    if m < 4 {
+        return None;
+    }
+    let h = m / 2;
+    let vmax = |a: usize, b: usize| {
+        (a..b)
+            .flat_map(|k| win.at(k)[d..].iter().map(|v| v.abs()))
+            .fold(0.0, f64::max)
+    };
+    let (v1, v2) = (vmax(0, h), vmax(h, m));
+    if v2 >= REST_DECAY * v1 && v2 >= 1e-7 {
+        return None;
+    }
+    let z = |k: usize| win.at(k)[0].hypot(win.at(k)[1]);
+    let (z1, z2) = (
+        (0..h).map(z).fold(0.0, f64::max),
+        (h..m).map(z).fold(0.0, f64::max),
+    );
+    if z2 < REST_DECAY * z1 {
+        let half = win.t[m - 1] - win.t[h];
+        let left = (t_end - win.t[m - 1]) / half;
+        if z2 * (z2 / z1).powf(left) < 0.5 * opts.rest_tol {
+            return Some(Label::PerfectBalance);
+        }
+    }
+    let last = win.at(m - 1);
+    let spread = (h..m)
+        .map(|k| (win.at(k)[0] - last[0]).hypot(win.at(k)[1] - last[1]))
+        .fold(0.0, f64::max);
+    let zl = z(m - 1);
+    if (zl - opts.rest_tol).abs() <= 2.0 * spread + 1e-3 * opts.rest_tol {
+        return None;
+    }
+    Some(if zl < opts.rest_tol {
+        Label::PerfectBalance
+    } else {
+        Label::OtherEquilibrium
+    })
+}
+
+/// The torus test of [`EarlyStop`], over a whole final window: two balls rotating apart (their gap modulated, no
+/// periodic orbit to converge to) for `TORUS_RUNS` checkpoints, with steady mean rates
+/// (the halves of the window agree to `TORUS_RATE`, where the final judgement allows
+/// 10 %; a torus modulates them by 3 to 6 % at the thesis' Omega 1.2), a gap beyond `1.2 merge_tol` in the second half whose largest value has stopped
+/// growing (the halves agree to `TORUS_GAP`: the torus has settled, so its mean rates
+/// are those of later windows), and an undiminished
+/// vibration (a rotation dying out on its way to rest takes `|x + i y|` down).
+fn torus_is_clear(win: Window<'_>, o: usize, opts: &BasinOptions) -> bool {
+    let m = win.len();
+    if m < 4 {
+        return false;
+    }
+    let h = m / 2;
+    for i in 0..2 {
+        let r1 = (win.at(h)[o + i] - win.at(0)[o + i]) / (win.t[h] - win.t[0]);
+        let r2 = (win.at(m - 1)[o + i] - win.at(h)[o + i]) / (win.t[m - 1] - win.t[h]);
+        if (r1 - r2).abs() > TORUS_RATE * r1.abs().max(r2.abs()) {
+            return false;
+        }
+    }
+    let gap = |a: usize, b: usize| {
+        (a..b)
+            .map(|k| wrap(win.at(k)[o] - win.at(k)[o + 1]).abs())
+            .fold(0.0, f64::max)
+    };
+    let (g1, g2) = (gap(0, h), gap(h, m));
+    let z = |k: usize| win.at(k)[0].hypot(win.at(k)[1]);
+    let (z1, z2) = (
+        (0..h).map(z).fold(0.0, f64::max),
+        (h..m).map(z).fold(0.0, f64::max),
+    );
+    g2 > 1.2 * opts.merge_tol && (g2 - g1).abs() < TORUS_GAP * g2 && z2 > 0.95 * z1
 }
 
 fn judge<D: Dynamics + ?Sized>(
@@ -162,6 +566,7 @@ fn judge<D: Dynamics + ?Sized>(
     y0: &[f64],
     t_end: f64,
     opts: &BasinOptions,
+    early: bool,
 ) -> Result<Outcome> {
     let d = model.ndof();
     let o = model.first_ball();
@@ -169,10 +574,15 @@ fn judge<D: Dynamics + ?Sized>(
     let t_w = t_end - opts.window.min(t_end);
     let iopts = Options::new(opts.rtol, opts.atol);
     let mut solver = Dopri5::new(2 * d);
-    let mut samples: Vec<(f64, Vec<f64>)> = vec![];
+    let mut samples = Samples::new(2 * d);
     let mut next = t_w;
     let mut tmp = vec![0.0; 2 * d];
     let mut at_rest = false;
+    // The early stop's checks look at half the final window (at least one turn per
+    // half of it for the slowest rotation the final window recognises).
+    let check = 0.5 * opts.window;
+    let mut stop = (early && opts.window < t_end).then(|| EarlyStop::new(check, y0));
+    let mut early_out: Option<Outcome> = None;
     let res = solver.integrate(
         |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
         0.0,
@@ -182,12 +592,23 @@ fn judge<D: Dynamics + ?Sized>(
         |_, tb, dense| {
             while next <= tb {
                 dense.eval(next, &mut tmp);
-                samples.push((next, tmp.clone()));
+                samples.push(next, &tmp);
                 next += DT;
             }
             // As `attractors::classify`: a start at rest relative to the disk has
             // fallen into an equilibrium; stop there.
             at_rest = tb > 50.0 && dense.end()[d..].iter().all(|v| v.abs() < 1e-7);
+            if let Some(s) = stop.as_mut() {
+                s.observe(tb, dense, d, o, &mut tmp);
+                if !at_rest && tb >= s.next_check && tb < t_w {
+                    let t_c = (s.next_probe - 1) as f64 * PROBE_DT;
+                    let y_c = s.probe.at(s.probe.len() - 1).to_vec();
+                    if let Some(out) = s.decide(t_c, &y_c, d, o, t_end, opts) {
+                        early_out = Some(out);
+                        return false;
+                    }
+                }
+            }
             !at_rest
         },
     );
@@ -209,31 +630,66 @@ fn judge<D: Dynamics + ?Sized>(
     if y_end.iter().any(|v| !v.is_finite()) {
         return Ok(failed(t_stop));
     }
-    let rest = |y: &[f64]| {
-        let label = if y[0].hypot(y[1]) < opts.rest_tol {
-            Label::PerfectBalance
-        } else {
-            Label::OtherEquilibrium
-        };
-        Outcome {
-            label,
-            pattern: String::new(),
-            omega: 0.0,
-            rates: vec![0.0; n],
-            period: None,
-            t_stop,
-            long_label: None,
-            y_end: y.to_vec(),
-        }
-    };
-    if at_rest || samples.len() < 4 {
-        return Ok(rest(&y_end));
+    if let Some(mut out) = early_out {
+        out.t_stop = t_stop;
+        out.y_end = y_end;
+        return Ok(out);
     }
+    if at_rest || samples.len() < 4 {
+        return Ok(rest_outcome(&y_end, t_stop, n, opts));
+    }
+    Ok(label_window(
+        samples.from(0),
+        DT,
+        &y_end,
+        t_stop,
+        n,
+        d,
+        o,
+        opts,
+    ))
+}
+
+fn rest_outcome(y: &[f64], t_stop: f64, n: usize, opts: &BasinOptions) -> Outcome {
+    let label = if y[0].hypot(y[1]) < opts.rest_tol {
+        Label::PerfectBalance
+    } else {
+        Label::OtherEquilibrium
+    };
+    Outcome {
+        label,
+        pattern: String::new(),
+        omega: 0.0,
+        rates: vec![0.0; n],
+        period: None,
+        t_stop,
+        long_label: None,
+        y_end: y.to_vec(),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+/// The label of the motion sampled in `samples` (at least 4 of them), ending in `y_end`.
+fn label_window(
+    samples: Window<'_>,
+    dt: f64,
+    y_end: &[f64],
+    t_stop: f64,
+    n: usize,
+    d: usize,
+    o: usize,
+    opts: &BasinOptions,
+) -> Outcome {
+    let rest = |y: &[f64]| rest_outcome(y, t_stop, n, opts);
+    let y_end = y_end.to_vec();
     let m = samples.len();
+    if m < 4 {
+        return rest(&y_end);
+    }
     let h = m / 2;
-    let span = |a: usize, b: usize| samples[b].0 - samples[a].0;
+    let span = |a: usize, b: usize| samples.t[b] - samples.t[a];
     let turns =
-        |i: usize, a: usize, b: usize| (samples[b].1[o + i] - samples[a].1[o + i]) / (2.0 * PI);
+        |i: usize, a: usize, b: usize| (samples.at(b)[o + i] - samples.at(a)[o + i]) / (2.0 * PI);
     // A ball rotates when it makes at least one turn in each half of the window.
     let rot1: Vec<bool> = (0..n).map(|i| turns(i, 0, h).abs() >= 1.0).collect();
     let rot2: Vec<bool> = (0..n).map(|i| turns(i, h, m - 1).abs() >= 1.0).collect();
@@ -256,7 +712,7 @@ fn judge<D: Dynamics + ?Sized>(
         y_end: y_end.clone(),
     };
     if rot1 != rot2 {
-        return Ok(unsettled(String::new()));
+        return unsettled(String::new());
     }
     let n_rot = rot2.iter().filter(|&&r| r).count();
     if n_rot > 0 {
@@ -267,7 +723,7 @@ fn judge<D: Dynamics + ?Sized>(
             let r1 = turns(i, 0, h) / span(0, h);
             let r2 = turns(i, h, m - 1) / span(h, m - 1);
             if (r1 - r2).abs() > 0.1 * r1.abs().max(r2.abs()) {
-                return Ok(unsettled(pattern));
+                return unsettled(pattern);
             }
         }
         // Whole-turn crossings of each rotating ball: its period and, over whole
@@ -275,12 +731,12 @@ fn judge<D: Dynamics + ?Sized>(
         // the window would carry).
         let crossings_of = |i: usize| {
             let mut c = vec![];
-            for w in samples.windows(2) {
-                let (a, b) = (w[0].1[o + i], w[1].1[o + i]);
+            for k in 1..m {
+                let (a, b) = (samples.at(k - 1)[o + i], samples.at(k)[o + i]);
                 let (ka, kb) = ((a / (2.0 * PI)).floor(), (b / (2.0 * PI)).floor());
                 if ka != kb {
                     let level = 2.0 * PI * ka.max(kb);
-                    c.push(w[0].0 + (level - a) / (b - a) * DT);
+                    c.push(samples.t[k - 1] + (level - a) / (b - a) * dt);
                 }
             }
             c
@@ -300,9 +756,8 @@ fn judge<D: Dynamics + ?Sized>(
         let omega = (0..n).filter(|&i| rot2[i]).map(|i| rates[i]).sum::<f64>() / n_rot as f64;
         let label = match (n, n_rot) {
             (2, 2) => {
-                let gap = samples
-                    .iter()
-                    .map(|s| wrap(s.1[o] - s.1[o + 1]).abs())
+                let gap = (0..m)
+                    .map(|k| wrap(samples.at(k)[o] - samples.at(k)[o + 1]).abs())
                     .fold(0.0, f64::max);
                 if gap < opts.merge_tol {
                     Label::MergedRR
@@ -313,7 +768,7 @@ fn judge<D: Dynamics + ?Sized>(
             (2, 1) => Label::RO,
             _ => Label::Other,
         };
-        return Ok(Outcome {
+        return Outcome {
             label,
             pattern,
             omega,
@@ -322,31 +777,32 @@ fn judge<D: Dynamics + ?Sized>(
             t_stop,
             long_label: None,
             y_end,
-        });
+        };
     }
     // No ball rotates: at rest, on the way to rest, or oscillating.
     let vmax = |a: usize, b: usize| {
-        samples[a..b]
-            .iter()
-            .flat_map(|s| s.1[d..].iter().map(|v| v.abs()))
+        (a..b)
+            .flat_map(|k| samples.at(k)[d..].iter().map(|v| v.abs()))
             .fold(0.0, f64::max)
     };
     let (v1, v2) = (vmax(0, h), vmax(h, m));
     // Decaying by a fifth or more over half the window: a transient into an
     // equilibrium (the approach to a limit cycle does not take the velocities down).
     if v2 < 1e-6 || v2 < 0.8 * v1 {
-        return Ok(rest(&y_end));
+        return rest(&y_end);
     }
     if v2 > 1.05 * v1 {
-        return Ok(unsettled(pattern)); // still growing
+        return unsettled(pattern); // still growing
     }
-    let xs: Vec<(f64, f64, f64)> = samples.iter().map(|s| (s.0, s.1[0], s.1[d])).collect();
+    let xs: Vec<(f64, f64, f64)> = (0..m)
+        .map(|k| (samples.t[k], samples.at(k)[0], samples.at(k)[d]))
+        .collect();
     let period = match oscillation_period(&xs) {
         Oscillation::Period(_, p) => Some(p),
-        Oscillation::Rest => return Ok(rest(&y_end)),
+        Oscillation::Rest => return rest(&y_end),
         Oscillation::Irregular => None,
     };
-    Ok(Outcome {
+    Outcome {
         label: if n == 2 { Label::OO } else { Label::Other },
         pattern,
         omega: 0.0,
@@ -355,7 +811,7 @@ fn judge<D: Dynamics + ?Sized>(
         t_stop,
         long_label: None,
         y_end,
-    })
+    }
 }
 
 /// Classifies every start (`starts[k]`: the ball angles, at rest in the ground frame)
