@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import numpy as np
 import polars as pl
 
 from ballbal import _check, _native
@@ -19,6 +18,9 @@ from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer
 
 __all__ = ["equilibrium_branch", "equilibrium_curve", "from_seed003", "switch_equilibrium"]
+
+#: The default step control (a module-level value: a frozen dataclass).
+_DEFAULT = Continuation()
 
 #: The curve each event type continues into.
 _CURVE_OF = {"fold": "saddle_node", "hopf": "hopf", "branch_point": "pitchfork"}
@@ -88,7 +90,7 @@ def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, flo
 
 
 def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str = "perfect_balance",
-                       range: tuple[float, float], options: Continuation = Continuation()
+                       range: tuple[float, float], options: Continuation = _DEFAULT
                        ) -> Branch:
     """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
     ``model``, or a kind name: the first equilibrium of that kind) continued in
@@ -148,7 +150,7 @@ def switch_equilibrium(branch: Branch, event_index: int) -> Branch:
 
 
 def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
-                      range: tuple[float, float], options: Continuation = Continuation()
+                      range: tuple[float, float], options: Continuation = _DEFAULT
                       ) -> Curve:
     """The curve of the bifurcation ``branch.events[event_index]`` in (the branch's
     parameter, ``parameter2``), ``range`` bounding ``parameter2``, continued both ways:
@@ -222,6 +224,3 @@ def from_seed003(m0: float = 2.0, omega0: float = 1.5, e: float = 2.0, C0: float
     return Balancer(mu=1.0 / (1.0 + 2.0 * m0), zeta=C0 / s, zeta_b=D0 * s / 2.0,
                     delta=1.0 / e, Omega=omega0 * s, eta=(m0 / e, m0 / e))
 
-
-def _as_array(v: Any) -> np.ndarray:  # pragma: no cover - helper for plots
-    return np.asarray(v, dtype=float)
