@@ -11,7 +11,7 @@ import pytest
 from scipy.optimize import brentq
 
 import ballbal
-from ballbal._branch import Continuation
+from ballbal._branch import Branch, Continuation
 from ballbal.continuation import (
     equilibrium_branch,
     equilibrium_curve,
@@ -27,7 +27,7 @@ def eta_fold(om: np.ndarray, zeta: float) -> np.ndarray:
     return np.sqrt(0.25 + (1 - om**2) ** 2 / (16 * zeta**2 * om**2))
 
 
-def together_branch(om: float = 1.05, zeta: float = 0.05) -> ballbal.continuation.Branch:  # type: ignore[name-defined]
+def together_branch(om: float = 1.05, zeta: float = 0.05) -> Branch:
     b = ballbal.Balancer(mu=0.2, zeta=zeta, zeta_b=0.1, delta=50, Omega=om, eta=(0.3, 0.3))
     return equilibrium_branch(b, "eta", start="together", range=(0.2, 1.0), options=OPTS)
 
