@@ -272,7 +272,7 @@ pub fn equilibrium_curve<'py>(
 }
 
 fn options_checked(m: &Model, args: &ContinuationArgs, range: (f64, f64)) -> PyResult<EqOptions> {
-    if !(range.0 < range.1) || !range.0.is_finite() || !range.1.is_finite() {
+    if range.0 >= range.1 || !range.0.is_finite() || !range.1.is_finite() {
         return Err(Error::param(
             "range",
             format!("needs finite lo < hi, got ({}, {})", range.0, range.1),
