@@ -152,7 +152,14 @@ def bearing_balancer(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "bearing_balancer.png"]
 
 
+def seed003(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # both planes get the together saddle-node and the perfect balance's Hopf curve
+    assert stdout.count("saddle_node curve") == 2 and stdout.count("hopf curve") == 2, stdout
+    return [out / "seed003.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "seed003.py": seed003,
     "seed002.py": seed002,
     "accuracy_cost.py": accuracy_cost,
     "thesis_maps.py": thesis_maps,

@@ -17,7 +17,8 @@ from .options import PeriodicOptions, ScanOptions
 from .scene import Scene
 
 __all__ = [
-    "simulate", "validate", "equilibria", "balanced_states", "periodic", "orbit_closure",
+    "simulate", "validate", "equilibria", "balanced_states", "equilibrium_branch",
+    "equilibrium_switch", "equilibrium_curve", "periodic", "orbit_closure",
     "balance_map", "scan", "default_chunk", "certificate_seconds", "scan_stage_seconds",
     "validate_bearing",
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
@@ -52,6 +53,14 @@ def groove_study(
 ) -> dict[str, list[Any]]: ...
 def equilibria(model: Balancer | Scene) -> list[dict[str, Any]]: ...
 def balanced_states(models: Sequence[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
+def equilibrium_branch(model: Balancer | Scene, parameter: str, q: Sequence[float], kind: str,
+                       range: tuple[float, float], options: Any) -> dict[str, Any]: ...
+def equilibrium_switch(model: Balancer | Scene, parameter: str, x: Sequence[float], p: float,
+                       tangent: Sequence[float], range: tuple[float, float],
+                       options: Any) -> dict[str, Any]: ...
+def equilibrium_curve(model: Balancer | Scene, kind: str, parameter: str, parameter2: str,
+                      q: Sequence[float], p1: float, together: bool,
+                      range: tuple[float, float], options: Any) -> dict[str, Any]: ...
 # (status, equilibrium dict or None) per point: "ok", "no_balance" or "not_converged"
 def balance_map(
     model: Balancer | Scene, names: list[str], points: list[list[float]],

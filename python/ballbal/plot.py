@@ -21,10 +21,12 @@ def _pyplot() -> Any:
 
 def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = "R-R",
              ax: Any = None, title: str | None = None,
-             shade: str = "perfect balance stable") -> Any:
+             shade: str = "perfect balance stable", curves: Any = ()) -> Any:
     """The thesis' map (figures 3-6 to 3-16): solutions of ``type`` over the (x, y) plane,
     stable and unstable markers, and the perfect balance's stable region shaded (for a
-    scene with springs, its balanced state's: name it with ``shade``)."""
+    scene with springs, its balanced state's: name it with ``shade``). ``curves``:
+    :class:`~ballbal.continuation` curves (``Curve`` objects whose tables have the columns
+    ``x`` and ``y``) drawn over the map, with their codimension-two points."""
     plt = _pyplot()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))
@@ -45,6 +47,14 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
         if s.height:
             ax.scatter(s[x], s[y], marker=m, color=c, s=28, label=f"{type} {verdict}",
                        facecolors="none" if m == "o" and verdict != "stable" else None)
+    for cv in curves:
+        t = cv.table
+        for col in (x, y):
+            if col not in t.columns:
+                raise ValueError(f"curves: a {cv.kind} curve has no column {col!r}")
+        ax.plot(t[x], t[y], "-" if cv.kind != "hopf" else "--", lw=1.5, label=cv.kind)
+        if cv.points.height:
+            ax.plot(cv.points[x], cv.points[y], "k*", ms=9)
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     ax.set_title(title or f"{type} solutions")

@@ -7,10 +7,10 @@
 
 mod basins;
 mod bearing;
-#[allow(dead_code)] // used by the continuation entries being added (issue 15)
 mod continuation;
 mod convert;
 mod entries;
+mod eq_continuation;
 mod errors;
 mod groove;
 mod rotor;
@@ -75,6 +75,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bearing::bearing_coefficients, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_stability, m)?)?;
     basins::register(m)?;
+    eq_continuation::register(m)?;
     m.add_function(wrap_pyfunction!(groove::groove_study, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

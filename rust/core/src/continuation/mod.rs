@@ -11,6 +11,7 @@
 
 pub mod arclength;
 pub mod curves;
+pub mod equilibria;
 pub mod lattice;
 pub mod natural;
 

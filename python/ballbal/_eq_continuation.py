@@ -1,0 +1,226 @@
+"""Continuation of equilibria: one-parameter branches with their stability and located
+events (fold, Hopf, branch point / pitchfork), branch switching at a branch point, and
+two-parameter curves of those bifurcations (the core's
+``rust/core/src/continuation/equilibria.rs``); and seed 003's nondimensionalisation.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import polars as pl
+
+from ballbal import _check, _native
+from ballbal._branch import Branch, Continuation, Curve
+from ballbal.analysis import Equilibrium, _equilibrium, equilibria
+from ballbal.exceptions import ParameterError, ParameterTypeError
+from ballbal.model import Balancer
+
+__all__ = ["equilibrium_branch", "equilibrium_curve", "from_seed003", "switch_equilibrium"]
+
+#: The default step control (a module-level value: a frozen dataclass).
+_DEFAULT = Continuation()
+
+#: The curve each event type continues into.
+_CURVE_OF = {"fold": "saddle_node", "hopf": "hopf", "branch_point": "pitchfork"}
+
+
+def _range(v: Any) -> tuple[float, float]:
+    try:
+        lo, hi = v
+    except (TypeError, ValueError):
+        raise ParameterTypeError("range", f"must be a pair (lo, hi), got {v!r}") from None
+    lo = _check.real("range", lo)
+    hi = _check.real("range", hi)
+    if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ParameterError("range", f"needs finite lo < hi, got ({lo}, {hi})")
+    return lo, hi
+
+
+def _options(options: Any) -> Continuation:
+    if not isinstance(options, Continuation):
+        raise ParameterTypeError("options", f"must be a Continuation, got {type(options).__name__}")
+    return options
+
+
+def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, float],
+            options: Continuation) -> Branch:
+    pts = d["points"]
+    evs = d["events"]
+    marks: list[str | None] = [None] * len(pts)
+    for e in evs:
+        r = e["row"]
+        marks[r] = e["type"] if marks[r] is None else f"{marks[r]},{e['type']}"
+    table = pl.DataFrame({
+        parameter: [p["p"] for p in pts],
+        "q": [list(map(float, p["q"])) for p in pts],
+        "kind": [p["kind"] for p in pts],
+        "stability": [p["stability"] for p in pts],
+        "max_real": [p["index"] for p in pts],
+        "eig_re": [list(map(float, p["eig_re"])) for p in pts],
+        "eig_im": [list(map(float, p["eig_im"])) for p in pts],
+        "test_fold": [p["test_fold"] for p in pts],
+        "test_branch_point": [p["test_branch_point"] for p in pts],
+        "test_hopf": [p["test_hopf"] for p in pts],
+        "event": pl.Series(marks, dtype=pl.String),
+    }, schema_overrides={"q": pl.List(pl.Float64), "eig_re": pl.List(pl.Float64),
+                         "eig_im": pl.List(pl.Float64)})
+    events = pl.DataFrame({
+        "type": [e["type"] for e in evs],
+        parameter: [e["p"] for e in evs],
+        "q": [list(map(float, e["q"])) for e in evs],
+        "kind": [e["kind"] for e in evs],
+        "stability": [e["stability"] for e in evs],
+        "max_real": [e["index"] for e in evs],
+        "omega": [e["omega"] for e in evs],
+        "test": [e["test"] for e in evs],
+        "row": [e["row"] for e in evs],
+    }, schema={"type": pl.String, parameter: pl.Float64, "q": pl.List(pl.Float64),
+               "kind": pl.String, "stability": pl.String, "max_real": pl.Float64,
+               "omega": pl.Float64, "test": pl.Float64, "row": pl.Int64})
+    return Branch(
+        kind="equilibrium", parameter=parameter, table=table, events=events, stop=d["stop"],
+        solutions=tuple(_equilibrium(p) for p in pts),
+        event_solutions=tuple(_equilibrium(e) for e in evs),
+        meta={"model": model, "range": rng, "options": options,
+              "event_x": [list(e["x"]) for e in evs],
+              "event_tangent": [list(e["tangent"]) for e in evs]},
+    )
+
+
+def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str = "perfect_balance",
+                       range: tuple[float, float], options: Continuation = _DEFAULT
+                       ) -> Branch:
+    """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
+    ``model``, or a kind name: the first equilibrium of that kind) continued in
+    ``parameter`` (any name ``with_param`` takes: ``"Omega"``, ``"eta"`` (all balls),
+    ``"eta[1]"``, ``"zeta"``, ``"zeta_b"``, ``"mu"``, ``"delta"``, scene parameters) by
+    pseudo-arclength over ``range``, through folds.
+
+    ``table``: one row per point (the parameter, ``q``, ``kind``, ``stability``,
+    ``max_real``, the eigenvalues, the test functions ``test_fold`` (dp/ds),
+    ``test_branch_point`` (the bordered determinant, or on the balls-together branch the
+    antisymmetric ball mode's stiffness), ``test_hopf`` (the bialternate-product
+    determinant) and ``event``, the events located since the previous row). ``events``:
+    fold, Hopf (with its frequency ``omega``) and branch points, located to ~1e-11 in
+    arclength."""
+    _check.model("model", model)
+    parameter = _check.string("parameter", parameter)
+    rng = _range(range)
+    options = _options(options)
+    if isinstance(start, str):
+        found = [e for e in equilibria(model) if e.kind == start]
+        if not found:
+            raise ParameterError("start", f"the model has no {start!r} equilibrium",
+                                 allowed="perfect_balance, balanced, together, opposite, "
+                                         "unbalanced")
+        start = found[0]
+    if not isinstance(start, Equilibrium):
+        raise ParameterTypeError("start", "must be an Equilibrium or a kind name")
+    d = _native.equilibrium_branch(model, parameter, [float(v) for v in start.q], start.kind,
+                                   rng, options)
+    return _branch(d, parameter, model, rng, options)
+
+
+def _event(branch: Any, event_index: Any) -> int:
+    if not isinstance(branch, Branch) or branch.kind != "equilibrium":
+        raise ParameterTypeError("branch", "must be a Branch of equilibria")
+    i = _check.integer("event_index", event_index, 0)
+    if i >= branch.events.height:
+        raise ParameterError("event_index", f"the branch has {branch.events.height} events",
+                             value=i)
+    return i
+
+
+def switch_equilibrium(branch: Branch, event_index: int) -> Branch:
+    """The other branch through the branch point ``branch.events[event_index]`` (e.g. the
+    perfect balance born at the pitchfork of the balls-together branch, eta = 1/2 for two
+    balls), started along the null vector of ``[F_q, F_p]`` orthogonal to the branch's
+    tangent, over the same range with the same options."""
+    i = _event(branch, event_index)
+    if branch.events["type"][i] != "branch_point":
+        raise ParameterError("event_index", f"event {i} is a {branch.events['type'][i]}, "
+                             "not a branch point", allowed="branch_point")
+    m = branch.meta
+    d = _native.equilibrium_switch(m["model"], branch.parameter, m["event_x"][i],
+                                   float(branch.events[branch.parameter][i]),
+                                   m["event_tangent"][i], m["range"], m["options"])
+    return _branch(d, branch.parameter, m["model"], m["range"], m["options"])
+
+
+def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
+                      range: tuple[float, float], options: Continuation = _DEFAULT
+                      ) -> Curve:
+    """The curve of the bifurcation ``branch.events[event_index]`` in (the branch's
+    parameter, ``parameter2``), ``range`` bounding ``parameter2``, continued both ways:
+    a fold gives the saddle-node curve, a Hopf point the Hopf curve (with ``omega``), a
+    branch point of the balls-together branch the pitchfork curve (folds and pitchforks
+    of that branch are continued on its invariant subspace ``b_1 = ... = b_n``).
+
+    ``points`` lists the codimension-two points found: ``"BT"`` (a double zero
+    eigenvalue, e.g. (Omega, eta) = (1, 1/2) for two balls), ``"ZH"`` (zero-Hopf),
+    ``"cusp"`` (the curve reverses in the parameter plane), ``"pitchfork"`` (a
+    saddle-node curve meets the pitchfork)."""
+    i = _event(branch, event_index)
+    parameter2 = _check.string("parameter2", parameter2)
+    rng = _range(range)
+    options = _options(options)
+    etype = branch.events["type"][i]
+    kind = _CURVE_OF[etype]
+    ekind = branch.events["kind"][i]
+    together = ekind == "together" and etype in ("fold", "branch_point")
+    if etype == "branch_point" and not together:
+        raise ParameterError("event_index", "curves of branch points are continued for the "
+                             "pitchfork of the balls-together branch only",
+                             allowed="fold, hopf, or a together branch point")
+    m = branch.meta
+    d = _native.equilibrium_curve(m["model"], kind, branch.parameter, parameter2,
+                                  m["event_x"][i], float(branch.events[branch.parameter][i]),
+                                  together, rng, options)
+    p1, p2 = branch.parameter, parameter2
+    pts = d["points"]
+    table = pl.DataFrame({
+        p1: [p["p1"] for p in pts],
+        p2: [p["p2"] for p in pts],
+        "q": [list(map(float, p["q"])) for p in pts],
+        "kind": [p["kind"] for p in pts],
+        "stability": [p["stability"] for p in pts],
+        "max_real": [p["index"] for p in pts],
+        "omega": [p["omega"] for p in pts],
+        "test": [p["test"] for p in pts],
+    }, schema_overrides={"q": pl.List(pl.Float64)})
+    sp = d["special"]
+    points = pl.DataFrame({
+        "type": [s["type"] for s in sp],
+        p1: [s["p1"] for s in sp],
+        p2: [s["p2"] for s in sp],
+        "q": [list(map(float, s["q"])) for s in sp],
+        "row": [s["row"] for s in sp],
+    }, schema={"type": pl.String, p1: pl.Float64, p2: pl.Float64, "q": pl.List(pl.Float64),
+               "row": pl.Int64})
+    return Curve(kind=d["kind"], parameters=(p1, p2), table=table, points=points,
+                 stop=d["stop"], meta={"model": m["model"], "range": rng, "options": options})
+
+
+def from_seed003(m0: float = 2.0, omega0: float = 1.5, e: float = 2.0, C0: float = 0.35,
+                 D0: float = 0.35) -> Balancer:
+    """The two-ball balancer of seed 003 in its own units: lengths over the track radius
+    R, time over ``1/w_n`` with ``w_n = sqrt(K/M)`` of the disk mass ``M`` alone,
+    ``m0 = m/M`` (each ball), ``omega0 = w/w_n``, ``e = eps/R``, ``C0 = C/(2 sqrt(K M))``,
+    ``D0 = D/(m R^2 w_n)`` (``D`` the balls' torque damping). In this package's units
+    (model.md: the total mass ``M + 2m``, lengths over the eccentricity):
+    ``mu = 1/(1 + 2 m0)``, ``eta = m0/e``, ``delta = 1/e``,
+    ``Omega = omega0 sqrt(1 + 2 m0)``, ``zeta = C0/sqrt(1 + 2 m0)``,
+    ``zeta_b = D0 sqrt(1 + 2 m0)/2``. The seed's defaults (its table 2) are the
+    defaults; its curves meet at ``(omega0, m0) = (1/sqrt(1 + 2 m0), e/2)``, i.e.
+    (Omega, eta) = (1, 1/2)."""
+    m0 = _check.real("m0", m0, 0.0, math.inf, lo_open=True)
+    omega0 = _check.real("omega0", omega0, 0.0, math.inf)
+    e = _check.real("e", e, 0.0, math.inf, lo_open=True)
+    C0 = _check.real("C0", C0, 0.0, math.inf)
+    D0 = _check.real("D0", D0, 0.0, math.inf)
+    s = math.sqrt(1.0 + 2.0 * m0)
+    return Balancer(mu=1.0 / (1.0 + 2.0 * m0), zeta=C0 / s, zeta_b=D0 * s / 2.0,
+                    delta=1.0 / e, Omega=omega0 * s, eta=(m0 / e, m0 / e))
+

@@ -1,0 +1,292 @@
+//! Continuation of equilibria (`ballbal.continuation`): branches with events, switching
+//! at a branch point, two-parameter bifurcation curves. Glue only: the core's
+//! `continuation::equilibria` does the work, off the GIL.
+
+use crate::continuation::ContinuationArgs;
+use crate::convert::{dispatch, Model, ModelArgs};
+use crate::errors::{not_autonomous, CoreResult};
+use crate::run::guarded;
+use crate::tables::equilibrium_dict;
+use ballbal_core::continuation::equilibria::{
+    branch, curve, switch, CurveKind, EqBranch, EqCurve, EqOptions, EqSystem,
+};
+use ballbal_core::continuation::ArcStop;
+use ballbal_core::equilibria::EquilibriumKind;
+use ballbal_core::numerics::problem::Parametric;
+use ballbal_core::periodic::require_autonomous;
+use ballbal_core::{Error, Result};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+fn model(m: &ModelArgs) -> PyResult<Model> {
+    let built = m.build(false).py()?;
+    if let Model::Scene(s) = &built {
+        require_autonomous(s).map_err(|e| not_autonomous(e, "equilibrium continuation"))?;
+    }
+    Ok(built)
+}
+
+fn options(m: &Model, args: &ContinuationArgs, range: (f64, f64)) -> EqOptions {
+    EqOptions {
+        arc: args.options(range),
+        // with ball springs the perfect balance is no family
+        family: !matches!(m, Model::Scene(s) if s.springs != 0.0),
+        ..Default::default()
+    }
+}
+
+fn stop_str(s: &ArcStop) -> String {
+    match s {
+        ArcStop::MaxPoints => "max_points".into(),
+        ArcStop::Boundary => "boundary".into(),
+        ArcStop::StepTooSmall => "step_too_small".into(),
+        ArcStop::Finished(w) => w.clone(),
+        ArcStop::Failed(w) => format!("failed: {w}"),
+    }
+}
+
+fn kind_from(name: &str) -> Result<EquilibriumKind> {
+    Ok(match name {
+        "perfect_balance" => EquilibriumKind::PerfectBalance,
+        "balanced" => EquilibriumKind::Balanced,
+        "together" => EquilibriumKind::Together,
+        "opposite" => EquilibriumKind::Opposite,
+        "unbalanced" => EquilibriumKind::Unbalanced,
+        other => {
+            return Err(Error::param_range(
+                "start",
+                format!("unknown equilibrium kind {other:?}"),
+                "perfect_balance, balanced, together, opposite, unbalanced",
+            ))
+        }
+    })
+}
+
+fn check_q(q: &[f64], d: usize) -> Result<()> {
+    if q.len() != d || q.iter().any(|v| !v.is_finite()) {
+        return Err(Error::param(
+            "start",
+            format!("needs {d} finite coordinates, got {}", q.len()),
+        ));
+    }
+    Ok(())
+}
+
+fn run_branch<D: Parametric>(
+    d: &D,
+    parameter: &str,
+    q: &[f64],
+    kind: EquilibriumKind,
+    opts: &EqOptions,
+) -> Result<EqBranch> {
+    check_q(q, d.ndof())?;
+    let mut sys = EqSystem::family(d, &[parameter])?;
+    let p0 = d.param_value(parameter)?;
+    branch(&mut sys, q, p0, kind, None, opts)
+}
+
+fn run_switch<D: Parametric>(
+    d: &D,
+    parameter: &str,
+    x: &[f64],
+    p: f64,
+    tangent: &[f64],
+    opts: &EqOptions,
+) -> Result<EqBranch> {
+    check_q(x, d.ndof())?;
+    if tangent.len() != x.len() + 1 {
+        return Err(Error::param("event", "tangent of the wrong length"));
+    }
+    let mut sys = EqSystem::family(d, &[parameter])?;
+    switch(&mut sys, x, p, tangent, opts)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_curve<D: Parametric>(
+    d: &D,
+    kind: CurveKind,
+    names: (&str, &str),
+    q: &[f64],
+    p1: f64,
+    together: bool,
+    opts: &EqOptions,
+) -> Result<EqCurve> {
+    check_q(q, d.ndof())?;
+    if names.0 == names.1 {
+        return Err(Error::param(
+            "parameter2",
+            format!("must differ from the branch's parameter {:?}", names.0),
+        ));
+    }
+    let p2 = d.param_value(names.1)?;
+    let mut sys = EqSystem::family(d, &[names.0, names.1])?;
+    if together {
+        sys = sys.on_together()?;
+    }
+    curve(sys, kind, q, p1, p2, opts)
+}
+
+fn branch_dict(py: Python<'_>, b: EqBranch) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    let mut points = vec![];
+    for pt in b.points {
+        let d = equilibrium_dict(py, pt.eq)?;
+        d.set_item("p", pt.p)?;
+        d.set_item("x", pt.x)?;
+        d.set_item("tangent", pt.tangent)?;
+        d.set_item("test_fold", pt.fold)?;
+        d.set_item("test_branch_point", pt.bp)?;
+        d.set_item("test_hopf", pt.hopf)?;
+        points.push(d);
+    }
+    let mut events = vec![];
+    for e in b.events {
+        let d = equilibrium_dict(py, e.eq)?;
+        d.set_item("type", e.kind.as_str())?;
+        d.set_item("row", e.row)?;
+        d.set_item("p", e.p)?;
+        d.set_item("x", e.x)?;
+        d.set_item("tangent", e.tangent)?;
+        d.set_item("test", e.test)?;
+        d.set_item("omega", e.omega)?;
+        events.push(d);
+    }
+    out.set_item("points", points)?;
+    out.set_item("events", events)?;
+    out.set_item("stop", stop_str(&b.stop))?;
+    Ok(out)
+}
+
+fn curve_dict(py: Python<'_>, c: EqCurve) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    let mut points = vec![];
+    for pt in c.points {
+        let d = equilibrium_dict(py, pt.eq)?;
+        d.set_item("p1", pt.p[0])?;
+        d.set_item("p2", pt.p[1])?;
+        d.set_item("omega", pt.omega)?;
+        d.set_item("test", pt.g)?;
+        points.push(d);
+    }
+    let mut special = vec![];
+    for s in c.special {
+        let d = PyDict::new(py);
+        d.set_item("type", s.kind)?;
+        d.set_item("p1", s.p[0])?;
+        d.set_item("p2", s.p[1])?;
+        d.set_item("q", s.q)?;
+        d.set_item("row", s.row)?;
+        special.push(d);
+    }
+    out.set_item("kind", c.kind.as_str())?;
+    out.set_item("points", points)?;
+    out.set_item("special", special)?;
+    out.set_item(
+        "stop",
+        format!("{}/{}", stop_str(&c.stop[0]), stop_str(&c.stop[1])),
+    )?;
+    Ok(out)
+}
+
+/// A branch of equilibria from `q` (the model's equilibrium of kind `kind`) in
+/// `parameter` over `range`: a dict of `points`, `events` and `stop`.
+#[pyfunction]
+#[pyo3(signature = (model, parameter, q, kind, range, options))]
+pub fn equilibrium_branch<'py>(
+    py: Python<'py>,
+    model: ModelArgs,
+    parameter: String,
+    q: Vec<f64>,
+    kind: String,
+    range: (f64, f64),
+    options: ContinuationArgs,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = self::model(&model)?;
+    let k = kind_from(&kind).py()?;
+    let opts = options_checked(&m, &options, range)?;
+    let b = guarded(py, || {
+        dispatch!(&m, d => run_branch(d, &parameter, &q, k, &opts))
+    })?;
+    branch_dict(py, b)
+}
+
+/// The other branch through a branch point `(x, p)` reached along `tangent`.
+#[pyfunction]
+#[pyo3(signature = (model, parameter, x, p, tangent, range, options))]
+#[allow(clippy::too_many_arguments)]
+pub fn equilibrium_switch<'py>(
+    py: Python<'py>,
+    model: ModelArgs,
+    parameter: String,
+    x: Vec<f64>,
+    p: f64,
+    tangent: Vec<f64>,
+    range: (f64, f64),
+    options: ContinuationArgs,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = self::model(&model)?;
+    let opts = options_checked(&m, &options, range)?;
+    let b = guarded(py, || {
+        dispatch!(&m, d => run_switch(d, &parameter, &x, p, &tangent, &opts))
+    })?;
+    branch_dict(py, b)
+}
+
+/// The curve of `kind` (`"saddle_node"`, `"hopf"`, `"pitchfork"`) through the event
+/// `(q, p1)` in `(parameter, parameter2)`, `range` bounding `parameter2`; `together`:
+/// on the balls-together subspace.
+#[pyfunction]
+#[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options))]
+#[allow(clippy::too_many_arguments)]
+pub fn equilibrium_curve<'py>(
+    py: Python<'py>,
+    model: ModelArgs,
+    kind: String,
+    parameter: String,
+    parameter2: String,
+    q: Vec<f64>,
+    p1: f64,
+    together: bool,
+    range: (f64, f64),
+    options: ContinuationArgs,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = self::model(&model)?;
+    let k = match kind.as_str() {
+        "saddle_node" => CurveKind::Fold,
+        "hopf" => CurveKind::Hopf,
+        "pitchfork" => CurveKind::Pitchfork,
+        other => {
+            return Err(Error::param_range(
+                "kind",
+                format!("unknown curve kind {other:?}"),
+                "saddle_node, hopf, pitchfork",
+            ))
+            .py()
+        }
+    };
+    let opts = options_checked(&m, &options, range)?;
+    let c = guarded(py, || {
+        dispatch!(&m, d => run_curve(d, k, (&parameter, &parameter2), &q, p1, together, &opts))
+    })?;
+    curve_dict(py, c)
+}
+
+fn options_checked(m: &Model, args: &ContinuationArgs, range: (f64, f64)) -> PyResult<EqOptions> {
+    if range.0 >= range.1 || !range.0.is_finite() || !range.1.is_finite() {
+        return Err(Error::param(
+            "range",
+            format!("needs finite lo < hi, got ({}, {})", range.0, range.1),
+        ))
+        .py();
+    }
+    let o = options(m, args, range);
+    o.arc.validate().py()?;
+    Ok(o)
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(equilibrium_branch, m)?)?;
+    m.add_function(wrap_pyfunction!(equilibrium_switch, m)?)?;
+    m.add_function(wrap_pyfunction!(equilibrium_curve, m)?)?;
+    Ok(())
+}
