@@ -58,6 +58,7 @@ def balance_map(
 def periodic(
     model: Balancer | Scene, pattern: str, options: PeriodicOptions,
     guess: tuple[float, npt.NDArray[np.float64]] | None = None,
+    windings: list[int] | None = None,
 ) -> dict[str, Any]: ...
 def orbit_closure(
     model: Balancer | Scene, omega: float, coeffs: npt.NDArray[np.float64],

@@ -141,7 +141,7 @@ pub fn classify<D: Dynamics + ?Sized>(
     n_harm: usize,
     g: &GuessOptions,
 ) -> Attractor {
-    classify_as(model, y0, None, n_harm, g)
+    classify_as(model, y0, None, 1, n_harm, g)
 }
 
 /// Tries to turn one simulated attractor into a harmonic-balance starting guess.
@@ -156,7 +156,21 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     n_harm: usize,
     g: &GuessOptions,
 ) -> Option<HbSolution> {
-    classify_as(model, y0, rotating, n_harm, g).into_series()
+    classify_as(model, y0, rotating, 1, n_harm, g).into_series()
+}
+
+/// [`guess_from_state`] for an orbit on which the first rotating ball makes `turns`
+/// whole turns per period (a period-doubled orbit: 2): the period is measured over
+/// `turns` successive turns, whose durations may differ from each other.
+pub fn guess_with_turns<D: Dynamics + ?Sized>(
+    model: &D,
+    y0: &[f64],
+    rotating: &[bool],
+    turns: usize,
+    n_harm: usize,
+    g: &GuessOptions,
+) -> Option<HbSolution> {
+    classify_as(model, y0, Some(rotating), turns.max(1), n_harm, g).into_series()
 }
 
 /// [`classify`], stopping early (as `OtherPattern`) when `want` is given and the
@@ -165,6 +179,7 @@ fn classify_as<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
     want: Option<&[bool]>,
+    turns: usize,
     n_harm: usize,
     g: &GuessOptions,
 ) -> Attractor {
@@ -197,7 +212,7 @@ fn classify_as<D: Dynamics + ?Sized>(
     let mut end_b = start_b.clone();
     let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
     let mut tmp = vec![0.0; 2 * d];
-    let need = 6;
+    let need = 6.max(2 * turns + 2);
     let mut solver = Dopri5::new(2 * d);
     let res = solver.integrate(
         |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
@@ -248,7 +263,7 @@ fn classify_as<D: Dynamics + ?Sized>(
     }
     let r = detected.iter().position(|&b| b);
     let (t_c, period) = if let Some(r) = r {
-        match turn_period(&crossings[r]) {
+        match turns_period(&crossings[r], turns) {
             Some(p) => p,
             None => return NotSettled,
         }
@@ -310,12 +325,17 @@ fn classify_as<D: Dynamics + ?Sized>(
 /// whole turns: the last two intervals must agree to 2 % (else the motion is
 /// quasi-periodic, chaotic or not settled: `None`).
 pub(crate) fn turn_period(crossings: &[f64]) -> Option<(f64, f64)> {
-    if crossings.len() < 3 {
+    turns_period(crossings, 1)
+}
+
+/// [`turn_period`] over `m` turns per period.
+fn turns_period(crossings: &[f64], m: usize) -> Option<(f64, f64)> {
+    if crossings.len() < 2 * m + 1 {
         return None;
     }
     let k = crossings.len();
-    let t1 = crossings[k - 1] - crossings[k - 2];
-    let t2 = crossings[k - 2] - crossings[k - 3];
+    let t1 = crossings[k - 1] - crossings[k - 1 - m];
+    let t2 = crossings[k - 1 - m] - crossings[k - 1 - 2 * m];
     if (t1 - t2).abs() > 0.02 * t1 {
         return None; // not periodic (quasi-periodic or chaotic)
     }
@@ -395,7 +415,7 @@ mod tests {
             other => panic!("{}", other.as_str()),
         }
         // With a filter for another pattern the search stops at the pattern.
-        let filtered = classify_as(&p, y0, Some(&[false, false]), 3, &GuessOptions::default());
+        let filtered = classify_as(&p, y0, Some(&[false, false]), 1, 3, &GuessOptions::default());
         assert!(
             matches!(filtered, Attractor::OtherPattern { ref rotating } if rotating == &[true, true])
         );
