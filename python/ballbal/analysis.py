@@ -417,6 +417,11 @@ def periodic(
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
     d = _native.periodic(model, pattern, options,
                          None if go is None or gc is None else (go, gc), wind)
+    return _solution(model, d)
+
+
+def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:
+    """A :class:`PeriodicSolution` from the binding's dict."""
     mult = d["mult_re"] + 1j * d["mult_im"] if d["mult_re"] is not None else None
     hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None
     return PeriodicSolution(

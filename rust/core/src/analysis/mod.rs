@@ -10,3 +10,4 @@ pub mod journal;
 pub mod periodic;
 pub mod record;
 pub mod simulate;
+pub mod switch;
