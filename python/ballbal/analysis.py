@@ -318,6 +318,24 @@ def _windings(windings: Any) -> list[int]:
     return [_check.integer("windings", w, -16, 16) for w in items]
 
 
+def _homotopy(model: Balancer | Scene, homotopy: Any) -> list[tuple[str, float]]:
+    """The ``(parameter, value)`` starts of ``periodic(homotopy=...)``."""
+    if homotopy is True:
+        om = model.Omega if isinstance(model, Balancer) else model.balancer.Omega
+        starts = [("Omega", om + d) for d in (-0.1, 0.1, -0.2, 0.2) if om + d > 0]
+        return starts + [("eta", 1.0)]
+    items = list(homotopy.items()) if isinstance(homotopy, dict) else _check.sequence(
+        "homotopy", homotopy)
+    out = []
+    for item in items:
+        if not (isinstance(item, (tuple, list)) and len(item) == 2):
+            raise ParameterTypeError("homotopy", "must be True, {name: value} or pairs "
+                                     f"(name, value), got {item!r:.60}", value=homotopy)
+        out.append((_check.string("homotopy", item[0]),
+                    _check.real("homotopy", item[1], finite=True)))
+    return out
+
+
 @_check.renamed_model("balancer")
 def periodic(
     model: Balancer | Scene,
@@ -326,6 +344,7 @@ def periodic(
     options: PeriodicOptions | None = None,
     guess: PeriodicSolution | tuple[float, np.ndarray] | None = None,
     windings: Sequence[int] | None = None,
+    homotopy: bool | dict[str, float] | Sequence[tuple[str, float]] | None = None,
     **keywords: Any,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
@@ -357,6 +376,16 @@ def periodic(
     :class:`PeriodicSolution` lends its windings when ``windings`` is not given. Wrong
     lengths, zeros on ``R`` balls or non-integers raise
     :class:`~ballbal.exceptions.ParameterError` naming ``windings``.
+
+    ``homotopy``: where no simulated start reaches the pattern although a stable orbit
+    exists (every start settling to the perfect balance, as at the thesis' R-R point of
+    its table 4-7), find the orbit at a nearby parameter point instead and follow it
+    here by natural-parameter continuation (secant predictor, each step certified, the
+    step halved on failure). ``True`` tries ``Omega`` 0.1 and 0.2 below and above the
+    model's, then ``eta = 1``; a dict ``{"Omega": 1.2}`` or pairs ``[("Omega", 1.2)]``
+    give the starts to try, in order. Only used without ``guess`` and only when
+    simulation here finds nothing. ``info["guess_source"]`` says how every result was
+    found: ``"simulation"``, ``"guess"`` or ``"homotopy from Omega=1.2"``.
 
     ``N="auto"`` starts at 3 and raises the harmonics (solving from the last) until the
     highest harmonic relative to the motion (``tail``) and the trivial multiplier's
@@ -415,9 +444,12 @@ def periodic(
             raise ParameterTypeError("guess", "must be a PeriodicSolution or (omega, coeffs), "
                                      f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
+    starts = None if homotopy is None or homotopy is False else _homotopy(model, homotopy)
     d = _native.periodic(model, pattern, options,
-                         None if go is None or gc is None else (go, gc), wind)
-    return _solution(model, d)
+                         None if go is None or gc is None else (go, gc), wind, starts)
+    out = _solution(model, d)
+    out.info["guess_source"] = d["guess_source"]
+    return out
 
 
 def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:

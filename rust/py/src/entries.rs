@@ -7,6 +7,7 @@ use crate::convert::{dispatch, slice, Model, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::{guarded, run_polled};
 use crate::tables::{equilibrium_dict, scan_columns, solution_dict, Columns};
+use ballbal_core::analysis::homotopy::{periodic_homotopy, source_of};
 use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::ode::Options;
@@ -240,8 +241,10 @@ pub(crate) fn start(m: &Model, ball_winding: &[f64], w: f64, c: &[f64]) -> PyRes
 /// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers;
 /// `guess` is `(omega, coefficients)` or `None` (a simulated start); `windings` the
 /// balls' turns per period (`None`: -1 for each `R`, 0 for each `O`).
+/// `homotopy`: `(parameter, value)` starts to follow from when simulation finds no
+/// orbit here (`analysis::homotopy`); the dict's `guess_source` says how it was found.
 #[pyfunction]
-#[pyo3(signature = (model, pattern, options, guess=None, windings=None))]
+#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None))]
 pub fn periodic<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -249,6 +252,7 @@ pub fn periodic<'py>(
     options: PeriodicArgs,
     guess: Option<(f64, PyReadonlyArray1<'py, f64>)>,
     windings: Option<Vec<i64>>,
+    homotopy: Option<Vec<(String, f64)>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = autonomous(&model, false, "periodic")?;
     let ball_winding = parse_windings(pattern, windings.as_deref(), m.n_balls()).py()?;
@@ -257,13 +261,21 @@ pub fn periodic<'py>(
         Some((w, c)) => Some(start(&m, &ball_winding, *w, slice(c, "guess")?)?),
         None => None,
     };
-    let r = guarded(py, || {
+    let (r, source) = guarded(py, || {
         dispatch!(&m, d => {
             stiff_guess(d, guess.is_none(), &opts)?;
-            Ok(periodic_wound(d, &ball_winding, guess.as_ref(), &opts))
+            Ok(match (&guess, &homotopy) {
+                (None, Some(starts)) => periodic_homotopy(d, &ball_winding, starts, &opts),
+                _ => (
+                    periodic_wound(d, &ball_winding, guess.as_ref(), &opts),
+                    source_of(guess.is_some()),
+                ),
+            })
         })
     })?;
-    solution_dict(py, r, m.n_balls())
+    let out = solution_dict(py, r, m.n_balls())?;
+    out.set_item("guess_source", source)?;
+    Ok(out)
 }
 
 /// `Err(Stiff)` when the guess simulations would be too stiff for the explicit

@@ -6,6 +6,7 @@ pub mod balanced;
 pub mod basins;
 pub mod equilibria;
 pub mod family;
+pub mod homotopy;
 pub mod journal;
 pub mod periodic;
 pub mod record;
