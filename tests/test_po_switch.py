@@ -12,7 +12,7 @@ from ballbal.continuation import switch
 from ballbal.exceptions import ParameterError
 
 from reference import rhs
-from shooting import flow
+from shooting import flow, shoot
 
 
 def thesis(Omega: float, eta: float, zeta_b: float = 0.05) -> bb.Balancer:
@@ -213,3 +213,38 @@ def test_switch_refuses_bad_input_by_name() -> None:
     with pytest.raises(ParameterError) as e:
         switch(eq, parameter="Omega")
     assert e.value.parameter == "model"
+
+
+def test_homotopy_finds_the_thesis_rr_orbit_simulation_misses() -> None:
+    # Table 4-7 / figure 4-12: zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.7. Every simulated
+    # start settles to the perfect balance, yet a stable R-R orbit exists.
+    b = bb.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50, Omega=1.3, eta=[0.7, 0.7])
+    plain = periodic(b, "R-R", N=8)
+    assert plain.status == "no_guess" and plain.info["guess_source"] == "simulation"
+    s = periodic(b, "R-R", N=8, homotopy=True)
+    assert s.converged and s.stability == "stable"
+    assert s.info["guess_source"].startswith("homotopy from ")
+    # Shooting (scipy) from the series' state converges to the same period.
+    y, T = shoot(b, s.state(0.0), s.period, s.winding, 2)
+    assert abs(T - s.period) < 1e-6 * T
+    assert np.max(np.abs(y - s.state(0.0))) < 1e-5
+    # Simulation started on the orbit, slightly off, stays on it (a stable orbit).
+    n = 20
+    y0 = s.state(0.0) + 1e-4 * np.array([1, 0, 1, -1, 0, 0, 0, 0])
+    df = bb.simulate(b, y0, [0.0, n * s.period])
+    end = np.asarray(df.drop("t", "theta", "X", "Y").row(-1))
+    shift = np.zeros(8)
+    shift[:4] = 2 * np.pi * n * s.winding
+    assert np.max(np.abs(end - s.state(0.0) - shift)) < 1e-4
+
+
+def test_homotopy_keeps_results_simulation_finds_and_refuses_bad_starts() -> None:
+    b = thesis(1.2, 1.0)
+    a = periodic(b, "R-R")
+    h = periodic(b, "R-R", homotopy=True)
+    assert h.info["guess_source"] == "simulation"
+    assert a.omega == h.omega and np.array_equal(a.coeffs, h.coeffs)
+    for bad in ("Omega", [("Omega",)], [("Omega", "x")], 3):
+        with pytest.raises(ParameterError) as e:
+            periodic(b, "R-R", homotopy=bad)  # type: ignore[arg-type]
+        assert e.value.parameter == "homotopy"
