@@ -6,7 +6,9 @@ use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::CoreResult;
 use crate::run::guarded;
 use crate::tables::solution_dict;
-use ballbal_core::analysis::switch::{switch_hopf as core_hopf, switch_periodic as core_periodic, Switch, Switched};
+use ballbal_core::analysis::switch::{
+    switch_hopf as core_hopf, switch_periodic as core_periodic, Switch, Switched,
+};
 use ballbal_core::Error;
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
@@ -41,7 +43,11 @@ pub fn switch_periodic<'py>(
     let d = winding.len();
     let c = slice(&coeffs, "coeffs")?.to_vec();
     if d == 0 || !c.len().is_multiple_of(d) || (c.len() / d) % 2 != 1 || !(omega > 0.0) {
-        return Err(Error::param("solution", "needs a converged periodic solution")).py();
+        return Err(Error::param(
+            "solution",
+            "needs a converged periodic solution",
+        ))
+        .py();
     }
     let n_harm = (c.len() / d - 1) / 2;
     let sol = ballbal_core::hb::HbSolution::start(
@@ -51,9 +57,10 @@ pub fn switch_periodic<'py>(
         n_harm,
         ballbal_core::hb::Status::Converged,
     );
-    let s = guarded(py, || {
-        dispatch!(&m, x => core_periodic(x, parameter, &sol, kind, amplitude, &opts))
-    })?;
+    let s = guarded(
+        py,
+        || dispatch!(&m, x => core_periodic(x, parameter, &sol, kind, amplitude, &opts)),
+    )?;
     out(py, s, m.n_balls())
 }
 
@@ -69,9 +76,10 @@ pub fn switch_hopf<'py>(
 ) -> PyResult<Out<'py>> {
     let m = model.build(false).py()?;
     let opts = options.to_core()?;
-    let s = guarded(py, || {
-        dispatch!(&m, x => core_hopf(x, parameter, &q, amplitude, &opts))
-    })?;
+    let s = guarded(
+        py,
+        || dispatch!(&m, x => core_hopf(x, parameter, &q, amplitude, &opts)),
+    )?;
     out(py, s, m.n_balls())
 }
 

@@ -415,7 +415,14 @@ mod tests {
             other => panic!("{}", other.as_str()),
         }
         // With a filter for another pattern the search stops at the pattern.
-        let filtered = classify_as(&p, y0, Some(&[false, false]), 1, 3, &GuessOptions::default());
+        let filtered = classify_as(
+            &p,
+            y0,
+            Some(&[false, false]),
+            1,
+            3,
+            &GuessOptions::default(),
+        );
         assert!(
             matches!(filtered, Attractor::OtherPattern { ref rotating } if rotating == &[true, true])
         );

@@ -12,8 +12,8 @@ use std::f64::consts::PI;
 
 // The simulated starts and their classification live in `attractors`; these names stay
 // here too, where callers of the periodic solve have always found them.
-pub use crate::analysis::attractors::{guess_from_state, initial_states, GuessOptions};
 use crate::analysis::attractors::guess_with_turns;
+pub use crate::analysis::attractors::{guess_from_state, initial_states, GuessOptions};
 
 /// Which balls rotate (`true`) and which oscillate, from the canonical pattern: one
 /// letter per ball, `R` (rotating) or `O` (oscillating), joined by `-` (`"R-O"`; `"R"`
@@ -61,7 +61,10 @@ pub fn parse_windings(
 ) -> crate::Result<Vec<f64>> {
     let rotating = parse_pattern(pattern, n_balls)?;
     let Some(w) = windings else {
-        return Ok(rotating.iter().map(|&r| if r { -1.0 } else { 0.0 }).collect());
+        return Ok(rotating
+            .iter()
+            .map(|&r| if r { -1.0 } else { 0.0 })
+            .collect());
     };
     let allowed = format!(
         "{n_balls} integers, non-zero (|w| <= {MAX_WINDING}) for each R ball of the pattern and 0 for each O ball"
@@ -83,7 +86,10 @@ pub fn parse_windings(
             let letter = if r { "R" } else { "O" };
             return Err(crate::Error::param_range(
                 "windings",
-                format!("ball {} is {letter} in pattern {pattern:?} but has winding {wi}", i + 1),
+                format!(
+                    "ball {} is {letter} in pattern {pattern:?} but has winding {wi}",
+                    i + 1
+                ),
                 allowed,
             ));
         }
@@ -363,8 +369,7 @@ fn wound_search<D: Dynamics + ?Sized>(
     let mut repeating: Option<HbSolution> = None;
     let mut failed: Option<HbSolution> = None;
     for y0 in initial_states(p) {
-        let Some(g) = guess_with_turns(p, &y0, rotating, turns, opts.hb.n_harm, &opts.guess)
-        else {
+        let Some(g) = guess_with_turns(p, &y0, rotating, turns, opts.hb.n_harm, &opts.guess) else {
             continue;
         };
         if g.winding[o..] != *ball_winding {
@@ -534,7 +539,11 @@ pub fn no_guess<D: Dynamics + ?Sized>(p: &D, rotating: &[bool], n_harm: usize) -
 }
 
 /// [`no_guess`] with the balls' windings given.
-pub fn no_guess_wound<D: Dynamics + ?Sized>(p: &D, ball_winding: &[f64], n_harm: usize) -> HbSolution {
+pub fn no_guess_wound<D: Dynamics + ?Sized>(
+    p: &D,
+    ball_winding: &[f64],
+    n_harm: usize,
+) -> HbSolution {
     let d = p.ndof();
     let mut winding = vec![0.0; d];
     winding[p.first_ball()..].copy_from_slice(ball_winding);

@@ -227,7 +227,9 @@ fn critical_mode<D: Dynamics + ?Sized>(
                     for rr in 0..2 {
                         let er = basis(rr);
                         b[rr * 2 + c] = (0..n2)
-                            .map(|row| er[row] * (0..n2).map(|k| phi[row * n2 + k] * ec[k]).sum::<f64>())
+                            .map(|row| {
+                                er[row] * (0..n2).map(|k| phi[row * n2 + k] * ec[k]).sum::<f64>()
+                            })
                             .sum();
                     }
                 }
@@ -299,7 +301,10 @@ fn step_off<D: Parametric>(
     tangent.push(0.0); // the parameter
     let norm = tangent.iter().map(|t| t * t).sum::<f64>().sqrt();
     if !(norm > 0.0 && norm.is_finite()) {
-        return Err(Error::param("solution", "no critical direction to switch along"));
+        return Err(Error::param(
+            "solution",
+            "no critical direction to switch along",
+        ));
     }
     tangent.iter_mut().for_each(|t| *t /= norm);
     let from = ArcPoint {
@@ -376,14 +381,23 @@ pub fn switch_periodic<D: Parametric>(
     let dir = variational_series(model, sol, &e, m, base.n_harm, &fo)?;
     let o = model.first_ball();
     match kind {
-        Switch::PeriodDoubling => step_off(model, name, &base, dir, amplitude, opts, (lam, 0.0), |s| {
-            !crate::analysis::periodic::repeats(s, 2)
-        }),
+        Switch::PeriodDoubling => {
+            step_off(model, name, &base, dir, amplitude, opts, (lam, 0.0), |s| {
+                !crate::analysis::periodic::repeats(s, 2)
+            })
+        }
         Switch::BranchPoint => {
             let merged = merged_pair(sol, o).is_some();
-            step_off(model, name, &base, dir, amplitude, opts, (lam, 0.0), move |s| {
-                !merged || merged_pair(s, o).is_none()
-            })
+            step_off(
+                model,
+                name,
+                &base,
+                dir,
+                amplitude,
+                opts,
+                (lam, 0.0),
+                move |s| !merged || merged_pair(s, o).is_none(),
+            )
         }
     }
 }
