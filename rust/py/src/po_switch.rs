@@ -42,7 +42,12 @@ pub fn switch_periodic<'py>(
     let opts = options.to_core()?;
     let d = winding.len();
     let c = slice(&coeffs, "coeffs")?.to_vec();
-    if d == 0 || !c.len().is_multiple_of(d) || (c.len() / d) % 2 != 1 || !(omega > 0.0) {
+    if d == 0
+        || !c.len().is_multiple_of(d)
+        || (c.len() / d) % 2 != 1
+        || omega.is_nan()
+        || omega <= 0.0
+    {
         return Err(Error::param(
             "solution",
             "needs a converged periodic solution",
