@@ -68,6 +68,8 @@ def balance_map(
 def periodic(
     model: Balancer | Scene, pattern: str, options: PeriodicOptions,
     guess: tuple[float, npt.NDArray[np.float64]] | None = None,
+    windings: list[int] | None = None,
+    homotopy: list[tuple[str, float]] | None = None,
 ) -> dict[str, Any]: ...
 def orbit_closure(
     model: Balancer | Scene, omega: float, coeffs: npt.NDArray[np.float64],
@@ -107,3 +109,11 @@ def attractor_series(
 def classify_state(
     model: Balancer | Scene, y0: npt.NDArray[np.float64], options: BasinOptions,
 ) -> tuple[dict[str, Any], npt.NDArray[np.float64]]: ...
+def switch_periodic(
+    model: Balancer | Scene, parameter: str, omega: float, coeffs: npt.NDArray[np.float64],
+    winding: list[float], kind: str, amplitude: float, options: PeriodicOptions,
+) -> tuple[dict[str, Any], float, tuple[float, float]]: ...
+def switch_hopf(
+    model: Balancer | Scene, parameter: str, q: list[float], amplitude: float,
+    options: PeriodicOptions,
+) -> tuple[dict[str, Any], float, tuple[float, float]]: ...

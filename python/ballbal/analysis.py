@@ -313,6 +313,29 @@ class PeriodicSolution:
             _check.real("atol", atol))
 
 
+def _windings(windings: Any) -> list[int]:
+    items = _check.sequence("windings", windings)
+    return [_check.integer("windings", w, -16, 16) for w in items]
+
+
+def _homotopy(model: Balancer | Scene, homotopy: Any) -> list[tuple[str, float]]:
+    """The ``(parameter, value)`` starts of ``periodic(homotopy=...)``."""
+    if homotopy is True:
+        om = model.Omega if isinstance(model, Balancer) else model.balancer.Omega
+        starts = [("Omega", om + d) for d in (-0.1, 0.1, -0.2, 0.2) if om + d > 0]
+        return starts + [("eta", 1.0)]
+    items = list(homotopy.items()) if isinstance(homotopy, dict) else _check.sequence(
+        "homotopy", homotopy)
+    out = []
+    for item in items:
+        if not (isinstance(item, (tuple, list)) and len(item) == 2):
+            raise ParameterTypeError("homotopy", "must be True, {name: value} or pairs "
+                                     f"(name, value), got {item!r:.60}", value=homotopy)
+        out.append((_check.string("homotopy", item[0]),
+                    _check.real("homotopy", item[1], finite=True)))
+    return out
+
+
 @_check.renamed_model("balancer")
 def periodic(
     model: Balancer | Scene,
@@ -320,6 +343,8 @@ def periodic(
     *,
     options: PeriodicOptions | None = None,
     guess: PeriodicSolution | tuple[float, np.ndarray] | None = None,
+    windings: Sequence[int] | None = None,
+    homotopy: bool | dict[str, float] | Sequence[tuple[str, float]] | None = None,
     **keywords: Any,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
@@ -340,6 +365,27 @@ def periodic(
     longer integration ends in ``floquet_error`` and an undetermined verdict); a verdict
     needs the largest non-trivial modulus further than ``max(margin, trivial_error)``
     from 1.
+
+    ``windings``: the balls' whole turns per period, one integer per ball, non-zero for
+    each ``R`` ball and 0 for each ``O`` ball (``|w| <= 16``; default -1 per ``R``: a ball
+    lagging the disk by one turn per period). ``periodic(b, "R-R", windings=(-2, -2))``
+    asks for a period-doubled R-R orbit, each ball winding twice per (doubled) period;
+    without ``guess`` its simulated starts are observed over two turns of the first
+    ball, whose durations may differ, and a series that only repeats a period-``T``
+    orbit twice is returned only if no start gives a genuine one. A ``guess`` that is a
+    :class:`PeriodicSolution` lends its windings when ``windings`` is not given. Wrong
+    lengths, zeros on ``R`` balls or non-integers raise
+    :class:`~ballbal.exceptions.ParameterError` naming ``windings``.
+
+    ``homotopy``: where no simulated start reaches the pattern although a stable orbit
+    exists (every start settling to the perfect balance, as at the thesis' R-R point of
+    its table 4-7), find the orbit at a nearby parameter point instead and follow it
+    here by natural-parameter continuation (secant predictor, each step certified, the
+    step halved on failure). ``True`` tries ``Omega`` 0.1 and 0.2 below and above the
+    model's, then ``eta = 1``; a dict ``{"Omega": 1.2}`` or pairs ``[("Omega", 1.2)]``
+    give the starts to try, in order. Only used without ``guess`` and only when
+    simulation here finds nothing. ``info["guess_source"]`` says how every result was
+    found: ``"simulation"``, ``"guess"`` or ``"homotopy from Omega=1.2"``.
 
     ``N="auto"`` starts at 3 and raises the harmonics (solving from the last) until the
     highest harmonic relative to the motion (``tail``) and the trivial multiplier's
@@ -379,6 +425,7 @@ def periodic(
     options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
                             "ballbal.PeriodicOptions")
     options = with_keywords(options, "periodic", keywords, PERIODIC_KEYWORDS)
+    wind = None if windings is None else _windings(windings)
     go: float | None = None
     gc: np.ndarray | None = None
     if guess is not None:
@@ -387,14 +434,26 @@ def periodic(
                 raise ParameterError("guess", "a solution that did not converge cannot seed "
                                      "a solve")
             go, gc = guess.omega, guess.coeffs
+            if wind is None and guess.type == pattern:
+                lent = [int(w) for w in guess.winding[-model.n_balls:]]
+                if any(abs(w) > 1 for w in lent):
+                    wind = lent
         elif isinstance(guess, (tuple, list)) and len(guess) == 2:
             go, gc = _check.real("guess", guess[0]), _check.array("guess", guess[1])
         else:
             raise ParameterTypeError("guess", "must be a PeriodicSolution or (omega, coeffs), "
                                      f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
+    starts = None if homotopy is None or homotopy is False else _homotopy(model, homotopy)
     d = _native.periodic(model, pattern, options,
-                         None if go is None or gc is None else (go, gc))
+                         None if go is None or gc is None else (go, gc), wind, starts)
+    out = _solution(model, d)
+    out.info["guess_source"] = d["guess_source"]
+    return out
+
+
+def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:
+    """A :class:`PeriodicSolution` from the binding's dict."""
     mult = d["mult_re"] + 1j * d["mult_im"] if d["mult_re"] is not None else None
     hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None
     return PeriodicSolution(

@@ -1,11 +1,14 @@
-"""Continuation: branches of solutions in one parameter with located bifurcations,
-branch switching, and two-parameter bifurcation curves."""
+"""Continuation and bifurcations: branches of solutions in one parameter with located
+bifurcations, branch switching, and two-parameter bifurcation curves."""
 
+from ballbal._branch import Branch, Continuation, Curve
 from ballbal._eq_continuation import (
     equilibrium_branch,
     equilibrium_curve,
     from_seed003,
     switch_equilibrium,
 )
+from ballbal._po_switch import switch
 
-__all__ = ["equilibrium_branch", "equilibrium_curve", "from_seed003", "switch_equilibrium"]
+__all__ = ["Branch", "Continuation", "Curve", "equilibrium_branch", "equilibrium_curve",
+           "from_seed003", "switch", "switch_equilibrium"]

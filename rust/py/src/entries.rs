@@ -7,11 +7,13 @@ use crate::convert::{dispatch, slice, Model, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::{guarded, run_polled};
 use crate::tables::{equilibrium_dict, scan_columns, solution_dict, Columns};
+use ballbal_core::analysis::homotopy::{periodic_homotopy, source_of};
 use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{
-    closure_error, parse_pattern, periodic as core_periodic, require_autonomous, PeriodicOptions,
+    closure_error, parse_pattern, parse_windings, periodic_wound, require_autonomous,
+    PeriodicOptions,
 };
 use ballbal_core::scan::{Family, ScanRow, ScanSpec};
 use ballbal_core::simulate::simulate as core_simulate;
@@ -205,7 +207,7 @@ pub fn balance_map<'py>(
 }
 
 /// A start for Newton from `(omega, coefficients)`, checked against the model.
-fn start(m: &Model, rotating: &[bool], w: f64, c: &[f64]) -> PyResult<HbSolution> {
+pub(crate) fn start(m: &Model, ball_winding: &[f64], w: f64, c: &[f64]) -> PyResult<HbSolution> {
     let (d, o) = dispatch!(m, x => (x.ndof(), x.first_ball()));
     if !c.len().is_multiple_of(d) || (c.len() / d) % 2 != 1 {
         return Err(Error::param(
@@ -225,9 +227,7 @@ fn start(m: &Model, rotating: &[bool], w: f64, c: &[f64]) -> PyResult<HbSolution
         .py();
     }
     let mut winding = vec![0.0; d];
-    for (i, &r) in rotating.iter().enumerate() {
-        winding[o + i] = if r { -1.0 } else { 0.0 };
-    }
+    winding[o..].copy_from_slice(ball_winding);
     let nh = (c.len() / d - 1) / 2;
     Ok(HbSolution::start(
         w,
@@ -239,30 +239,43 @@ fn start(m: &Model, rotating: &[bool], w: f64, c: &[f64]) -> PyResult<HbSolution
 }
 
 /// Periodic solution of the given pattern by Newton–IHB, with Floquet multipliers;
-/// `guess` is `(omega, coefficients)` or `None` (a simulated start).
+/// `guess` is `(omega, coefficients)` or `None` (a simulated start); `windings` the
+/// balls' turns per period (`None`: -1 for each `R`, 0 for each `O`).
+/// `homotopy`: `(parameter, value)` starts to follow from when simulation finds no
+/// orbit here (`analysis::homotopy`); the dict's `guess_source` says how it was found.
 #[pyfunction]
-#[pyo3(signature = (model, pattern, options, guess=None))]
+#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None))]
 pub fn periodic<'py>(
     py: Python<'py>,
     model: ModelArgs,
     pattern: &str,
     options: PeriodicArgs,
     guess: Option<(f64, PyReadonlyArray1<'py, f64>)>,
+    windings: Option<Vec<i64>>,
+    homotopy: Option<Vec<(String, f64)>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = autonomous(&model, false, "periodic")?;
-    let rotating = parse_pattern(pattern, m.n_balls()).py()?;
+    let ball_winding = parse_windings(pattern, windings.as_deref(), m.n_balls()).py()?;
     let opts = options.to_core()?;
     let guess = match &guess {
-        Some((w, c)) => Some(start(&m, &rotating, *w, slice(c, "guess")?)?),
+        Some((w, c)) => Some(start(&m, &ball_winding, *w, slice(c, "guess")?)?),
         None => None,
     };
-    let r = guarded(py, || {
+    let (r, source) = guarded(py, || {
         dispatch!(&m, d => {
             stiff_guess(d, guess.is_none(), &opts)?;
-            Ok(core_periodic(d, &rotating, guess.as_ref(), &opts))
+            Ok(match (&guess, &homotopy) {
+                (None, Some(starts)) => periodic_homotopy(d, &ball_winding, starts, &opts),
+                _ => (
+                    periodic_wound(d, &ball_winding, guess.as_ref(), &opts),
+                    source_of(guess.is_some()),
+                ),
+            })
         })
     })?;
-    solution_dict(py, r, m.n_balls())
+    let out = solution_dict(py, r, m.n_balls())?;
+    out.set_item("guess_source", source)?;
+    Ok(out)
 }
 
 /// `Err(Stiff)` when the guess simulations would be too stiff for the explicit

@@ -13,6 +13,7 @@ mod entries;
 mod eq_continuation;
 mod errors;
 mod groove;
+mod po_switch;
 mod rotor;
 mod run;
 mod tables;
@@ -76,6 +77,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bearing::bearing_stability, m)?)?;
     basins::register(m)?;
     eq_continuation::register(m)?;
+    po_switch::register(m)?;
     m.add_function(wrap_pyfunction!(groove::groove_study, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -141,7 +141,7 @@ pub fn classify<D: Dynamics + ?Sized>(
     n_harm: usize,
     g: &GuessOptions,
 ) -> Attractor {
-    classify_as(model, y0, None, n_harm, g)
+    classify_as(model, y0, None, 1, n_harm, g)
 }
 
 /// Tries to turn one simulated attractor into a harmonic-balance starting guess.
@@ -156,7 +156,21 @@ pub fn guess_from_state<D: Dynamics + ?Sized>(
     n_harm: usize,
     g: &GuessOptions,
 ) -> Option<HbSolution> {
-    classify_as(model, y0, rotating, n_harm, g).into_series()
+    classify_as(model, y0, rotating, 1, n_harm, g).into_series()
+}
+
+/// [`guess_from_state`] for an orbit on which the first rotating ball makes `turns`
+/// whole turns per period (a period-doubled orbit: 2): the period is measured over
+/// `turns` successive turns, whose durations may differ from each other.
+pub fn guess_with_turns<D: Dynamics + ?Sized>(
+    model: &D,
+    y0: &[f64],
+    rotating: &[bool],
+    turns: usize,
+    n_harm: usize,
+    g: &GuessOptions,
+) -> Option<HbSolution> {
+    classify_as(model, y0, Some(rotating), turns.max(1), n_harm, g).into_series()
 }
 
 /// [`guess_from_state`] without a pattern filter, as a scan's seeds use it: the same
@@ -170,7 +184,7 @@ pub fn seed_guess<D: Dynamics + ?Sized>(
     n_harm: usize,
     g: &GuessOptions,
 ) -> Option<HbSolution> {
-    classify_with(model, y0, None, n_harm, g, true).into_series()
+    classify_with(model, y0, None, 1, n_harm, g, true).into_series()
 }
 
 /// Watches a simulation for rest at loose tolerances, where the explicit integrator's
@@ -222,10 +236,11 @@ fn classify_as<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
     want: Option<&[bool]>,
+    turns: usize,
     n_harm: usize,
     g: &GuessOptions,
 ) -> Attractor {
-    classify_with(model, y0, want, n_harm, g, false)
+    classify_with(model, y0, want, turns, n_harm, g, false)
 }
 
 /// [`classify_as`]; `quick`: as for [`seed_guess`].
@@ -233,6 +248,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
     want: Option<&[bool]>,
+    turns: usize,
     n_harm: usize,
     g: &GuessOptions,
     quick: bool,
@@ -268,7 +284,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     let mut end_b = start_b.clone();
     let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
     let mut tmp = vec![0.0; 2 * d];
-    let need = 6;
+    let need = 6.max(2 * turns + 2);
     let mut watch = RestWatch::new(g.settle);
     let mut rested = false;
     let mut solver = Dopri5::new(2 * d);
@@ -325,7 +341,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     }
     let r = detected.iter().position(|&b| b);
     let (t_c, period) = if let Some(r) = r {
-        match turn_period(&crossings[r]) {
+        match turns_period(&crossings[r], turns) {
             Some(p) => p,
             None => return NotSettled,
         }
@@ -390,12 +406,17 @@ fn classify_with<D: Dynamics + ?Sized>(
 /// whole turns: the last two intervals must agree to 2 % (else the motion is
 /// quasi-periodic, chaotic or not settled: `None`).
 pub(crate) fn turn_period(crossings: &[f64]) -> Option<(f64, f64)> {
-    if crossings.len() < 3 {
+    turns_period(crossings, 1)
+}
+
+/// [`turn_period`] over `m` turns per period.
+fn turns_period(crossings: &[f64], m: usize) -> Option<(f64, f64)> {
+    if crossings.len() < 2 * m + 1 {
         return None;
     }
     let k = crossings.len();
-    let t1 = crossings[k - 1] - crossings[k - 2];
-    let t2 = crossings[k - 2] - crossings[k - 3];
+    let t1 = crossings[k - 1] - crossings[k - 1 - m];
+    let t2 = crossings[k - 1 - m] - crossings[k - 1 - 2 * m];
     if (t1 - t2).abs() > 0.02 * t1 {
         return None; // not periodic (quasi-periodic or chaotic)
     }
@@ -475,7 +496,14 @@ mod tests {
             other => panic!("{}", other.as_str()),
         }
         // With a filter for another pattern the search stops at the pattern.
-        let filtered = classify_as(&p, y0, Some(&[false, false]), 3, &GuessOptions::default());
+        let filtered = classify_as(
+            &p,
+            y0,
+            Some(&[false, false]),
+            1,
+            3,
+            &GuessOptions::default(),
+        );
         assert!(
             matches!(filtered, Attractor::OtherPattern { ref rotating } if rotating == &[true, true])
         );
@@ -531,7 +559,7 @@ mod tests {
         y1[2] += 0.05;
         y1[3] -= 0.05;
         assert!(matches!(
-            classify_with(&q, &y1, None, 3, &g, true),
+            classify_with(&q, &y1, None, 1, 3, &g, true),
             Attractor::Rest
         ));
     }

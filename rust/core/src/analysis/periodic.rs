@@ -12,6 +12,7 @@ use std::f64::consts::PI;
 
 // The simulated starts and their classification live in `attractors`; these names stay
 // here too, where callers of the periodic solve have always found them.
+use crate::analysis::attractors::guess_with_turns;
 pub use crate::analysis::attractors::{guess_from_state, initial_states, GuessOptions};
 
 /// Which balls rotate (`true`) and which oscillate, from the canonical pattern: one
@@ -42,6 +43,73 @@ pub fn parse_pattern(pattern: &str, n_balls: usize) -> crate::Result<Vec<bool>> 
         format!("must give R (rotating) or O (oscillating) for each of the {n_balls} balls, joined by '-', e.g. \"{example}\", got {pattern:?}")
     };
     Err(crate::Error::param_range("pattern", message, allowed))
+}
+
+/// Largest number of whole turns per period a ball may be asked to make: an orbit with
+/// more is a long sequence of turns that a harmonic series of modest `N` cannot hold.
+pub const MAX_WINDING: i64 = 16;
+
+/// The secular slope of each ball (turns per period, `-1` for the usual rotating ball,
+/// 0 for an oscillating one) from a pattern and, optionally, explicit windings: one
+/// non-zero integer per `R` ball and 0 per `O` ball, at most [`MAX_WINDING`] in size.
+/// A period-doubled R-R orbit is `"R-R"` with windings `[-2, -2]`: each ball winds
+/// twice (backwards, lagging the disk) per doubled period.
+pub fn parse_windings(
+    pattern: &str,
+    windings: Option<&[i64]>,
+    n_balls: usize,
+) -> crate::Result<Vec<f64>> {
+    let rotating = parse_pattern(pattern, n_balls)?;
+    let Some(w) = windings else {
+        return Ok(rotating
+            .iter()
+            .map(|&r| if r { -1.0 } else { 0.0 })
+            .collect());
+    };
+    let allowed = format!(
+        "{n_balls} integers, non-zero (|w| <= {MAX_WINDING}) for each R ball of the pattern and 0 for each O ball"
+    );
+    if w.len() != n_balls {
+        return Err(crate::Error::param_range(
+            "windings",
+            format!("needs one winding per ball ({n_balls}), got {}", w.len()),
+            allowed,
+        ));
+    }
+    for (i, (&wi, &r)) in w.iter().zip(&rotating).enumerate() {
+        let ok = if r {
+            wi != 0 && wi.abs() <= MAX_WINDING
+        } else {
+            wi == 0
+        };
+        if !ok {
+            let letter = if r { "R" } else { "O" };
+            return Err(crate::Error::param_range(
+                "windings",
+                format!(
+                    "ball {} is {letter} in pattern {pattern:?} but has winding {wi}",
+                    i + 1
+                ),
+                allowed,
+            ));
+        }
+    }
+    Ok(w.iter().map(|&v| v as f64).collect())
+}
+
+/// Whether the series repeats `m` times per period (only harmonics that are multiples
+/// of `m`, windings divisible by `m`): an orbit of period `T / m` written over `T`.
+pub fn repeats(sol: &HbSolution, m: usize) -> bool {
+    if m <= 1 || sol.winding.iter().any(|w| (w / m as f64).fract() != 0.0) {
+        return m <= 1;
+    }
+    let scale = sol.coeffs.iter().fold(1e-300f64, |a, c| a.max(c.abs()));
+    (0..sol.ndof()).all(|j| {
+        let c = sol.coord(j);
+        (1..=sol.n_harm)
+            .filter(|k| k % m != 0)
+            .all(|k| c[2 * k - 1].hypot(c[2 * k]) <= 1e-6 * scale)
+    })
 }
 
 /// The R/O pattern of the balls, which are the last `n_balls` coordinates.
@@ -228,6 +296,37 @@ pub fn periodic<D: Dynamics + ?Sized>(
     guess: Option<&HbSolution>,
     opts: &PeriodicOptions,
 ) -> Periodic {
+    let ball_winding: Vec<f64> = rotating
+        .iter()
+        .map(|&r| if r { -1.0 } else { 0.0 })
+        .collect();
+    periodic_wound(p, &ball_winding, guess, opts)
+}
+
+/// [`periodic`] with the balls' windings per period given ([`parse_windings`]). With a
+/// winding of more than one turn and no guess, the simulated starts are observed over
+/// as many turns of the first rotating ball; a start whose series turns out to repeat
+/// within the period (an orbit of a shorter period, written several times) is kept only
+/// if no start gives a genuine one.
+pub fn periodic_wound<D: Dynamics + ?Sized>(
+    p: &D,
+    ball_winding: &[f64],
+    guess: Option<&HbSolution>,
+    opts: &PeriodicOptions,
+) -> Periodic {
+    let rotating: Vec<bool> = ball_winding.iter().map(|w| *w != 0.0).collect();
+    let turns = ball_winding
+        .iter()
+        .find(|w| **w != 0.0)
+        .map_or(1, |w| w.abs() as usize);
+    if turns > 1 || ball_winding.iter().any(|w| w.abs() > 1.0) {
+        let sol = match guess {
+            Some(g) => solve(p, g, &opts.hb),
+            None => wound_search(p, ball_winding, &rotating, turns, opts),
+        };
+        return finish(p, sol, opts);
+    }
+    let rotating = &rotating[..];
     let sol = match guess {
         Some(g) => solve(p, g, &opts.hb),
         None => {
@@ -255,6 +354,43 @@ pub fn periodic<D: Dynamics + ?Sized>(
         }
     };
     finish(p, sol, opts)
+}
+
+/// The simulated search of [`periodic_wound`] for windings of more than one turn.
+fn wound_search<D: Dynamics + ?Sized>(
+    p: &D,
+    ball_winding: &[f64],
+    rotating: &[bool],
+    turns: usize,
+    opts: &PeriodicOptions,
+) -> HbSolution {
+    let o = p.first_ball();
+    // Converged and genuine; converged but repeating; the first failure.
+    let mut repeating: Option<HbSolution> = None;
+    let mut failed: Option<HbSolution> = None;
+    for y0 in initial_states(p) {
+        let Some(g) = guess_with_turns(p, &y0, rotating, turns, opts.hb.n_harm, &opts.guess) else {
+            continue;
+        };
+        if g.winding[o..] != *ball_winding {
+            continue;
+        }
+        let mut s = solve(p, &g, &opts.hb);
+        if opts.auto.is_none() {
+            certify(p, &mut s, opts);
+        }
+        if s.status == Status::Converged {
+            if !repeats(&s, turns) {
+                return s;
+            }
+            repeating.get_or_insert(s);
+        } else {
+            failed.get_or_insert(s);
+        }
+    }
+    repeating
+        .or(failed)
+        .unwrap_or_else(|| no_guess_wound(p, ball_winding, opts.hb.n_harm))
 }
 
 pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptions) -> Periodic {
@@ -393,6 +529,24 @@ pub fn no_guess<D: Dynamics + ?Sized>(p: &D, rotating: &[bool], n_harm: usize) -
     for (i, &r) in rotating.iter().enumerate() {
         winding[p.first_ball() + i] = if r { -1.0 } else { 0.0 };
     }
+    HbSolution::start(
+        f64::NAN,
+        vec![f64::NAN; d * (2 * n_harm + 1)],
+        winding,
+        n_harm,
+        Status::NoGuess,
+    )
+}
+
+/// [`no_guess`] with the balls' windings given.
+pub fn no_guess_wound<D: Dynamics + ?Sized>(
+    p: &D,
+    ball_winding: &[f64],
+    n_harm: usize,
+) -> HbSolution {
+    let d = p.ndof();
+    let mut winding = vec![0.0; d];
+    winding[p.first_ball()..].copy_from_slice(ball_winding);
     HbSolution::start(
         f64::NAN,
         vec![f64::NAN; d * (2 * n_harm + 1)],
