@@ -7,12 +7,12 @@
 
 mod basins;
 mod bearing;
-#[allow(dead_code)] // used by the continuation entries being added (issue 15)
 mod continuation;
 mod convert;
 mod entries;
 mod errors;
 mod groove;
+mod po_continuation;
 mod rotor;
 mod run;
 mod tables;
@@ -75,6 +75,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bearing::bearing_stability, m)?)?;
     basins::register(m)?;
     m.add_function(wrap_pyfunction!(groove::groove_study, m)?)?;
+    m.add_function(wrap_pyfunction!(po_continuation::periodic_branch, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

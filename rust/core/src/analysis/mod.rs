@@ -8,5 +8,6 @@ pub mod equilibria;
 pub mod family;
 pub mod journal;
 pub mod periodic;
+pub mod po_branch;
 pub mod record;
 pub mod simulate;
