@@ -18,6 +18,8 @@ from ballbal.exceptions import ParameterError
 from reference import rhs
 
 STD = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
+NOT_YET_RUN = pytest.mark.skip(reason="written against shooting, simulation or a scan but "
+                               "not yet run to completion (issue 15, pocont report)")
 OPTS = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8))
 
 
@@ -165,7 +167,7 @@ def test_branch_point_against_shooting() -> None:
     assert abs(zero - om) < 2e-4, (zero, om)
 
 
-@pytest.mark.skip(reason="written against shooting/simulation/scan but not yet run to completion on the shared machine (issue 15, pocont report)")
+@NOT_YET_RUN
 def test_fold_against_shooting() -> None:
     """Near a fold the nontrivial multiplier closest to +1 goes as 1 + c sqrt|p - p_LP|:
     (lambda - 1)^2 from shooting at two points of the branch extrapolates to the fold."""
@@ -187,7 +189,7 @@ def test_fold_against_shooting() -> None:
     assert abs(zero - om) < 1e-3, (zero, om, vals)
 
 
-@pytest.mark.skip(reason="written against shooting/simulation/scan but not yet run to completion on the shared machine (issue 15, pocont report)")
+@NOT_YET_RUN
 def test_simulation_past_the_branch_point_separates_the_balls() -> None:
     """Beyond the branch point the merged orbit is unstable in the separation direction:
     a simulation from it with the balls nudged apart ends at the perfect balance (balls
@@ -222,7 +224,7 @@ def rr_zeta_b_01_down() -> ballbal.continuation.Branch:
                            options=Continuation(ds=0.02, ds_max=0.05, forward=False))
 
 
-@pytest.mark.skip(reason="written against shooting/simulation/scan but not yet run to completion on the shared machine (issue 15, pocont report)")
+@NOT_YET_RUN
 def test_continuation_down_stops_at_the_infinite_period_end() -> None:
     br = rr_zeta_b_01_down()
     assert br.stop == "infinite_period", br.stop
@@ -244,7 +246,7 @@ def test_continuation_down_stops_at_the_infinite_period_end() -> None:
     assert abs(shoot_star - om_star) < 2e-3, (shoot_star, om_star)
 
 
-@pytest.mark.skip(reason="written against shooting/simulation/scan but not yet run to completion on the shared machine (issue 15, pocont report)")
+@NOT_YET_RUN
 def test_monodromy_and_hill_give_the_same_events() -> None:
     br = standard_up()
     b = br.solutions[0].balancer
@@ -258,7 +260,7 @@ def test_monodromy_and_hill_give_the_same_events() -> None:
                        atol=1e-3)
 
 
-@pytest.mark.skip(reason="written against shooting/simulation/scan but not yet run to completion on the shared machine (issue 15, pocont report)")
+@NOT_YET_RUN
 def test_scan_verdicts_agree_with_the_events() -> None:
     """Every converged merged R-R row of a fine scan has the verdict of the branch on
     its side of the located events (the branch row nearest in (Omega, omega)), except
