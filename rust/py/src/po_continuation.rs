@@ -34,7 +34,11 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
     d.set_item("test_NS", pt.tests.ns)?;
     d.set_item(
         "event",
-        pt.events.iter().map(|e| e.as_str()).collect::<Vec<_>>().join(","),
+        pt.events
+            .iter()
+            .map(|e| e.as_str())
+            .collect::<Vec<_>>()
+            .join(","),
     )?;
     Ok(d)
 }
@@ -65,7 +69,11 @@ pub fn periodic_branch<'py>(
     let (omega, coeffs, winding) = start;
     let coeffs = slice(&coeffs, "start")?.to_vec();
     let d = dispatch!(&m, x => x.ndof());
-    if winding.len() != d || coeffs.is_empty() || !coeffs.len().is_multiple_of(d) || (coeffs.len() / d) % 2 != 1 {
+    if winding.len() != d
+        || coeffs.is_empty()
+        || !coeffs.len().is_multiple_of(d)
+        || (coeffs.len() / d) % 2 != 1
+    {
         return Err(Error::param(
             "start",
             format!("coefficients and winding do not fit a model with {d} coordinates"),
@@ -81,7 +89,10 @@ pub fn periodic_branch<'py>(
         event_tol,
     };
     let name = parameter.to_string();
-    let b = guarded(py, || dispatch!(&m, x => core_branch(x, &name, &start, &opts)))?;
+    let b = guarded(
+        py,
+        || dispatch!(&m, x => core_branch(x, &name, &start, &opts)),
+    )?;
     let out = PyDict::new(py);
     let mut points = Vec::with_capacity(b.points.len());
     for pt in b.points {

@@ -320,9 +320,12 @@ pub fn periodic_branch<D: Parametric>(
     opts: &PoBranchOptions,
 ) -> Result<PoBranch> {
     opts.validate()?;
-    let p0 = base
-        .param_value(name)
-        .map_err(|_| Error::param("parameter", format!("{name:?} is not a parameter of this model")))?;
+    let p0 = base.param_value(name).map_err(|_| {
+        Error::param(
+            "parameter",
+            format!("{name:?} is not a parameter of this model"),
+        )
+    })?;
     if !(opts.arc.p_min..=opts.arc.p_max).contains(&p0) {
         return Err(Error::param_range(
             "range",
@@ -447,22 +450,20 @@ fn between<P: Problem + ?Sized, D: Parametric>(
     let changes = |x: f64, y: f64| x * y < 0.0;
     let fold = changes(a.tests.lp, b.tests.lp);
     let det_flip = changes(a.tests.bp, b.tests.bp);
-    let mut push = |prob: &mut P,
-                    kind: PoEventKind,
-                    found: Option<(ArcPoint, f64)>|
-     -> Result<()> {
-        if let Some((pt, g)) = found {
-            let point = ctx.point(prob, &pt)?;
-            out.push(PoEvent {
-                kind,
-                p: pt.p,
-                point,
-                test: g,
-                index,
-            });
-        }
-        Ok(())
-    };
+    let mut push =
+        |prob: &mut P, kind: PoEventKind, found: Option<(ArcPoint, f64)>| -> Result<()> {
+            if let Some((pt, g)) = found {
+                let point = ctx.point(prob, &pt)?;
+                out.push(PoEvent {
+                    kind,
+                    p: pt.p,
+                    point,
+                    test: g,
+                    index,
+                });
+            }
+            Ok(())
+        };
     if fold {
         let f = locate(
             prob,
@@ -506,18 +507,48 @@ fn between<P: Problem + ?Sized, D: Parametric>(
     };
     let pair = |x: Option<f64>, y: Option<f64>| x.zip(y).filter(|(x, y)| changes(*x, *y));
     if let Some((ga, gb)) = pair(a.tests.pd, b.tests.pd) {
-        let f = locate(prob, &a.arc, &b.arc, ga, gb, on_multipliers(1), tol, 0.0, &opts.arc)?;
+        let f = locate(
+            prob,
+            &a.arc,
+            &b.arc,
+            ga,
+            gb,
+            on_multipliers(1),
+            tol,
+            0.0,
+            &opts.arc,
+        )?;
         push(prob, PoEventKind::PeriodDoubling, f)?;
     }
     if a.tests.complex_pairs == b.tests.complex_pairs {
         if let Some((ga, gb)) = pair(a.tests.ns, b.tests.ns) {
-            let f = locate(prob, &a.arc, &b.arc, ga, gb, on_multipliers(2), tol, 0.0, &opts.arc)?;
+            let f = locate(
+                prob,
+                &a.arc,
+                &b.arc,
+                ga,
+                gb,
+                on_multipliers(2),
+                tol,
+                0.0,
+                &opts.arc,
+            )?;
             push(prob, PoEventKind::NeimarkSacker, f)?;
         }
     }
     if !fold && !det_flip {
         if let Some((ga, gb)) = pair(a.tests.bp_multipliers, b.tests.bp_multipliers) {
-            let f = locate(prob, &a.arc, &b.arc, ga, gb, on_multipliers(0), tol, 0.0, &opts.arc)?;
+            let f = locate(
+                prob,
+                &a.arc,
+                &b.arc,
+                ga,
+                gb,
+                on_multipliers(0),
+                tol,
+                0.0,
+                &opts.arc,
+            )?;
             push(prob, PoEventKind::BranchPoint, f)?;
         }
     }
@@ -609,13 +640,26 @@ mod tests {
             Err(Error::InvalidParameter { name, .. }) => name,
             other => panic!("{:?}", other.map(|b| b.stop)),
         };
-        assert_eq!(name(periodic_branch(&p, "nope", &start.sol, &o)), "parameter");
         assert_eq!(
-            name(periodic_branch(&p, "Omega", &start.sol, &opts(4, 1.3, 1.4, true))),
+            name(periodic_branch(&p, "nope", &start.sol, &o)),
+            "parameter"
+        );
+        assert_eq!(
+            name(periodic_branch(
+                &p,
+                "Omega",
+                &start.sol,
+                &opts(4, 1.3, 1.4, true)
+            )),
             "range"
         );
         assert_eq!(
-            name(periodic_branch(&p, "Omega", &start.sol, &opts(4, 1.3, 1.2, true))),
+            name(periodic_branch(
+                &p,
+                "Omega",
+                &start.sol,
+                &opts(4, 1.3, 1.2, true)
+            )),
             "range"
         );
         let mut bad = start.sol.clone();
@@ -623,7 +667,10 @@ mod tests {
         assert_eq!(name(periodic_branch(&p, "Omega", &bad, &o)), "start");
         let mut o2 = o.clone();
         o2.min_omega = f64::NAN;
-        assert_eq!(name(periodic_branch(&p, "Omega", &start.sol, &o2)), "min_omega");
+        assert_eq!(
+            name(periodic_branch(&p, "Omega", &start.sol, &o2)),
+            "min_omega"
+        );
     }
 }
 
@@ -640,11 +687,23 @@ mod explore {
     #[test]
     #[ignore]
     fn explore_branch() {
-        let zb: f64 = std::env::var("ZB").ok().and_then(|v| v.parse().ok()).unwrap_or(0.05);
-        let eta: f64 = std::env::var("ETA").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
-        let om: f64 = std::env::var("OM").ok().and_then(|v| v.parse().ok()).unwrap_or(1.2);
-        let fwd = std::env::var("FWD").map_or(true, |v| v == "1");
-        let n: usize = std::env::var("N").ok().and_then(|v| v.parse().ok()).unwrap_or(8);
+        let zb: f64 = std::env::var("ZB")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0.05);
+        let eta: f64 = std::env::var("ETA")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1.0);
+        let om: f64 = std::env::var("OM")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1.2);
+        let fwd = std::env::var("FWD").as_deref() != Ok("0");
+        let n: usize = std::env::var("N")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(8);
         let p = Planar::new(0.2, 0.05, &[zb], 50.0, om, &[eta, eta]).unwrap();
         let o = PoBranchOptions {
             arc: ArcOptions {
@@ -671,10 +730,18 @@ mod explore {
         println!("start {:?} omega {}", start.sol.status, start.sol.omega);
         let t = std::time::Instant::now();
         let b = periodic_branch(&p, "Omega", &start.sol, &o).unwrap();
-        println!("{} points in {:?}, stop {}", b.points.len(), t.elapsed(), b.stop);
+        println!(
+            "{} points in {:?}, stop {}",
+            b.points.len(),
+            t.elapsed(),
+            b.stop
+        );
         for pt in &b.points {
             let m = pt.multipliers().map(|m| {
-                m.iter().map(|z| format!("{:.3}{:+.3}i", z.0, z.1)).collect::<Vec<_>>().join(" ")
+                m.iter()
+                    .map(|z| format!("{:.3}{:+.3}i", z.0, z.1))
+                    .collect::<Vec<_>>()
+                    .join(" ")
             });
             println!(
                 "p={:.6} w={:.5} {} {} lp={:+.2e} bp={:+.2e} pd={:?} ns={:?} ev={:?} | {}",
@@ -691,7 +758,14 @@ mod explore {
             );
         }
         for e in &b.events {
-            println!("EVENT {} p={:.9} test={:.3e} idx={} w={}", e.kind.as_str(), e.p, e.test, e.index, e.point.omega());
+            println!(
+                "EVENT {} p={:.9} test={:.3e} idx={} w={}",
+                e.kind.as_str(),
+                e.p,
+                e.test,
+                e.index,
+                e.point.omega()
+            );
         }
     }
 }
