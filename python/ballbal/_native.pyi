@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ._branch import Continuation
 from ._rotor import RotorOnBearing
 from .basins import BasinOptions
 from .bearing import Bearing
@@ -24,7 +25,7 @@ __all__ = [
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
-    "groove_study", "__version__",
+    "groove_study", "periodic_branch", "switch_periodic", "switch_hopf", "__version__",
 ]
 
 __version__: str
@@ -117,3 +118,10 @@ def switch_hopf(
     model: Balancer | Scene, parameter: str, q: list[float], amplitude: float,
     options: PeriodicOptions,
 ) -> tuple[dict[str, Any], float, tuple[float, float]]: ...
+
+# rust/py/src/po_continuation.rs: {"points": [dict], "events": [dict], "stop": str}
+def periodic_branch(
+    model: Balancer | Scene, parameter: str,
+    start: tuple[float, npt.NDArray[np.float64], list[float]], p_range: tuple[float, float],
+    continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
+) -> dict[str, Any]: ...

@@ -8,7 +8,8 @@ from ballbal._eq_continuation import (
     from_seed003,
     switch_equilibrium,
 )
+from ballbal._po_continuation import periodic_branch
 from ballbal._po_switch import switch
 
 __all__ = ["Branch", "Continuation", "Curve", "equilibrium_branch", "equilibrium_curve",
-           "from_seed003", "switch", "switch_equilibrium"]
+           "from_seed003", "periodic_branch", "switch", "switch_equilibrium"]

@@ -411,7 +411,10 @@ fn run_scan<D: Family>(
         |(c, rows)| {
             let t = std::time::Instant::now();
             let r = scan_columns(py, cols, &rows).and_then(|d| on_chunk.call1((c, d)).map(|_| ()));
-            TABLE_NS.fetch_add(t.elapsed().as_nanos() as u64, std::sync::atomic::Ordering::Relaxed);
+            TABLE_NS.fetch_add(
+                t.elapsed().as_nanos() as u64,
+                std::sync::atomic::Ordering::Relaxed,
+            );
             r
         },
     )

@@ -204,9 +204,10 @@ pub fn equilibrium_branch<'py>(
     let m = self::model(&model)?;
     let k = kind_from(&kind).py()?;
     let opts = options_checked(&m, &options, range)?;
-    let b = guarded(py, || {
-        dispatch!(&m, d => run_branch(d, &parameter, &q, k, &opts))
-    })?;
+    let b = guarded(
+        py,
+        || dispatch!(&m, d => run_branch(d, &parameter, &q, k, &opts)),
+    )?;
     branch_dict(py, b)
 }
 
@@ -226,9 +227,10 @@ pub fn equilibrium_switch<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let opts = options_checked(&m, &options, range)?;
-    let b = guarded(py, || {
-        dispatch!(&m, d => run_switch(d, &parameter, &x, p, &tangent, &opts))
-    })?;
+    let b = guarded(
+        py,
+        || dispatch!(&m, d => run_switch(d, &parameter, &x, p, &tangent, &opts)),
+    )?;
     branch_dict(py, b)
 }
 
@@ -265,9 +267,10 @@ pub fn equilibrium_curve<'py>(
         }
     };
     let opts = options_checked(&m, &options, range)?;
-    let c = guarded(py, || {
-        dispatch!(&m, d => run_curve(d, k, (&parameter, &parameter2), &q, p1, together, &opts))
-    })?;
+    let c = guarded(
+        py,
+        || dispatch!(&m, d => run_curve(d, k, (&parameter, &parameter2), &q, p1, together, &opts)),
+    )?;
     curve_dict(py, c)
 }
 

@@ -13,6 +13,7 @@ mod entries;
 mod eq_continuation;
 mod errors;
 mod groove;
+mod po_continuation;
 mod po_switch;
 mod rotor;
 mod run;
@@ -79,6 +80,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     eq_continuation::register(m)?;
     po_switch::register(m)?;
     m.add_function(wrap_pyfunction!(groove::groove_study, m)?)?;
+    m.add_function(wrap_pyfunction!(po_continuation::periodic_branch, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -9,6 +9,7 @@ pub mod family;
 pub mod homotopy;
 pub mod journal;
 pub mod periodic;
+pub mod po_branch;
 pub mod record;
 pub mod simulate;
 pub mod switch;

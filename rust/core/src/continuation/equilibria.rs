@@ -489,7 +489,10 @@ pub fn branch<D: Dynamics + Clone>(
     opts: &EqOptions,
 ) -> Result<EqBranch> {
     if sys.reduced {
-        return Err(Error::param("start", "a branch is continued on full coordinates"));
+        return Err(Error::param(
+            "start",
+            "a branch is continued on full coordinates",
+        ));
     }
     if !(opts.locate_tol > 0.0) {
         return Err(Error::param("locate_tol", "must be positive"));
@@ -877,14 +880,7 @@ fn curve_half<'a, D: Dynamics + Clone>(
         ));
     }
     let x0 = sys.reduce(q);
-    let mut ext = Extended::new(
-        sys,
-        CurveTest {
-            kind,
-            scale: 1.0,
-        },
-        p2,
-    );
+    let mut ext = Extended::new(sys, CurveTest { kind, scale: 1.0 }, p2);
     // Normalise g by its gradient at the start: then |g| is about the distance from the
     // curve, and the corrector's tolerance applies to it as to F.
     let n = x0.len();
@@ -1022,13 +1018,7 @@ fn curve_half<'a, D: Dynamics + Clone>(
         let k = kind_of(&q, s.o, start_kind);
         let eq = analyse_model(s.model(&p)?, &q, k, opts.family);
         let g = raw_curve_test(kind, s, &pt.x[..n], &p)? * arc.problem().test.scale;
-        points.push(CurvePoint {
-            p,
-            q,
-            eq,
-            omega,
-            g,
-        });
+        points.push(CurvePoint { p, q, eq, omega, g });
         prev = Some((pt, tt));
     }
     let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
@@ -1103,7 +1093,10 @@ mod tests {
         }
         let prod = pair_sum_product(&ev);
         let det = bialternate_det(&a, 4);
-        assert!((prod - det).abs() < 1e-10 * det.abs().max(1.0), "{prod} {det}");
+        assert!(
+            (prod - det).abs() < 1e-10 * det.abs().max(1.0),
+            "{prod} {det}"
+        );
     }
 
     #[test]
@@ -1136,7 +1129,11 @@ mod tests {
             .collect();
         assert!(!bp.is_empty() && !fold.is_empty(), "{:?}", br.events);
         assert!((bp[0].p - 0.5).abs() < 1e-9, "{}", bp[0].p);
-        assert!((fold[0].p - eta_fold(om, zeta)).abs() < 1e-8, "{}", fold[0].p);
+        assert!(
+            (fold[0].p - eta_fold(om, zeta)).abs() < 1e-8,
+            "{}",
+            fold[0].p
+        );
         // Switching at the pitchfork reaches the perfect balance, b = arccos(-1/(2 eta)).
         let ev = bp[0];
         let pb = switch(&mut sys, &ev.x, ev.p, &ev.tangent, &opts(0.2, 1.0)).unwrap();
@@ -1169,7 +1166,11 @@ mod tests {
             &opts(0.2, 1.0),
         )
         .unwrap();
-        let f = br.events.iter().find(|e| e.kind == EventKind::Fold).unwrap();
+        let f = br
+            .events
+            .iter()
+            .find(|e| e.kind == EventKind::Fold)
+            .unwrap();
         let sys2 = EqSystem::family(&p, &["eta", "Omega"])
             .unwrap()
             .on_together()
@@ -1218,11 +1219,20 @@ mod tests {
             .expect("hopf");
         let lead = h.eq.eigenvalues[0];
         assert!(lead.0.abs() < 1e-8, "{lead:?}");
-        assert!((lead.1.abs() - h.omega).abs() < 1e-8, "{lead:?} {}", h.omega);
+        assert!(
+            (lead.1.abs() - h.omega).abs() < 1e-8,
+            "{lead:?} {}",
+            h.omega
+        );
         let mut sys2 = EqSystem::family(&p, &["Omega", "eta"]).unwrap();
         let _ = &mut sys2;
         let c = curve(sys2, CurveKind::Hopf, &h.x, h.p, 1.3, &opts(0.5, 1.5)).unwrap();
-        assert!(c.points.len() > 10, "{:?} {:?}", c.stop, c.points.iter().map(|p| p.p).collect::<Vec<_>>());
+        assert!(
+            c.points.len() > 10,
+            "{:?} {:?}",
+            c.stop,
+            c.points.iter().map(|p| p.p).collect::<Vec<_>>()
+        );
         for pt in &c.points {
             assert!(pt.eq.index.abs() < 1e-7, "{} at {:?}", pt.eq.index, pt.p);
         }

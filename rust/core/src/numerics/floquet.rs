@@ -746,7 +746,10 @@ mod tests {
                     };
                     let (us, f) = time(&|| floquet(&p, &sol, &o).unwrap());
                     let e = multiplier_distance(&f.multipliers, &reference.multipliers);
-                    println!("  rk45   rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e}", f.steps);
+                    println!(
+                        "  rk45   rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e}",
+                        f.steps
+                    );
                 }
                 let n2 = 8;
                 let rho = state_norm(&mut orbit_state_matrix(&p, &sol), n2, sol.period());
@@ -766,7 +769,10 @@ mod tests {
                     let ev = eigenvalues(&phi, n2).unwrap();
                     let e = multiplier_distance(&ev, &reference.multipliers);
                     let hr = sol.period() / k as f64 * rho;
-                    println!("  magnus K {k:4}: {us:8.0} us err {e:.1e} h||A|| {hr:.2} C(1e-6) {:.1}", hr / e.powf(1.0 / 6.0));
+                    println!(
+                        "  magnus K {k:4}: {us:8.0} us err {e:.1e} h||A|| {hr:.2} C(1e-6) {:.1}",
+                        hr / e.powf(1.0 / 6.0)
+                    );
                 }
                 for rtol in [1e-5, 1e-6, 1e-7, 1e-8] {
                     let o = FloquetOptions {

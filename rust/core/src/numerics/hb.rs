@@ -1117,7 +1117,9 @@ mod tests {
         g: &HbSolution,
         o: &crate::periodic::PeriodicOptions,
     ) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+        crate::periodic::periodic(p, &[true, true], Some(g), o)
+            .sol
+            .omega
     }
     #[inline(never)]
     fn hb_profile_n6(
@@ -1125,7 +1127,9 @@ mod tests {
         g: &HbSolution,
         o: &crate::periodic::PeriodicOptions,
     ) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+        crate::periodic::periodic(p, &[true, true], Some(g), o)
+            .sol
+            .omega
     }
     #[inline(never)]
     fn hb_profile_n8(
@@ -1133,7 +1137,9 @@ mod tests {
         g: &HbSolution,
         o: &crate::periodic::PeriodicOptions,
     ) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+        crate::periodic::periodic(p, &[true, true], Some(g), o)
+            .sol
+            .omega
     }
     #[inline(never)]
     fn hb_profile_n12(
@@ -1141,6 +1147,8 @@ mod tests {
         g: &HbSolution,
         o: &crate::periodic::PeriodicOptions,
     ) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o).sol.omega
+        crate::periodic::periodic(p, &[true, true], Some(g), o)
+            .sol
+            .omega
     }
 }

@@ -337,7 +337,10 @@ mod tests {
         let r = monodromy_fixed(a, 2, p, 400);
         let err = |k| {
             let m = monodromy_fixed(a, 2, p, k);
-            m.iter().zip(&r).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+            m.iter()
+                .zip(&r)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max)
         };
         let (e1, e2) = (err(8), err(16));
         assert!(e1 / e2 > 40.0 && e1 / e2 < 100.0, "{e1} {e2}");

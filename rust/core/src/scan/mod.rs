@@ -54,7 +54,8 @@ pub fn stage_seconds() -> [f64; 4] {
     std::array::from_fn(|i| STAGE_NS[i].load(Ordering::Relaxed) as f64 * 1e-9)
 }
 
-static STAGE_NS: [std::sync::atomic::AtomicU64; 4] = [const { std::sync::atomic::AtomicU64::new(0) }; 4];
+static STAGE_NS: [std::sync::atomic::AtomicU64; 4] =
+    [const { std::sync::atomic::AtomicU64::new(0) }; 4];
 
 fn add_stage(i: usize, since: std::time::Instant) {
     STAGE_NS[i].fetch_add(since.elapsed().as_nanos() as u64, Ordering::Relaxed);

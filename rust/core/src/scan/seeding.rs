@@ -4,9 +4,9 @@
 use super::grid::Local;
 use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
 use super::{Family, Found, Origin, ScanSpec};
+use crate::analysis::attractors::seed_guess;
 use crate::continuation::Lattice;
 use crate::hb::{solve, HbSolution, Status};
-use crate::analysis::attractors::seed_guess;
 use crate::periodic::{finish, initial_states};
 use rayon::prelude::*;
 use std::ops::Range;

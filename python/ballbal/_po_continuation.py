@@ -1,0 +1,175 @@
+"""Continuation of periodic solutions in one parameter (pseudo-arclength on the
+harmonic-balance equations, ``rust/core/src/analysis/po_branch.rs``), every point
+certified and judged as :func:`ballbal.periodic` does, with its bifurcations located.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+from . import _check, _native
+from ._branch import Branch, Continuation
+from .analysis import PeriodicSolution
+from .exceptions import ParameterError, ParameterTypeError
+from .model import Balancer
+from .options import PERIODIC_DEFAULTS, PeriodicOptions
+from .scene import Scene
+
+__all__ = ["Branch", "Continuation", "periodic_branch"]
+
+_INDEXED = re.compile(r"^(eta|zeta_b)\[(\d+)\]$")
+
+
+def _model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:
+    """``model`` with ``parameter`` set to ``value`` (``"eta[2]"``: one ball's)."""
+    m = _INDEXED.match(parameter)
+    if m is None:
+        return model.replace(**{parameter: value})
+    name, i = m.group(1), int(m.group(2))
+    bal = model.balancer if isinstance(model, Scene) else model
+    old = getattr(bal, name)
+    vals = list(old) if isinstance(old, (tuple, list)) else [old] * bal.n_balls
+    vals[i - 1] = value
+    return model.replace(**{name: tuple(vals)})
+
+
+def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:
+    mult = d["mult_re"] + 1j * d["mult_im"] if d["mult_re"] is not None else None
+    hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None
+    return PeriodicSolution(
+        tail=d["tail"], target_met=d["target_met"], hill_multipliers=hill_m,
+        hill_stability=d["hill_stability"], verdicts_disagree=d["verdicts_disagree"],
+        balancer=model, status=d["status"], type=d["type"], omega=d["omega"],
+        coeffs=d["coeffs"], winding=d["winding"], N=d["N"], samples=d["samples"],
+        residual=d["residual"], iterations=d["iterations"], multipliers=mult,
+        stability=d["stability"], max_modulus=d["max_modulus"],
+        trivial_error=d["trivial_error"], floquet_steps=d["floquet_steps"],
+        pivot_ratio=d["pivot_ratio"], closure=d["closure"],
+        separation_error=d["separation_error"],
+        info={"floquet_error": d["floquet_error"], "last_omega": d["last_omega"]},
+    )
+
+
+def _multipliers(d: dict[str, Any]) -> tuple[list[float] | None, list[float] | None]:
+    if d["mult_re"] is not None:
+        return list(d["mult_re"]), list(d["mult_im"])
+    if "hill_re" in d:
+        return list(d["hill_re"]), list(d["hill_im"])
+    return None, None
+
+
+def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
+    re_, im = _multipliers(d)
+    omega = d["omega"]
+    mod = None if re_ is None or im is None else np.hypot(re_, im)
+    return {
+        parameter: d["p"], "omega": omega,
+        "period": None if omega is None else 2 * np.pi / omega,
+        "status": d["status"], "stability": d["stability"],
+        "max_modulus": d["max_modulus"] if d["max_modulus"] is not None or mod is None
+        else float(np.sort(mod)[-2] if len(mod) > 1 else mod[0]),
+        "mult_re": re_, "mult_im": im,
+        "trivial_error": d["trivial_error"], "closure": d["closure"], "tail": d["tail"],
+        "separation_error": d["separation_error"], "residual": d["residual"],
+        "dp_ds": d["dp_ds"], "det_sign": d["det_sign"],
+        "test_LP": d["test_LP"], "test_BP": d["test_BP"],
+        "test_BP_multipliers": d["test_BP_multipliers"], "test_PD": d["test_PD"],
+        "test_NS": d["test_NS"], "event": d["event"],
+    }
+
+
+def _schema(parameter: str) -> dict[str, Any]:
+    f, s, lf = pl.Float64, pl.Utf8, pl.List(pl.Float64)
+    return {parameter: f, "omega": f, "period": f, "status": s, "stability": s,
+            "max_modulus": f, "mult_re": lf, "mult_im": lf, "trivial_error": f,
+            "closure": f, "tail": f, "separation_error": f, "residual": f, "dp_ds": f,
+            "det_sign": f, "test_LP": f, "test_BP": f, "test_BP_multipliers": f,
+            "test_PD": f, "test_NS": f, "event": s}
+
+
+def periodic_branch(
+    start: PeriodicSolution,
+    parameter: str,
+    *,
+    range: tuple[float, float],  # noqa: A002 - the documented keyword
+    options: Continuation | None = None,
+    N: int | None = None,
+    periodic_options: PeriodicOptions | None = None,
+    min_omega: float = 1e-3,
+    event_tol: float = 1e-7,
+) -> Branch:
+    """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
+    in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
+    ``"eta[2]"``, a scene's ``"springs"``, ...) over ``range = (lo, hi)`` by
+    pseudo-arclength continuation of the harmonic-balance equations (through folds),
+    with ``N`` harmonics (default: the start's).
+
+    Every point gets the certificates and Floquet multipliers of :func:`ballbal.periodic`
+    with ``periodic_options`` (default :data:`ballbal.options.PERIODIC_DEFAULTS`;
+    ``Floquet(monodromy=False, hill=True)`` uses Hill's multipliers instead): a point
+    whose certificate fails has status ``not_closed`` / ``truncated`` and is never
+    called stable. Events, located to ``event_tol`` in the parameter between two
+    points: ``LP`` (fold: ``dp/ds`` changes sign), ``BP`` (branch point: the bordered
+    determinant changes sign, i.e. a real multiplier passes +1 other than the trivial
+    one; for merged balls the ball-separation multiplier), ``PD`` (a real multiplier
+    through -1), ``NS`` (a complex pair through the unit circle) and ``IP`` (infinite
+    period: omega falls below ``min_omega``, or a point fails its certificate while
+    omega falls; that point is not kept, the branch stops with ``"infinite_period"`` and
+    the event's parameter is where ``omega^2``, linear in the parameter there,
+    extrapolates to 0).
+
+    Returns a :class:`~ballbal._branch.Branch` of kind ``"periodic"``: ``table`` (one row
+    per point: the parameter, omega, period, status, stability, max modulus, multipliers,
+    certificates, test functions, ``event``: the events located between the previous row
+    and this one), ``events`` (type, parameter, the located solution's summary, the test
+    function's value, ``index``: the row after it), ``solutions`` and
+    ``event_solutions`` (:class:`~ballbal.PeriodicSolution` objects with the model at
+    their parameter value, row for row and event for event).
+    """
+    if not isinstance(start, PeriodicSolution):
+        raise ParameterTypeError("start", "must be a PeriodicSolution (from ballbal.periodic)",
+                                 value=start)
+    if start.omega is None or start.status != "converged":
+        raise ParameterError("start", f"must be a converged solution, got status {start.status!r}")
+    _check.string("parameter", parameter)
+    if not isinstance(range, (tuple, list)) or len(range) != 2:
+        raise ParameterTypeError("range", "must be (lo, hi)", value=range)
+    lo, hi = _check.real("range", range[0]), _check.real("range", range[1])
+    options = _check.option("options", options, Continuation, Continuation(),
+                            "ballbal.continuation.Continuation")
+    popts = _check.option("periodic_options", periodic_options, PeriodicOptions,
+                          PERIODIC_DEFAULTS, "ballbal.PeriodicOptions")
+    n = start.N if N is None else _check.integer("N", N, 1, 256)
+    popts = replace(popts, harmonic_balance=replace(popts.harmonic_balance, N=n))
+    min_omega = _check.real("min_omega", min_omega)
+    event_tol = _check.real("event_tol", event_tol)
+    model = start.balancer
+    coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
+    winding = [float(w) for w in start.winding]
+    d = _native.periodic_branch(model, parameter, (float(start.omega), coeffs, winding),
+                                (lo, hi), options, popts, min_omega, event_tol)
+    table = pl.DataFrame([_row(parameter, p) for p in d["points"]], schema=_schema(parameter),
+                         orient="row") if d["points"] else pl.DataFrame(schema=_schema(parameter))
+    ev_rows = []
+    for e in d["events"]:
+        r = _row(parameter, e)
+        r.pop("event")
+        r[parameter] = e["event_p"]
+        ev_rows.append({"type": e["event_type"], **r, "test": e["test"], "index": e["index"]})
+    ev_schema = {"type": pl.Utf8, **{k: v for k, v in _schema(parameter).items() if k != "event"},
+                 "test": pl.Float64, "index": pl.Int64}
+    events = (pl.DataFrame(ev_rows, schema=ev_schema, orient="row") if ev_rows
+              else pl.DataFrame(schema=ev_schema))
+    solutions = tuple(_solution(_model_at(model, parameter, p["p"]), p) for p in d["points"])
+    event_solutions = tuple(_solution(_model_at(model, parameter, e["p"]), e)
+                            for e in d["events"])
+    return Branch(kind="periodic", parameter=parameter, table=table, events=events,
+                  stop=d["stop"], solutions=solutions, event_solutions=event_solutions,
+                  meta={"N": n, "pattern": start.type, "range": (lo, hi),
+                        "min_omega": min_omega, "event_tol": event_tol,
+                        "options": options})

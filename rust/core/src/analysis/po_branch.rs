@@ -1,0 +1,771 @@
+//! Branches of periodic solutions in one model parameter: pseudo-arclength continuation
+//! ([`crate::continuation::Arclength`]) of the harmonic-balance problem
+//! ([`HbProblem`], unknowns the coefficients and omega), every point certified and
+//! judged exactly as [`crate::periodic::periodic`] does it ([`finish`]: closure and
+//! tail certificates, Floquet multipliers, trivial and separation checks), with the
+//! bifurcations located between points:
+//!
+//! * fold `LP`: the tangent's parameter component `dp/ds` changes sign;
+//! * branch point `BP`: the bordered determinant `det [[F_x, F_p], [t^T]]` changes sign
+//!   (for merged balls, the antisymmetric separation multiplier passes +1, and the
+//!   separated solutions live in the same harmonic-balance space); a real multiplier
+//!   through +1 that neither a fold nor the determinant explains is reported as `BP`
+//!   too, located on the multipliers;
+//! * period doubling `PD`: a real multiplier through -1 (`prod (lambda + 1)`);
+//! * Neimark–Sacker `NS`: a complex pair through the unit circle
+//!   (`prod (|lambda|^2 - 1)` over the complex pairs, when their count is the same on
+//!   both sides);
+//! * infinite period `IP`: on a rotating branch omega falls to 0 (a saddle-node on the
+//!   invariant circle of the equilibria, `T ~ C / sqrt|p - p*|`). A fixed number of
+//!   harmonics cannot follow it: the branch ends when omega falls below `min_omega`, or
+//!   when a point fails its certificate while omega is falling. That point is not
+//!   kept; `p*` is estimated from the last two kept points (`omega^2` linear in `p`).
+//!
+//! Every test function is continuous along the branch and changes sign exactly at its
+//! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
+//! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
+
+use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::error::{Error, Result};
+use crate::floquet::Stability;
+use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
+use crate::numerics::problem::{ModelAt, Parametric, Problem};
+use crate::periodic::{finish, Periodic, PeriodicOptions};
+use nalgebra::DMatrix;
+
+/// Settings of [`periodic_branch`].
+#[derive(Debug, Clone)]
+pub struct PoBranchOptions {
+    /// Step control and the parameter window (`p_min`, `p_max`).
+    pub arc: ArcOptions,
+    /// Harmonics, certificates and the Floquet / Hill analysis of every point (`auto`
+    /// is ignored: a branch keeps one number of harmonics).
+    pub periodic: PeriodicOptions,
+    /// The branch ends (infinite period) when omega falls below this.
+    pub min_omega: f64,
+    /// Events are located to this arclength, hence to this in the parameter.
+    pub event_tol: f64,
+}
+
+impl Default for PoBranchOptions {
+    fn default() -> Self {
+        PoBranchOptions {
+            arc: ArcOptions::default(),
+            periodic: PeriodicOptions::default(),
+            min_omega: 1e-3,
+            event_tol: 1e-7,
+        }
+    }
+}
+
+impl PoBranchOptions {
+    pub fn validate(&self) -> Result<()> {
+        if !(self.arc.p_min < self.arc.p_max) || self.arc.p_min.is_nan() {
+            return Err(Error::param_range(
+                "range",
+                format!(
+                    "needs lo < hi, got ({}, {})",
+                    self.arc.p_min, self.arc.p_max
+                ),
+                "lo < hi",
+            ));
+        }
+        self.arc.validate()?;
+        self.periodic.validate()?;
+        crate::error::check_range("min_omega", self.min_omega, 0.0, false, 1e3, true)?;
+        crate::error::check_range("event_tol", self.event_tol, 0.0, true, 1.0, true)?;
+        Ok(())
+    }
+}
+
+/// An event type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PoEventKind {
+    Fold,
+    BranchPoint,
+    PeriodDoubling,
+    NeimarkSacker,
+    InfinitePeriod,
+}
+
+impl PoEventKind {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            PoEventKind::Fold => "LP",
+            PoEventKind::BranchPoint => "BP",
+            PoEventKind::PeriodDoubling => "PD",
+            PoEventKind::NeimarkSacker => "NS",
+            PoEventKind::InfinitePeriod => "IP",
+        }
+    }
+}
+
+/// The test functions at a point (multiplier ones `None` without multipliers).
+#[derive(Debug, Clone, Default)]
+pub struct PoTests {
+    /// `dp/ds`.
+    pub lp: f64,
+    /// The bordered determinant (rows scaled to unit max-norm: same sign, continuous).
+    pub bp: f64,
+    /// `prod (lambda - 1) / max(1, |lambda|)` over the non-trivial multipliers.
+    pub bp_multipliers: Option<f64>,
+    /// `prod (lambda + 1) / max(1, |lambda|)` over the non-trivial multipliers.
+    pub pd: Option<f64>,
+    /// `prod (|lambda|^2 - 1) / max(1, |lambda|^2)` over the complex pairs.
+    pub ns: Option<f64>,
+    /// Number of complex pairs among the non-trivial multipliers.
+    pub complex_pairs: usize,
+}
+
+/// One point of a branch.
+#[derive(Debug, Clone)]
+pub struct PoPoint {
+    pub p: f64,
+    /// The series, certified and judged as `periodic()` does (a point whose certificate
+    /// fails has status `NotClosed` / `Truncated`, no multipliers and no verdict).
+    pub result: Periodic,
+    pub arc: ArcPoint,
+    pub tests: PoTests,
+    /// Events located between the previous point and this one.
+    pub events: Vec<PoEventKind>,
+}
+
+impl PoPoint {
+    pub fn omega(&self) -> f64 {
+        self.result.sol.omega
+    }
+    /// The multipliers the test functions use: the monodromy's, else Hill's.
+    pub fn multipliers(&self) -> Option<&[(f64, f64)]> {
+        match (&self.result.floquet, &self.result.hill) {
+            (Some(f), _) => Some(&f.multipliers),
+            (None, Some((m, _))) => Some(m),
+            _ => None,
+        }
+    }
+    pub fn stability(&self) -> Stability {
+        match (&self.result.floquet, &self.result.hill) {
+            (Some(f), _) => f.stability,
+            (None, Some((_, s))) => *s,
+            _ => Stability::Undetermined,
+        }
+    }
+}
+
+/// A located event.
+#[derive(Debug, Clone)]
+pub struct PoEvent {
+    pub kind: PoEventKind,
+    pub p: f64,
+    /// The solution at the event (for `IP`, the last point kept).
+    pub point: PoPoint,
+    /// The test function's value there (for `IP`, the period of the last point kept).
+    pub test: f64,
+    /// Index of the branch point after the event (for `IP`, one past the last).
+    pub index: usize,
+}
+
+#[derive(Debug, Clone)]
+pub struct PoBranch {
+    pub points: Vec<PoPoint>,
+    pub events: Vec<PoEvent>,
+    /// `"boundary"`, `"max_points"`, `"step_too_small"`, `"infinite_period"`,
+    /// `"failed: ..."`.
+    pub stop: String,
+}
+
+fn stop_text(s: Option<&ArcStop>) -> String {
+    match s {
+        None | Some(ArcStop::MaxPoints) => "max_points".into(),
+        Some(ArcStop::Boundary) => "boundary".into(),
+        Some(ArcStop::StepTooSmall) => "step_too_small".into(),
+        Some(ArcStop::Finished(w)) => w.clone(),
+        Some(ArcStop::Failed(w)) => format!("failed: {w}"),
+    }
+}
+
+/// What a point needs besides its `ArcPoint`: the model family and the series' shape.
+struct Ctx<'a, D> {
+    base: &'a D,
+    name: &'a str,
+    winding: Vec<f64>,
+    n_harm: usize,
+    samples: usize,
+    popts: PeriodicOptions,
+    w: Vec<f64>,
+}
+
+impl<D: Parametric> Ctx<'_, D> {
+    fn series(&self, pt: &ArcPoint) -> HbSolution {
+        let n = pt.x.len();
+        let omega = pt.x[n - 1];
+        HbSolution {
+            omega,
+            coeffs: pt.x[..n - 1].to_vec(),
+            winding: self.winding.clone(),
+            n_harm: self.n_harm,
+            samples: self.samples,
+            residual: pt.residual,
+            step: 0.0,
+            iterations: pt.iterations,
+            status: if omega > 0.0 && omega.is_finite() {
+                Status::Converged
+            } else {
+                Status::Diverged
+            },
+            pivot_ratio: f64::NAN,
+        }
+    }
+
+    /// Certificates and multipliers of the point, as `periodic()` gives them.
+    fn judge(&self, pt: &ArcPoint) -> Result<Periodic> {
+        let m = self.base.with_param(self.name, pt.p)?;
+        Ok(finish(&m, self.series(pt), &self.popts))
+    }
+
+    fn point<P: Problem + ?Sized>(&self, prob: &mut P, pt: &ArcPoint) -> Result<PoPoint> {
+        let result = self.judge(pt)?;
+        let mut tests = PoTests {
+            lp: pt.dp_ds(),
+            bp: bordered_det(prob, pt, &self.w)?,
+            ..Default::default()
+        };
+        let po = PoPoint {
+            p: pt.p,
+            result,
+            arc: pt.clone(),
+            tests: PoTests::default(),
+            events: vec![],
+        };
+        if let Some(m) = po.multipliers() {
+            let t = multiplier_tests(m);
+            tests.bp_multipliers = Some(t.0);
+            tests.pd = Some(t.1);
+            tests.ns = Some(t.2);
+            tests.complex_pairs = t.3;
+        }
+        Ok(PoPoint { tests, ..po })
+    }
+}
+
+/// The bordered matrix's determinant with each row scaled to unit max-norm (a positive
+/// factor: the sign, which changes at a branch point, and continuity are kept, and the
+/// value stays in range).
+fn bordered_det<P: Problem + ?Sized>(prob: &mut P, pt: &ArcPoint, w: &[f64]) -> Result<f64> {
+    let n = prob.size();
+    let (mut r, mut jac, mut fp) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n]);
+    prob.jac_x(&pt.x, pt.p, &mut r, &mut jac)?;
+    prob.jac_p(&pt.x, pt.p, &mut fp)?;
+    let mut m = DMatrix::from_fn(n + 1, n + 1, |i, j| {
+        if i < n {
+            if j < n {
+                jac[i * n + j]
+            } else {
+                fp[i]
+            }
+        } else {
+            w[j] * pt.tangent[j]
+        }
+    });
+    for i in 0..=n {
+        let s = (0..=n).fold(0.0f64, |a, j| a.max(m[(i, j)].abs()));
+        if s > 0.0 {
+            for j in 0..=n {
+                m[(i, j)] /= s;
+            }
+        }
+    }
+    Ok(m.lu().determinant())
+}
+
+/// `(bp, pd, ns, complex pairs)` from the multipliers, the trivial one (closest to 1)
+/// left out. Each factor is divided by a positive scale so that strongly unstable orbits
+/// (moduli up to 1e7) keep the products in range.
+fn multiplier_tests(m: &[(f64, f64)]) -> (f64, f64, f64, usize) {
+    let trivial = m
+        .iter()
+        .enumerate()
+        .min_by(|a, b| {
+            let da = (a.1 .0 - 1.0).hypot(a.1 .1);
+            let db = (b.1 .0 - 1.0).hypot(b.1 .1);
+            da.total_cmp(&db)
+        })
+        .map_or(usize::MAX, |(i, _)| i);
+    let (mut bp, mut pd, mut ns) = ((1.0, 0.0), (1.0, 0.0), 1.0);
+    let mut pairs = 0;
+    let mul = |a: (f64, f64), b: (f64, f64)| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
+    for (i, &(re, im)) in m.iter().enumerate() {
+        if i == trivial {
+            continue;
+        }
+        let r = re.hypot(im);
+        let s = r.max(1.0);
+        bp = mul(bp, ((re - 1.0) / s, im / s));
+        pd = mul(pd, ((re + 1.0) / s, im / s));
+        // One factor per conjugate pair (the one with im > 0).
+        if im > 1e-9 * s {
+            ns *= (r * r - 1.0) / (s * s);
+            pairs += 1;
+        }
+    }
+    (bp.0, pd.0, ns, pairs)
+}
+
+/// Continues the periodic solution `start` (a converged series of `base`) in the
+/// parameter `name` of `base` over `opts.arc.p_min ..= p_max`, from `base`'s value of
+/// it, with `opts.periodic.hb.n_harm` harmonics.
+pub fn periodic_branch<D: Parametric>(
+    base: &D,
+    name: &str,
+    start: &HbSolution,
+    opts: &PoBranchOptions,
+) -> Result<PoBranch> {
+    opts.validate()?;
+    let p0 = base.param_value(name).map_err(|_| {
+        Error::param(
+            "parameter",
+            format!("{name:?} is not a parameter of this model"),
+        )
+    })?;
+    if !(opts.arc.p_min..=opts.arc.p_max).contains(&p0) {
+        return Err(Error::param_range(
+            "range",
+            format!(
+                "must contain the start's {name} = {p0}, got ({}, {})",
+                opts.arc.p_min, opts.arc.p_max
+            ),
+            format!("lo <= {p0} <= hi"),
+        ));
+    }
+    let d = base.ndof();
+    if start.winding.len() != d
+        || start.coeffs.len() != d * (2 * start.n_harm + 1)
+        || !(start.omega > 0.0 && start.omega.is_finite())
+        || start.coeffs.iter().any(|c| !c.is_finite())
+    {
+        return Err(Error::param(
+            "start",
+            "needs a converged periodic solution of this model (omega > 0, finite coefficients)",
+        ));
+    }
+    let mut popts = opts.periodic.clone();
+    popts.auto = None;
+    let n_harm = popts.hb.n_harm;
+    let samples = popts.hb.samples.unwrap_or_else(|| default_samples(n_harm));
+    popts.hb.samples = Some(samples);
+    // The start at the branch's own harmonics and samples.
+    let first = solve(base, start, &popts.hb);
+    if first.status != Status::Converged {
+        return Err(Error::param(
+            "start",
+            format!(
+                "does not converge with N = {n_harm} at {name} = {p0} (status {})",
+                first.status.as_str()
+            ),
+        ));
+    }
+    let mut prob = HbProblem::new(
+        ModelAt::family(base, name, p0),
+        &first.winding,
+        n_harm,
+        samples,
+    );
+    let n1 = prob.size() + 1;
+    let ctx = Ctx {
+        base,
+        name,
+        winding: first.winding.clone(),
+        n_harm,
+        samples,
+        popts,
+        w: opts
+            .arc
+            .weights
+            .clone()
+            .filter(|w| w.len() == n1)
+            .unwrap_or_else(|| vec![1.0; n1]),
+    };
+    let mut arc = Arclength::new(&mut prob, &first.unknowns(), p0, None, opts.arc.clone())?;
+    let mut points: Vec<PoPoint> = Vec::new();
+    let mut events: Vec<PoEvent> = Vec::new();
+    while let Some(pt) = arc.next() {
+        let mut po = ctx.point(arc.problem(), &pt)?;
+        let certified = po.result.sol.status == Status::Converged;
+        if let Some(prev) = points.last() {
+            let falling = po.omega() < prev.omega();
+            if po.omega() < opts.min_omega || (!certified && falling) {
+                events.push(infinite_period(&points));
+                arc.finish("infinite_period");
+                break;
+            }
+            let found = between(arc.problem(), &ctx, prev, &po, opts, points.len())?;
+            po.events = found.iter().map(|e| e.kind).collect();
+            events.extend(found);
+        }
+        points.push(po);
+    }
+    let stop = stop_text(arc.stop());
+    Ok(PoBranch {
+        points,
+        events,
+        stop,
+    })
+}
+
+/// The `IP` event: `p*` where `omega^2`, linear in `p` near a saddle-node on the
+/// invariant circle, extrapolates to 0 from the last two points kept.
+fn infinite_period(points: &[PoPoint]) -> PoEvent {
+    let last = points.last().expect("a point before the end").clone();
+    let p_star = match points.len() {
+        0 | 1 => last.p,
+        k => {
+            let a = &points[k - 2];
+            let (w1, w2) = (a.omega().powi(2), last.omega().powi(2));
+            if (w2 - w1).abs() > 0.0 {
+                last.p - w2 * (last.p - a.p) / (w2 - w1)
+            } else {
+                last.p
+            }
+        }
+    };
+    PoEvent {
+        kind: PoEventKind::InfinitePeriod,
+        p: p_star,
+        test: last.result.sol.period(),
+        point: last,
+        index: points.len(),
+    }
+}
+
+/// Events between consecutive points `a` and `b` (`b` will have row `index`).
+fn between<P: Problem + ?Sized, D: Parametric>(
+    prob: &mut P,
+    ctx: &Ctx<'_, D>,
+    a: &PoPoint,
+    b: &PoPoint,
+    opts: &PoBranchOptions,
+    index: usize,
+) -> Result<Vec<PoEvent>> {
+    let mut out = Vec::new();
+    let tol = opts.event_tol;
+    let changes = |x: f64, y: f64| x * y < 0.0;
+    let fold = changes(a.tests.lp, b.tests.lp);
+    let det_flip = changes(a.tests.bp, b.tests.bp);
+    let mut push =
+        |prob: &mut P, kind: PoEventKind, found: Option<(ArcPoint, f64)>| -> Result<()> {
+            if let Some((pt, g)) = found {
+                let point = ctx.point(prob, &pt)?;
+                out.push(PoEvent {
+                    kind,
+                    p: pt.p,
+                    point,
+                    test: g,
+                    index,
+                });
+            }
+            Ok(())
+        };
+    if fold {
+        let f = locate(
+            prob,
+            &a.arc,
+            &b.arc,
+            a.tests.lp,
+            b.tests.lp,
+            |_, pt| Ok(pt.dp_ds()),
+            tol,
+            0.0,
+            &opts.arc,
+        )?;
+        push(prob, PoEventKind::Fold, f)?;
+    }
+    if det_flip {
+        let f = locate(
+            prob,
+            &a.arc,
+            &b.arc,
+            a.tests.bp,
+            b.tests.bp,
+            |pr, pt| bordered_det(pr, pt, &ctx.w),
+            tol,
+            0.0,
+            &opts.arc,
+        )?;
+        push(prob, PoEventKind::BranchPoint, f)?;
+    }
+    // Multiplier test functions: evaluated (monodromy or Hill) at each trial point.
+    let on_multipliers = |which: usize| {
+        move |_: &mut P, pt: &ArcPoint| -> Result<f64> {
+            let r = ctx.judge(pt)?;
+            let m = match (&r.floquet, &r.hill) {
+                (Some(f), _) => f.multipliers.clone(),
+                (None, Some((m, _))) => m.clone(),
+                _ => return Ok(f64::NAN),
+            };
+            let t = multiplier_tests(&m);
+            Ok([t.0, t.1, t.2][which])
+        }
+    };
+    let pair = |x: Option<f64>, y: Option<f64>| x.zip(y).filter(|(x, y)| changes(*x, *y));
+    if let Some((ga, gb)) = pair(a.tests.pd, b.tests.pd) {
+        let f = locate(
+            prob,
+            &a.arc,
+            &b.arc,
+            ga,
+            gb,
+            on_multipliers(1),
+            tol,
+            0.0,
+            &opts.arc,
+        )?;
+        push(prob, PoEventKind::PeriodDoubling, f)?;
+    }
+    if a.tests.complex_pairs == b.tests.complex_pairs {
+        if let Some((ga, gb)) = pair(a.tests.ns, b.tests.ns) {
+            let f = locate(
+                prob,
+                &a.arc,
+                &b.arc,
+                ga,
+                gb,
+                on_multipliers(2),
+                tol,
+                0.0,
+                &opts.arc,
+            )?;
+            push(prob, PoEventKind::NeimarkSacker, f)?;
+        }
+    }
+    if !fold && !det_flip {
+        if let Some((ga, gb)) = pair(a.tests.bp_multipliers, b.tests.bp_multipliers) {
+            let f = locate(
+                prob,
+                &a.arc,
+                &b.arc,
+                ga,
+                gb,
+                on_multipliers(0),
+                tol,
+                0.0,
+                &opts.arc,
+            )?;
+            push(prob, PoEventKind::BranchPoint, f)?;
+        }
+    }
+    out.sort_by(|x, y| {
+        let s = |e: &PoEvent| (e.p - a.p).abs();
+        s(x).total_cmp(&s(y))
+    });
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::floquet::FloquetOptions;
+    use crate::hb::HbOptions;
+    use crate::periodic::periodic;
+    use crate::Planar;
+
+    fn opts(n: usize, lo: f64, hi: f64, forward: bool) -> PoBranchOptions {
+        PoBranchOptions {
+            arc: ArcOptions {
+                ds: 0.02,
+                ds_max: 0.1,
+                ds_min: 1e-6,
+                max_points: 300,
+                p_min: lo,
+                p_max: hi,
+                forward,
+                ..Default::default()
+            },
+            periodic: PeriodicOptions {
+                hb: HbOptions {
+                    n_harm: n,
+                    ..Default::default()
+                },
+                floquet: Some(FloquetOptions::default()),
+                ..Default::default()
+            },
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn multiplier_tests_change_sign_at_their_crossings() {
+        let base = [(1.0, 0.0), (0.5, 0.0)];
+        let with = |z: (f64, f64)| {
+            let mut m = base.to_vec();
+            m.push(z);
+            multiplier_tests(&m)
+        };
+        assert!(with((-0.9, 0.0)).1 * with((-1.1, 0.0)).1 < 0.0);
+        assert!(with((0.9, 0.0)).0 * with((1.1, 0.0)).0 < 0.0);
+        let ns = |r: f64| {
+            let mut m = base.to_vec();
+            m.push((r * 0.6, r * 0.8));
+            m.push((r * 0.6, -r * 0.8));
+            multiplier_tests(&m)
+        };
+        assert!(ns(0.9).2 * ns(1.1).2 < 0.0);
+        assert_eq!(ns(0.9).3, 1);
+        // A complex pair does not change the PD or BP signs.
+        assert!(ns(0.9).1 > 0.0 && ns(1.1).1 > 0.0);
+    }
+
+    /// The thesis' standard R-R orbit continued up in Omega: every point's residual is
+    /// Newton's, and a point re-solved by `periodic()` at its Omega gives the same omega.
+    #[test]
+    fn branch_points_are_solutions_of_periodic() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let o = opts(6, 1.2, 1.3, true);
+        let start = periodic(&p, &[true, true], None, &o.periodic);
+        assert_eq!(start.sol.status, Status::Converged);
+        let b = periodic_branch(&p, "Omega", &start.sol, &o).unwrap();
+        assert_eq!(b.stop, "boundary", "{}", b.stop);
+        assert_eq!(b.points.last().unwrap().p, 1.3);
+        for pt in b.points.iter().step_by(5) {
+            let q = p.with_param("Omega", pt.p).unwrap();
+            let r = periodic(&q, &[true, true], Some(&pt.result.sol), &o.periodic);
+            assert!((r.sol.omega - pt.omega()).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn bad_inputs_name_the_parameter() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let o = opts(4, 1.2, 1.3, true);
+        let start = periodic(&p, &[true, true], None, &o.periodic);
+        let name = |r: Result<PoBranch>| match r {
+            Err(Error::InvalidParameter { name, .. }) => name,
+            other => panic!("{:?}", other.map(|b| b.stop)),
+        };
+        assert_eq!(
+            name(periodic_branch(&p, "nope", &start.sol, &o)),
+            "parameter"
+        );
+        assert_eq!(
+            name(periodic_branch(
+                &p,
+                "Omega",
+                &start.sol,
+                &opts(4, 1.3, 1.4, true)
+            )),
+            "range"
+        );
+        assert_eq!(
+            name(periodic_branch(
+                &p,
+                "Omega",
+                &start.sol,
+                &opts(4, 1.3, 1.2, true)
+            )),
+            "range"
+        );
+        let mut bad = start.sol.clone();
+        bad.omega = -1.0;
+        assert_eq!(name(periodic_branch(&p, "Omega", &bad, &o)), "start");
+        let mut o2 = o.clone();
+        o2.min_omega = f64::NAN;
+        assert_eq!(
+            name(periodic_branch(&p, "Omega", &start.sol, &o2)),
+            "min_omega"
+        );
+    }
+}
+
+#[cfg(test)]
+mod explore {
+    use super::*;
+    use crate::floquet::FloquetOptions;
+    use crate::hb::HbOptions;
+    use crate::periodic::periodic;
+    use crate::Planar;
+
+    /// Measurement: `cargo test --release -p ballbal-core explore_branch -- --ignored
+    /// --nocapture`.
+    #[test]
+    #[ignore]
+    fn explore_branch() {
+        let zb: f64 = std::env::var("ZB")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0.05);
+        let eta: f64 = std::env::var("ETA")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1.0);
+        let om: f64 = std::env::var("OM")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1.2);
+        let fwd = std::env::var("FWD").as_deref() != Ok("0");
+        let n: usize = std::env::var("N")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(8);
+        let p = Planar::new(0.2, 0.05, &[zb], 50.0, om, &[eta, eta]).unwrap();
+        let o = PoBranchOptions {
+            arc: ArcOptions {
+                ds: 0.02,
+                ds_max: 0.1,
+                ds_min: 1e-6,
+                max_points: 400,
+                p_min: 0.5,
+                p_max: 3.0,
+                forward: fwd,
+                ..Default::default()
+            },
+            periodic: PeriodicOptions {
+                hb: HbOptions {
+                    n_harm: n,
+                    ..Default::default()
+                },
+                floquet: Some(FloquetOptions::default()),
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let start = periodic(&p, &[true, true], None, &o.periodic);
+        println!("start {:?} omega {}", start.sol.status, start.sol.omega);
+        let t = std::time::Instant::now();
+        let b = periodic_branch(&p, "Omega", &start.sol, &o).unwrap();
+        println!(
+            "{} points in {:?}, stop {}",
+            b.points.len(),
+            t.elapsed(),
+            b.stop
+        );
+        for pt in &b.points {
+            let m = pt.multipliers().map(|m| {
+                m.iter()
+                    .map(|z| format!("{:.3}{:+.3}i", z.0, z.1))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            });
+            println!(
+                "p={:.6} w={:.5} {} {} lp={:+.2e} bp={:+.2e} pd={:?} ns={:?} ev={:?} | {}",
+                pt.p,
+                pt.omega(),
+                pt.result.sol.status.as_str(),
+                pt.stability().as_str(),
+                pt.tests.lp,
+                pt.tests.bp,
+                pt.tests.pd.map(|v| (v * 1e3).round() / 1e3),
+                pt.tests.ns.map(|v| (v * 1e3).round() / 1e3),
+                pt.events,
+                m.unwrap_or_default()
+            );
+        }
+        for e in &b.events {
+            println!(
+                "EVENT {} p={:.9} test={:.3e} idx={} w={}",
+                e.kind.as_str(),
+                e.p,
+                e.test,
+                e.index,
+                e.point.omega()
+            );
+        }
+    }
+}
