@@ -24,7 +24,7 @@ OPTS = Continuation(ds=0.01, ds_max=0.1 if SMALL else 0.05, max_points=150 if SM
 
 def curves(second: str, lo: float, hi: float) -> list:
     # from low speed upwards: branches are continued forwards from their start
-    b = from_seed003(m0=M0, omega0=0.3)
+    b = from_seed003(0.3, M0, 2.0, C0=0.35, D0=0.35)
     out = []
     for start in ("together", "perfect_balance"):
         br = equilibrium_branch(b, "Omega", start=start, range=(0.25 * S, 2.2 * S), options=OPTS)

@@ -165,5 +165,5 @@ def test_from_seed003_meets_at_the_thesis_point() -> None:
     # the seed's curves meet at (omega0, m0) = (1/sqrt(1 + 2 m0), e/2)
     b = from_seed003(m0=1.0, omega0=1 / np.sqrt(3.0), e=2.0)
     assert abs(b.Omega - 1.0) < 1e-15 and abs(b.eta[0] - 0.5) < 1e-15
-    d = from_seed003()
+    d = from_seed003(1.5, 2.0, 2.0, C0=0.35, D0=0.35)  # the seed's table 2
     assert abs(d.mu - 0.2) < 1e-15 and abs(d.delta - 0.5) < 1e-15

@@ -15,9 +15,8 @@ from ballbal import _check, _native
 from ballbal._branch import Branch, Continuation, Curve
 from ballbal.analysis import Equilibrium, _equilibrium, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
-from ballbal.model import Balancer
 
-__all__ = ["equilibrium_branch", "equilibrium_curve", "from_seed003", "switch_equilibrium"]
+__all__ = ["equilibrium_branch", "equilibrium_curve", "switch_equilibrium"]
 
 #: The default step control (a module-level value: a frozen dataclass).
 _DEFAULT = Continuation()
@@ -201,26 +200,3 @@ def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
                "row": pl.Int64})
     return Curve(kind=d["kind"], parameters=(p1, p2), table=table, points=points,
                  stop=d["stop"], meta={"model": m["model"], "range": rng, "options": options})
-
-
-def from_seed003(m0: float = 2.0, omega0: float = 1.5, e: float = 2.0, C0: float = 0.35,
-                 D0: float = 0.35) -> Balancer:
-    """The two-ball balancer of seed 003 in its own units: lengths over the track radius
-    R, time over ``1/w_n`` with ``w_n = sqrt(K/M)`` of the disk mass ``M`` alone,
-    ``m0 = m/M`` (each ball), ``omega0 = w/w_n``, ``e = eps/R``, ``C0 = C/(2 sqrt(K M))``,
-    ``D0 = D/(m R^2 w_n)`` (``D`` the balls' torque damping). In this package's units
-    (model.md: the total mass ``M + 2m``, lengths over the eccentricity):
-    ``mu = 1/(1 + 2 m0)``, ``eta = m0/e``, ``delta = 1/e``,
-    ``Omega = omega0 sqrt(1 + 2 m0)``, ``zeta = C0/sqrt(1 + 2 m0)``,
-    ``zeta_b = D0 sqrt(1 + 2 m0)/2``. The seed's defaults (its table 2) are the
-    defaults; its curves meet at ``(omega0, m0) = (1/sqrt(1 + 2 m0), e/2)``, i.e.
-    (Omega, eta) = (1, 1/2)."""
-    m0 = _check.real("m0", m0, 0.0, math.inf, lo_open=True)
-    omega0 = _check.real("omega0", omega0, 0.0, math.inf)
-    e = _check.real("e", e, 0.0, math.inf, lo_open=True)
-    C0 = _check.real("C0", C0, 0.0, math.inf)
-    D0 = _check.real("D0", D0, 0.0, math.inf)
-    s = math.sqrt(1.0 + 2.0 * m0)
-    return Balancer(mu=1.0 / (1.0 + 2.0 * m0), zeta=C0 / s, zeta_b=D0 * s / 2.0,
-                    delta=1.0 / e, Omega=omega0 * s, eta=(m0 / e, m0 / e))
-

@@ -5,11 +5,11 @@ from ballbal._branch import Branch, Continuation, Curve
 from ballbal._eq_continuation import (
     equilibrium_branch,
     equilibrium_curve,
-    from_seed003,
     switch_equilibrium,
 )
 from ballbal._po_continuation import periodic_branch
 from ballbal._po_switch import switch
+from ballbal.model import from_seed003
 
 __all__ = ["Branch", "Continuation", "Curve", "equilibrium_branch", "equilibrium_curve",
            "from_seed003", "periodic_branch", "switch", "switch_equilibrium"]
