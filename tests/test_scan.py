@@ -38,7 +38,8 @@ def thesis_maps():
 
 def test_standard_point_equals_single_point_solver(small):
     row = small.filter((pl.col("Omega") == 1.2) & (pl.col("eta") == 1.0)).row(0, named=True)
-    single = ballbal.periodic(BASE, "R-R", N=3, rtol=1e-6, atol=1e-9)
+    # the scan's Floquet settings (Magnus at rtol 1e-6)
+    single = ballbal.periodic(BASE, "R-R", N=3, rtol=1e-6, atol=1e-9, floquet_method="magnus")
     assert row["status"] == "converged" and row["type"] == "R-R"
     assert abs(row["omega"] - single.omega) < 1e-9
     assert abs(row["max_modulus"] - single.max_modulus) < 1e-6
