@@ -6,12 +6,45 @@ pseudo-arclength engine (``rust/core/src/continuation/arclength.rs``) are
 
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
 import polars as pl
 
 from ballbal import _check
+from ballbal.exceptions import ParameterError, ParameterTypeError
+from ballbal.model import Balancer
+from ballbal.scene import Scene
+
+_INDEXED = re.compile(r"^(eta|zeta_b)\[(\d+)\]$")
+
+
+def parameter_range(v: Any) -> tuple[float, float]:
+    """The ``range=(lo, hi)`` argument of a continuation: finite, ``lo < hi``."""
+    try:
+        lo, hi = v
+    except (TypeError, ValueError):
+        raise ParameterTypeError("range", f"must be a pair (lo, hi), got {v!r}") from None
+    lo = _check.real("range", lo)
+    hi = _check.real("range", hi)
+    if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ParameterError("range", f"needs finite lo < hi, got ({lo}, {hi})")
+    return lo, hi
+
+
+def model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:
+    """``model`` with ``parameter`` set to ``value`` (``"eta[2]"``: one ball's)."""
+    m = _INDEXED.match(parameter)
+    if m is None:
+        return model.replace(**{parameter: value})
+    name, i = m.group(1), int(m.group(2))
+    bal = model.balancer if isinstance(model, Scene) else model
+    old = getattr(bal, name)
+    vals = list(old) if isinstance(old, (tuple, list)) else [old] * bal.n_balls
+    vals[i - 1] = value
+    return model.replace(**{name: tuple(vals)})
 
 
 @dataclass(frozen=True)

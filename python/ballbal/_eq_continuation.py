@@ -6,13 +6,12 @@ two-parameter curves of those bifurcations (the core's
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import polars as pl
 
 from ballbal import _check, _native
-from ballbal._branch import Branch, Continuation, Curve
+from ballbal._branch import Branch, Continuation, Curve, parameter_range
 from ballbal.analysis import Equilibrium, _equilibrium, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
 
@@ -23,18 +22,6 @@ _DEFAULT = Continuation()
 
 #: The curve each event type continues into.
 _CURVE_OF = {"fold": "saddle_node", "hopf": "hopf", "branch_point": "pitchfork"}
-
-
-def _range(v: Any) -> tuple[float, float]:
-    try:
-        lo, hi = v
-    except (TypeError, ValueError):
-        raise ParameterTypeError("range", f"must be a pair (lo, hi), got {v!r}") from None
-    lo = _check.real("range", lo)
-    hi = _check.real("range", hi)
-    if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
-        raise ParameterError("range", f"needs finite lo < hi, got ({lo}, {hi})")
-    return lo, hi
 
 
 def _options(options: Any) -> Continuation:
@@ -106,7 +93,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     arclength."""
     _check.model("model", model)
     parameter = _check.string("parameter", parameter)
-    rng = _range(range)
+    rng = parameter_range(range)
     options = _options(options)
     if isinstance(start, str):
         found = [e for e in equilibria(model) if e.kind == start]
@@ -163,7 +150,7 @@ def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
     saddle-node curve meets the pitchfork)."""
     i = _event(branch, event_index)
     parameter2 = _check.string("parameter2", parameter2)
-    rng = _range(range)
+    rng = parameter_range(range)
     options = _options(options)
     etype = branch.events["type"][i]
     kind = _CURVE_OF[etype]

@@ -5,7 +5,6 @@ certified and judged as :func:`ballbal.periodic` does, with its bifurcations loc
 
 from __future__ import annotations
 
-import re
 from dataclasses import replace
 from typing import Any
 
@@ -13,47 +12,12 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from ._branch import Branch, Continuation
-from .analysis import PeriodicSolution
+from ._branch import Branch, Continuation, model_at, parameter_range
+from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
-from .model import Balancer
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
-from .scene import Scene
 
 __all__ = ["Branch", "Continuation", "periodic_branch"]
-
-_INDEXED = re.compile(r"^(eta|zeta_b)\[(\d+)\]$")
-
-
-def _model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:
-    """``model`` with ``parameter`` set to ``value`` (``"eta[2]"``: one ball's)."""
-    m = _INDEXED.match(parameter)
-    if m is None:
-        return model.replace(**{parameter: value})
-    name, i = m.group(1), int(m.group(2))
-    bal = model.balancer if isinstance(model, Scene) else model
-    old = getattr(bal, name)
-    vals = list(old) if isinstance(old, (tuple, list)) else [old] * bal.n_balls
-    vals[i - 1] = value
-    return model.replace(**{name: tuple(vals)})
-
-
-def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:
-    mult = d["mult_re"] + 1j * d["mult_im"] if d["mult_re"] is not None else None
-    hill_m = d["hill_re"] + 1j * d["hill_im"] if "hill_re" in d else None
-    return PeriodicSolution(
-        tail=d["tail"], target_met=d["target_met"], hill_multipliers=hill_m,
-        hill_stability=d["hill_stability"], verdicts_disagree=d["verdicts_disagree"],
-        balancer=model, status=d["status"], type=d["type"], omega=d["omega"],
-        coeffs=d["coeffs"], winding=d["winding"], N=d["N"], samples=d["samples"],
-        residual=d["residual"], iterations=d["iterations"], multipliers=mult,
-        stability=d["stability"], max_modulus=d["max_modulus"],
-        trivial_error=d["trivial_error"], floquet_steps=d["floquet_steps"],
-        pivot_ratio=d["pivot_ratio"], closure=d["closure"],
-        separation_error=d["separation_error"],
-        info={"floquet_error": d["floquet_error"], "last_omega": d["last_omega"]},
-    )
-
 
 def _multipliers(d: dict[str, Any]) -> tuple[list[float] | None, list[float] | None]:
     if d["mult_re"] is not None:
@@ -137,9 +101,7 @@ def periodic_branch(
     if start.omega is None or start.status != "converged":
         raise ParameterError("start", f"must be a converged solution, got status {start.status!r}")
     _check.string("parameter", parameter)
-    if not isinstance(range, (tuple, list)) or len(range) != 2:
-        raise ParameterTypeError("range", "must be (lo, hi)", value=range)
-    lo, hi = _check.real("range", range[0]), _check.real("range", range[1])
+    lo, hi = parameter_range(range)
     options = _check.option("options", options, Continuation, Continuation(),
                             "ballbal.continuation.Continuation")
     popts = _check.option("periodic_options", periodic_options, PeriodicOptions,
@@ -165,8 +127,8 @@ def periodic_branch(
                  "test": pl.Float64, "index": pl.Int64}
     events = (pl.DataFrame(ev_rows, schema=ev_schema, orient="row") if ev_rows
               else pl.DataFrame(schema=ev_schema))
-    solutions = tuple(_solution(_model_at(model, parameter, p["p"]), p) for p in d["points"])
-    event_solutions = tuple(_solution(_model_at(model, parameter, e["p"]), e)
+    solutions = tuple(_solution(model_at(model, parameter, p["p"]), p) for p in d["points"])
+    event_solutions = tuple(_solution(model_at(model, parameter, e["p"]), e)
                             for e in d["events"])
     return Branch(kind="periodic", parameter=parameter, table=table, events=events,
                   stop=d["stop"], solutions=solutions, event_solutions=event_solutions,

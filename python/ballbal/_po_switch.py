@@ -9,7 +9,7 @@ from typing import Any, Literal
 import numpy as np
 
 from . import _check, _native
-from ._branch import Branch
+from ._branch import Branch, model_at
 from .analysis import Equilibrium, PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
@@ -112,6 +112,6 @@ def _at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Sce
     """The model with ``parameter`` set to ``value`` (its ``replace``; a name it does not
     have leaves the Python model as it was, the core having used its own registry)."""
     try:
-        return model.replace(**{parameter: value})
+        return model_at(model, parameter, value)
     except (TypeError, ValueError):
         return model
