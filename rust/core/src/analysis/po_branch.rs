@@ -567,7 +567,7 @@ mod tests {
     use crate::periodic::periodic;
     use crate::Planar;
 
-    fn opts(n: usize, lo: f64, hi: f64, forward: bool) -> PoBranchOptions {
+    pub(super) fn opts(n: usize, lo: f64, hi: f64, forward: bool) -> PoBranchOptions {
         PoBranchOptions {
             arc: ArcOptions {
                 ds: 0.02,
@@ -676,9 +676,8 @@ mod tests {
 
 #[cfg(test)]
 mod explore {
+    use super::tests::opts;
     use super::*;
-    use crate::floquet::FloquetOptions;
-    use crate::hb::HbOptions;
     use crate::periodic::periodic;
     use crate::Planar;
 
@@ -705,27 +704,8 @@ mod explore {
             .and_then(|v| v.parse().ok())
             .unwrap_or(8);
         let p = Planar::new(0.2, 0.05, &[zb], 50.0, om, &[eta, eta]).unwrap();
-        let o = PoBranchOptions {
-            arc: ArcOptions {
-                ds: 0.02,
-                ds_max: 0.1,
-                ds_min: 1e-6,
-                max_points: 400,
-                p_min: 0.5,
-                p_max: 3.0,
-                forward: fwd,
-                ..Default::default()
-            },
-            periodic: PeriodicOptions {
-                hb: HbOptions {
-                    n_harm: n,
-                    ..Default::default()
-                },
-                floquet: Some(FloquetOptions::default()),
-                ..Default::default()
-            },
-            ..Default::default()
-        };
+        let mut o = opts(n, 0.5, 3.0, fwd);
+        o.arc.max_points = 400;
         let start = periodic(&p, &[true, true], None, &o.periodic);
         println!("start {:?} omega {}", start.sol.status, start.sol.omega);
         let t = std::time::Instant::now();

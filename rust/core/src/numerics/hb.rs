@@ -1085,7 +1085,7 @@ mod tests {
     }
 
     /// Warm-started solves at N = 3, 6, 8, 12 for callgrind (`--ignored --exact
-    /// numerics::hb::tests::hb_profile`): per N, a `hb_profile_nN` frame.
+    /// numerics::hb::tests::hb_profile`): per N, a `warm_solve::<N>` frame.
     #[test]
     #[ignore]
     fn hb_profile() {
@@ -1103,46 +1103,17 @@ mod tests {
         let seed12 = periodic(&near, &[true, true], Some(&seed), &opts(12)).sol;
         let mut acc = 0.0;
         for _ in 0..20 {
-            acc += hb_profile_n3(&p, &seed12, &opts(3));
-            acc += hb_profile_n6(&p, &seed12, &opts(6));
-            acc += hb_profile_n8(&p, &seed12, &opts(8));
-            acc += hb_profile_n12(&p, &seed12, &opts(12));
+            acc += warm_solve::<3>(&p, &seed12, &opts(3));
+            acc += warm_solve::<6>(&p, &seed12, &opts(6));
+            acc += warm_solve::<8>(&p, &seed12, &opts(8));
+            acc += warm_solve::<12>(&p, &seed12, &opts(12));
         }
         println!("{acc}");
     }
 
+    /// One solve; monomorphised per `N` so that callgrind reports each N apart.
     #[inline(never)]
-    fn hb_profile_n3(
-        p: &crate::Planar,
-        g: &HbSolution,
-        o: &crate::periodic::PeriodicOptions,
-    ) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o)
-            .sol
-            .omega
-    }
-    #[inline(never)]
-    fn hb_profile_n6(
-        p: &crate::Planar,
-        g: &HbSolution,
-        o: &crate::periodic::PeriodicOptions,
-    ) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o)
-            .sol
-            .omega
-    }
-    #[inline(never)]
-    fn hb_profile_n8(
-        p: &crate::Planar,
-        g: &HbSolution,
-        o: &crate::periodic::PeriodicOptions,
-    ) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o)
-            .sol
-            .omega
-    }
-    #[inline(never)]
-    fn hb_profile_n12(
+    fn warm_solve<const N: usize>(
         p: &crate::Planar,
         g: &HbSolution,
         o: &crate::periodic::PeriodicOptions,
