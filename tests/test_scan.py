@@ -200,6 +200,14 @@ def test_resume_refuses_a_different_scan(tmp_path):
     assert meta["grid"] == {"Omega": [1.2], "eta": [1.0]}
 
 
+def test_resume_refuses_another_floquet_method(tmp_path):
+    # The multipliers of the two methods differ in their last digits: a directory must
+    # not end up holding rows of both.
+    ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s")
+    with pytest.raises(ballbal.exceptions.ScanStoreError, match="differs in options.floquet_method"):
+        ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s", floquet_method="rk45")
+
+
 @pytest.mark.parametrize(
     ("grid", "name"),
     [

@@ -150,11 +150,26 @@ class _Job:
         }
 
 
+def _differences(old: Mapping[str, Any], new: Mapping[str, Any], prefix: str = "") -> list[str]:
+    """The keys whose values differ, nested dictionaries' as ``outer.inner``, so that the
+    error says which option differs rather than "options"."""
+    out: list[str] = []
+    for k in sorted(old.keys() | new.keys()):
+        a, b = old.get(k), new.get(k)
+        if isinstance(a, dict) and isinstance(b, dict):
+            out += _differences(a, b, f"{prefix}{k}.")
+        elif a != b:
+            out.append(prefix + k)
+    return out
+
+
 def _meta_options(o: ScanOptions) -> dict[str, Any]:
     """The options as ``meta.json`` records them (the scan's fingerprint): the flat
     keywords of before the option classes, in their order, so that directories written
     then resume; ``guess_atol`` only where it is not ``guess_rtol / 1000`` (what those
-    keywords implied)."""
+    keywords implied). The Floquet method is always recorded: directories written before
+    it was an option hold RK45 multipliers and must not be completed with another
+    method's."""
     h, f, g = o.harmonic_balance, o.floquet, o.guess
     d: dict[str, Any] = {
         "N": h._start, "auto": h._auto_target, "N_max": h.N_max, "hill": f.hill,
@@ -163,6 +178,7 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
         "max_steps": f.max_steps, "settle": g.settle, "window": g.window,
         "guess_rtol": g.rtol, "seeds": g.seeds, "starts": g.starts, "max_tail": o.max_tail,
         "max_closure": o.max_closure, "max_trivial": f.max_trivial,
+        "floquet_method": f.method,
     }
     if g.atol != g.rtol * 1e-3:
         d["guess_atol"] = g.atol
@@ -379,7 +395,7 @@ class _Store:
                 job = replace(job, chunk=stored)
                 meta["chunk"] = stored
             if old != meta:
-                diff = sorted(k for k in meta.keys() | old.keys() if old.get(k) != meta.get(k))
+                diff = _differences(old, meta)
                 raise ScanStoreError(
                     f"out: {self.dir} holds a different scan (it differs in "
                     f"{', '.join(diff)}); choose another directory or delete it")
