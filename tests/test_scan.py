@@ -11,7 +11,7 @@ import polars as pl
 import pytest
 
 import ballbal
-from ballbal.exceptions import ParameterError
+from ballbal.exceptions import ParameterError, ScanStoreError
 
 BASE = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
 THESIS = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
@@ -204,7 +204,7 @@ def test_resume_refuses_another_floquet_method(tmp_path):
     # The multipliers of the two methods differ in their last digits: a directory must
     # not end up holding rows of both.
     ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s")
-    with pytest.raises(ballbal.exceptions.ScanStoreError, match="differs in options.floquet_method"):
+    with pytest.raises(ScanStoreError, match="differs in options.floquet_method"):
         ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s", floquet_method="rk45")
 
 
