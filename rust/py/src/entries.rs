@@ -7,7 +7,8 @@ use crate::convert::{dispatch, slice, Model, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::{guarded, run_polled};
 use crate::tables::{equilibrium_dict, scan_columns, solution_dict, Columns};
-use ballbal_core::analysis::homotopy::{periodic_homotopy, source_of};
+use ballbal_core::analysis::constructed::periodic_discover;
+use ballbal_core::analysis::homotopy::source_of;
 use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::ode::Options;
@@ -242,7 +243,8 @@ pub(crate) fn start(m: &Model, ball_winding: &[f64], w: f64, c: &[f64]) -> PyRes
 /// `guess` is `(omega, coefficients)` or `None` (a simulated start); `windings` the
 /// balls' turns per period (`None`: -1 for each `R`, 0 for each `O`).
 /// `homotopy`: `(parameter, value)` starts to follow from when simulation finds no
-/// orbit here (`analysis::homotopy`); the dict's `guess_source` says how it was found.
+/// orbit here (`analysis::homotopy`), before the constructed starts
+/// (`analysis::constructed`); the dict's `guess_source` says how it was found.
 #[pyfunction]
 #[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None))]
 pub fn periodic<'py>(
@@ -264,12 +266,9 @@ pub fn periodic<'py>(
     let (r, source) = guarded(py, || {
         dispatch!(&m, d => {
             stiff_guess(d, guess.is_none(), &opts)?;
-            Ok(match (&guess, &homotopy) {
-                (None, Some(starts)) => periodic_homotopy(d, &ball_winding, starts, &opts),
-                _ => (
-                    periodic_wound(d, &ball_winding, guess.as_ref(), &opts),
-                    source_of(guess.is_some()),
-                ),
+            Ok(match &guess {
+                None => periodic_discover(d, &ball_winding, homotopy.as_deref(), &opts),
+                Some(g) => (periodic_wound(d, &ball_winding, Some(g), &opts), source_of(true)),
             })
         })
     })?;

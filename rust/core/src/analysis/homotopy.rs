@@ -66,20 +66,15 @@ fn walk<D: Parametric>(
     None
 }
 
-/// [`periodic_wound`] without a guess, then, if it found no orbit, from each of
-/// `starts` (`(parameter, value)`) in turn: the orbit found by simulation there,
-/// followed to `p`. Returns the result and how it was found (`"simulation"` or
-/// `"homotopy from NAME=VALUE"`).
-pub fn periodic_homotopy<D: Parametric>(
+/// From each of `starts` (`(parameter, value)`) in turn: the orbit found by simulation
+/// there, followed to `p`. The first that arrives, with how it was found (`"homotopy
+/// from NAME=VALUE"`); `None` if none does.
+pub fn homotopy_walks<D: Parametric>(
     p: &D,
     ball_winding: &[f64],
     starts: &[(String, f64)],
     opts: &PeriodicOptions,
-) -> (Periodic, String) {
-    let first = periodic_wound(p, ball_winding, None, opts);
-    if first.sol.status == Status::Converged {
-        return (first, source_of(false));
-    }
+) -> Option<(Periodic, String)> {
     // The start needs no multipliers: only its series is followed.
     let quiet = PeriodicOptions {
         floquet: None,
@@ -104,11 +99,11 @@ pub fn periodic_homotopy<D: Parametric>(
         if let Some(sol) = walk(p, name, *from, r0.sol, &quiet) {
             let r = finish(p, sol, opts);
             if r.sol.status == Status::Converged {
-                return (r, format!("homotopy from {name}={from}"));
+                return Some((r, format!("homotopy from {name}={from}")));
             }
         }
     }
-    (first, source_of(false))
+    None
 }
 
 #[cfg(test)]

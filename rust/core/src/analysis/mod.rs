@@ -4,6 +4,7 @@
 pub mod attractors;
 pub mod balanced;
 pub mod basins;
+pub mod constructed;
 pub mod equilibria;
 pub mod family;
 pub mod homotopy;
