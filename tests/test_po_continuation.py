@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, curve_fit, fsolve, root
 
 import ballbal
-from ballbal.continuation import Continuation, periodic_branch
+from ballbal.continuation import Continuation, periodic_branch, switch
 from ballbal.exceptions import ParameterError
 
 from reference import rhs
@@ -358,6 +358,96 @@ def test_continuation_down_stops_at_the_infinite_period_end() -> None:
     # period error adds 1.4e-4 (measured 2.3e-4 in all), hence 4e-4.
     assert abs(_period_law_end(om, T_sim) - om_star) < 2e-4
     assert abs(om_ip - om_star) < 4e-4, (om_ip, om_star)
+
+
+def _thesis(eta: float) -> ballbal.Balancer:
+    return ballbal.Balancer(**STD, Omega=1.2, eta=(eta, eta))
+
+
+def shoot_newton(b: ballbal.Balancer, y: np.ndarray, T: float,
+                 winding: np.ndarray) -> tuple[float, np.ndarray]:
+    """Shooting by Newton with the monodromy from forward differences of the flow
+    (phase: the first ball's angle fixed), from a close start: period and multipliers at
+    the closed orbit."""
+    n = len(y)
+    shift = np.zeros(n)
+    shift[: len(winding)] = 2 * np.pi * np.asarray(winding)
+    free = [i for i in range(n) if i != 2]
+    h = 1e-6
+    for _ in range(6):
+        end = _flow_tol(b, y, T, 1e-10)
+        M = np.empty((n, n))
+        for j in range(n):
+            e = np.zeros(n)
+            e[j] = h
+            M[:, j] = (_flow_tol(b, y + e, T, 1e-10) - end) / h
+        r = end - y - shift
+        if np.abs(r).max() < 1e-9:
+            return T, np.linalg.eigvals(M)
+        J = np.column_stack([(M - np.eye(n))[:, free], rhs(b, T, end)])
+        d = np.linalg.solve(J, -r)
+        y = y.copy()
+        y[free] += d[:-1]
+        T += d[-1]
+    raise AssertionError(f"shooting did not close: {np.abs(r).max()}")
+
+
+def _turns(b: ballbal.Balancer, y0: np.ndarray, t_end: float) -> np.ndarray:
+    """Durations of the first ball's successive whole turns in a simulation."""
+    t = np.arange(0.0, t_end, 0.02)
+    b1 = ballbal.simulate(b, y0, t)["b1"].to_numpy()
+    k = np.floor(b1 / (2 * np.pi))
+    idx = np.nonzero(np.diff(k))[0]
+    level = 2 * np.pi * np.maximum(k[idx], k[idx + 1])
+    return np.diff(t[idx] + (level - b1[idx]) / (b1[idx + 1] - b1[idx]) * (t[idx + 1] - t[idx]))
+
+
+def test_period_doubling_against_shooting_and_simulation() -> None:
+    """The merged R-R orbit at zeta_b 0.05, Omega 1.2 continued down in eta: a real
+    multiplier passes -1 (the thesis' tongue of balls rotating separately). Shooting at
+    eta_PD +- 3e-3 brackets it and its secant zero is the located eta (measured 2e-6:
+    the N = 8 series closes to 1e-6 under scipy there; 2e-5 allowed for the secant's
+    curvature error over the bracket). Inside the tongue, simulation from the merged
+    orbit, nudged, settles on alternating turns whose sum is the period of the doubled
+    orbit switched to from the event; above it the turns stay equal, one period each."""
+    s = ballbal.periodic(_thesis(0.9), "R-R", options=OPTS)
+    br = periodic_branch(s, "eta", range=(0.8, 0.9),
+                         options=Continuation(ds=0.01, ds_max=0.02, forward=False))
+    pd = br.events.filter(br.events["type"] == "PD")
+    assert pd.height == 1, br.events
+    e_pd = float(pd["eta"][0])
+    k = int(pd["index"][0])
+    h = 3e-3
+    g = []
+    for e in (e_pd + h, e_pd - h):
+        sol = ballbal.periodic(_thesis(e), "R-R", options=OPTS, guess=br.solutions[k])
+        assert sol.converged
+        T, ev = shoot_newton(_thesis(e), sol.state(0.0), sol.period, np.asarray(sol.winding))
+        assert abs(T - sol.period) < 1e-6 * T
+        real = ev[np.abs(ev.imag) < 1e-8].real
+        g.append(real[np.argmin(np.abs(real + 1))] + 1)
+    assert g[0] > 0 > g[1], g
+    zero = (e_pd + h) - g[0] * (-2 * h) / (g[1] - g[0])
+    assert abs(zero - e_pd) < 2e-5, (zero, e_pd)
+    # The doubled orbit from the event, followed into the tongue.
+    i_pd = br.events["type"].to_list().index("PD")
+    d2 = switch(br, event=i_pd, amplitude=0.2)
+    assert d2.converged and list(d2.winding[2:]) == [-2, -2] and d2.info["value"] < e_pd
+    for e in (0.84, 0.82):
+        d2 = ballbal.periodic(_thesis(e), "R-R", N=16, guess=d2)
+        assert d2.converged and list(d2.winding[2:]) == [-2, -2]
+    kick = 1e-3 * np.array([1, 0, 1, -1, 0, 0, 0, 0])
+    for e, inside in ((0.82, True), (0.88, False)):
+        merged = ballbal.periodic(_thesis(e), "R-R", options=OPTS, guess=br.solutions[0])
+        assert merged.converged
+        d = _turns(_thesis(e), merged.state(0.0) + kick, 6000.0)
+        if inside:
+            assert abs(d[-1] - d[-2]) > 0.1 * d[-1]
+            assert abs(d[-1] - d[-3]) < 1e-4 * d[-1]
+            assert abs((d[-1] + d[-2]) / d2.period - 1) < 1e-5, (d[-2:], d2.period)
+        else:
+            assert abs(d[-1] - d[-2]) < 1e-2 * d[-1]
+            assert abs(d[-1] / merged.period - 1) < 1e-3, (d[-2:], merged.period)
 
 
 def test_monodromy_and_hill_give_the_same_events() -> None:
