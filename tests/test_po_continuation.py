@@ -9,7 +9,7 @@ from functools import cache
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq, curve_fit, fsolve, root
+from scipy.optimize import brentq, curve_fit, root
 
 import ballbal
 from ballbal.continuation import Continuation, periodic_branch, switch
@@ -21,62 +21,40 @@ STD = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
 OPTS = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8))
 
 
-# --- shooting with variational equations (independent of the harmonic balance) ---------
+# --- shooting (independent of the harmonic balance) -------------------------------------
 
-def _flow_var(b: ballbal.Balancer, y0: np.ndarray, T: float) -> tuple[np.ndarray, np.ndarray]:
-    """State and monodromy after T: the variational equations integrated with the flow
-    (the Jacobian of the right-hand side by central differences of `reference.rhs`)."""
-    n2 = len(y0)
-
-    def jac(t: float, y: np.ndarray) -> np.ndarray:
-        J = np.empty((n2, n2))
-        for j in range(n2):
-            h = 1e-7 * max(1.0, abs(y[j]))
-            e = np.zeros(n2)
-            e[j] = h
-            J[:, j] = (rhs(b, t, y + e) - rhs(b, t, y - e)) / (2 * h)
-        return J
-
-    def f(t: float, z: np.ndarray) -> np.ndarray:
-        y, P = z[:n2], z[n2:].reshape(n2, n2)
-        return np.concatenate([rhs(b, t, y), (jac(t, y) @ P).ravel()])
-
-    z0 = np.concatenate([y0, np.eye(n2).ravel()])
-    r = solve_ivp(f, (0, T), z0, rtol=1e-10, atol=1e-12, method="DOP853")
-    z = r.y[:, -1]
-    return z[:n2], z[n2:].reshape(n2, n2)
-
-
-def shoot(b: ballbal.Balancer, y_guess: np.ndarray, T_guess: float,
-          winding: np.ndarray) -> tuple[np.ndarray, float, np.ndarray]:
-    """Periodic orbit by shooting (phase: the first ball's angle fixed): initial state,
-    period and the monodromy's eigenvalues, largest modulus first."""
-    n2 = len(y_guess)
-    d = n2 // 2
-    shift = np.zeros(n2)
-    shift[:d] = 2 * np.pi * winding
-    k = 2  # first ball's angle
-    free = [i for i in range(n2) if i != k]
-
-    def F(z: np.ndarray) -> np.ndarray:
-        y0 = y_guess.copy()
-        y0[free] = z[:-1]
-        return _flow(b, y0, z[-1]) - y0 - shift
-
-    z, _, ok, msg = fsolve(F, np.append(y_guess[free], T_guess), full_output=True,
-                           xtol=1e-12)
-    assert ok == 1, msg
-    y0 = y_guess.copy()
-    y0[free] = z[:-1]
-    _, M = _flow_var(b, y0, z[-1])
-    ev = np.linalg.eigvals(M)
-    return y0, float(z[-1]), ev[np.argsort(-np.abs(ev))]
-
-
-def _flow(b: ballbal.Balancer, y0: np.ndarray, T: float) -> np.ndarray:
-    r = solve_ivp(lambda t, s: rhs(b, t, s), (0, T), y0, rtol=1e-11, atol=1e-13,
+def _flow_tol(b: ballbal.Balancer, y0: np.ndarray, T: float, rtol: float) -> np.ndarray:
+    r = solve_ivp(lambda t, s: rhs(b, t, s), (0, T), y0, rtol=rtol, atol=rtol * 1e-2,
                   method="DOP853")
     return r.y[:, -1]
+
+
+def shoot_newton(b: ballbal.Balancer, y: np.ndarray, T: float,
+                 winding: np.ndarray) -> tuple[float, np.ndarray]:
+    """Shooting by Newton with the monodromy from forward differences of the flow
+    (phase: the first ball's angle fixed), from a close start: period and multipliers at
+    the closed orbit."""
+    n = len(y)
+    shift = np.zeros(n)
+    shift[: len(winding)] = 2 * np.pi * np.asarray(winding)
+    free = [i for i in range(n) if i != 2]
+    h = 1e-6
+    for _ in range(6):
+        end = _flow_tol(b, y, T, 1e-10)
+        M = np.empty((n, n))
+        for j in range(n):
+            e = np.zeros(n)
+            e[j] = h
+            M[:, j] = (_flow_tol(b, y + e, T, 1e-10) - end) / h
+        r = end - y - shift
+        if np.abs(r).max() < 1e-9:
+            return T, np.linalg.eigvals(M)
+        J = np.column_stack([(M - np.eye(n))[:, free], rhs(b, T, end)])
+        d = np.linalg.solve(J, -r)
+        y = y.copy()
+        y[free] += d[:-1]
+        T += d[-1]
+    raise AssertionError(f"shooting did not close: {np.abs(r).max()}")
 
 
 def _nontrivial(ev: np.ndarray) -> np.ndarray:
@@ -138,11 +116,13 @@ def _row_near(br: ballbal.continuation.Branch, om: float) -> int:
 
 
 def _shoot_from(br: ballbal.continuation.Branch, k: int, om: float) -> tuple[float, np.ndarray]:
-    """Shooting at Omega `om` from branch row `k`'s orbit: period and multipliers."""
+    """Shooting at Omega `om`, started from the series re-solved there from branch row
+    `k` (the start only): period and multipliers."""
     s = br.solutions[k]
     b = s.balancer.replace(Omega=om)
-    _, T, ev = shoot(b, s.state(0.0), s.period, np.asarray(s.winding))
-    return T, ev
+    start = ballbal.periodic(b, "R-R", options=OPTS, guess=s)
+    assert start.converged
+    return shoot_newton(b, start.state(0.0), start.period, np.asarray(start.winding))
 
 
 def test_branch_point_against_shooting() -> None:
@@ -162,7 +142,8 @@ def test_branch_point_against_shooting() -> None:
         g.append(min(real, key=lambda r: abs(r - 1)) - 1)
     assert g[0] * g[1] < 0, g
     zero = (om - h) - g[0] * (2 * h) / (g[1] - g[0])
-    assert abs(zero - om) < 2e-4, (zero, om)
+    # Measured 7e-6 (the secant over the +-2e-3 bracket; the series closes to 1e-11).
+    assert abs(zero - om) < 5e-5, (zero, om)
 
 
 # The merged balls' subspace (b1 = b2, b1' = b2') is invariant: shooting in it sees the
@@ -177,12 +158,6 @@ def _unmerge(z: np.ndarray) -> np.ndarray:
 
 def _merged_flow(b: ballbal.Balancer, z: np.ndarray, T: float) -> np.ndarray:
     return _flow_tol(b, _unmerge(z), T, 1e-10)[_MERGED]
-
-
-def _flow_tol(b: ballbal.Balancer, y0: np.ndarray, T: float, rtol: float) -> np.ndarray:
-    r = solve_ivp(lambda t, s: rhs(b, t, s), (0, T), y0, rtol=rtol, atol=rtol * 1e-2,
-                  method="DOP853")
-    return r.y[:, -1]
 
 
 def merged_fold_multiplier(b: ballbal.Balancer, y_guess: np.ndarray, T_guess: float,
@@ -362,34 +337,6 @@ def test_continuation_down_stops_at_the_infinite_period_end() -> None:
 
 def _thesis(eta: float) -> ballbal.Balancer:
     return ballbal.Balancer(**STD, Omega=1.2, eta=(eta, eta))
-
-
-def shoot_newton(b: ballbal.Balancer, y: np.ndarray, T: float,
-                 winding: np.ndarray) -> tuple[float, np.ndarray]:
-    """Shooting by Newton with the monodromy from forward differences of the flow
-    (phase: the first ball's angle fixed), from a close start: period and multipliers at
-    the closed orbit."""
-    n = len(y)
-    shift = np.zeros(n)
-    shift[: len(winding)] = 2 * np.pi * np.asarray(winding)
-    free = [i for i in range(n) if i != 2]
-    h = 1e-6
-    for _ in range(6):
-        end = _flow_tol(b, y, T, 1e-10)
-        M = np.empty((n, n))
-        for j in range(n):
-            e = np.zeros(n)
-            e[j] = h
-            M[:, j] = (_flow_tol(b, y + e, T, 1e-10) - end) / h
-        r = end - y - shift
-        if np.abs(r).max() < 1e-9:
-            return T, np.linalg.eigvals(M)
-        J = np.column_stack([(M - np.eye(n))[:, free], rhs(b, T, end)])
-        d = np.linalg.solve(J, -r)
-        y = y.copy()
-        y[free] += d[:-1]
-        T += d[-1]
-    raise AssertionError(f"shooting did not close: {np.abs(r).max()}")
 
 
 def _turns(b: ballbal.Balancer, y0: np.ndarray, t_end: float) -> np.ndarray:
