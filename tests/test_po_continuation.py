@@ -235,7 +235,7 @@ def _separation_and_balance(b: ballbal.Balancer, s: ballbal.PeriodicSolution,
     last = sim.tail(20)
     sep = float(np.abs(np.angle(np.exp(1j * (last["b1"][-1] - last["b2"][-1])))))
     disp = float(np.hypot(last["x"], last["y"]).max())
-    rate = max(float(last[c].abs().max()) for c in ("dx", "dy", "db1", "db2"))
+    rate = float(np.abs(last.select("dx", "dy", "db1", "db2").to_numpy()).max())
     return sep, disp, rate
 
 
