@@ -84,8 +84,9 @@ def periodic_branch(
     through -1), ``NS`` (a complex pair through the unit circle) and ``IP`` (infinite
     period: omega falls below ``min_omega``, or a point fails its certificate while
     omega falls; that point is not kept, the branch stops with ``"infinite_period"`` and
-    the event's parameter is where ``omega^2``, linear in the parameter there,
-    extrapolates to 0).
+    the event's parameter ``p*`` is fitted on the last three points as
+    ``T = C / sqrt|p - p*| + D``, the period law near a saddle-node on the invariant
+    circle).
 
     Returns a :class:`~ballbal._branch.Branch` of kind ``"periodic"``: ``table`` (one row
     per point: the parameter, omega, period, status, stability, max modulus, multipliers,
