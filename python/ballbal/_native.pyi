@@ -25,7 +25,8 @@ __all__ = [
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
-    "groove_study", "periodic_branch", "periodic_curve", "switch_periodic", "switch_hopf", "__version__",
+    "groove_study", "periodic_branch", "periodic_curve", "switch_periodic", "switch_hopf",
+    "__version__",
 ]
 
 __version__: str
