@@ -32,7 +32,7 @@ def branch_vs_scan(opts: ballbal.PeriodicOptions, label: str) -> ballbal.continu
     start = ballbal.periodic(b, "R-R", options=opts)
     t = time.perf_counter()
     br = periodic_branch(start, "Omega", range=(1.2, 3.0), periodic_options=opts,
-                         options=Continuation(ds=0.01, ds_max=0.01, max_points=200))
+                         options=Continuation(ds=0.06, ds_max=0.06, max_points=200))
     t_branch = time.perf_counter() - t
     n = br.table.height
     grid = np.sort(br.table["Omega"].to_numpy())
