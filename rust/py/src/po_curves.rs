@@ -6,7 +6,9 @@ use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
 use crate::tables::solution_dict;
-use ballbal_core::analysis::po_curves::{periodic_curve as core_curve, PoCurveKind, PoCurveOptions};
+use ballbal_core::analysis::po_curves::{
+    periodic_curve as core_curve, PoCurveKind, PoCurveOptions,
+};
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::periodic::require_autonomous;
 use ballbal_core::{Dynamics, Error};
@@ -63,9 +65,10 @@ pub fn periodic_curve<'py>(
         locate_tol,
     };
     let names = [parameter.to_string(), parameter2.to_string()];
-    let c = guarded(py, || {
-        dispatch!(&m, x => core_curve(x, [&names[0], &names[1]], k, &start, &opts))
-    })?;
+    let c = guarded(
+        py,
+        || dispatch!(&m, x => core_curve(x, [&names[0], &names[1]], k, &start, &opts)),
+    )?;
     let out = PyDict::new(py);
     let mut points = Vec::with_capacity(c.points.len());
     for pt in c.points {

@@ -260,7 +260,12 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
     }
 
     /// The matrix that is singular on a curve of `kind`, at this system's `x`.
-    pub fn test_matrix(&mut self, kind: PoCurveKind, x: &[f64], p: [f64; 2]) -> Result<DMatrix<f64>> {
+    pub fn test_matrix(
+        &mut self,
+        kind: PoCurveKind,
+        x: &[f64],
+        p: [f64; 2],
+    ) -> Result<DMatrix<f64>> {
         match kind {
             PoCurveKind::Fold => self.sys_jac(x, p),
             PoCurveKind::BranchPoint => {
@@ -307,7 +312,8 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
             let tau = 2.0 * PI * periods as f64 * i as f64 / s as f64;
             let sc = tau.sin_cos();
             for j in 0..d {
-                let (x0, x1, x2) = eval_series_sc(&xf[j * l..(j + 1) * l], self.winding[j], tau, sc);
+                let (x0, x1, x2) =
+                    eval_series_sc(&xf[j * l..(j + 1) * l], self.winding[j], tau, sc);
                 (q[j], qt[j], qtt[j]) = (x0, x1, x2);
                 if let Some(e) = pert {
                     let w = 2 * nh;
@@ -382,9 +388,14 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 let row = (jp - jm).tr_mul(&uv) / (2.0 * h);
                 grad[..n].copy_from_slice(row.as_slice());
                 for k in 0..2 {
-                    grad[n + k] = self.mixed_p(&xp, &xm, p, k, |r| {
-                        r.iter().zip(u).map(|(a, b)| a * b).sum()
-                    }, false)? / (2.0 * h);
+                    grad[n + k] = self.mixed_p(
+                        &xp,
+                        &xm,
+                        p,
+                        k,
+                        |r| r.iter().zip(u).map(|(a, b)| a * b).sum(),
+                        false,
+                    )? / (2.0 * h);
                 }
             }
             PoCurveKind::BranchPoint => {
@@ -401,22 +412,30 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 let jp = self.full_jac(&xp, p)?;
                 let jm = self.full_jac(&xm, p)?;
                 for k in 0..nf {
-                    let mut s = 0.0;
-                    for i in 0..l {
-                        let row = (o * l + i) * nf;
-                        s += u[i] * (jp[row + k] - jm[row + k]);
-                    }
+                    let s: f64 = u
+                        .iter()
+                        .enumerate()
+                        .map(|(i, ui)| {
+                            let row = (o * l + i) * nf;
+                            ui * (jp[row + k] - jm[row + k])
+                        })
+                        .sum();
                     grad[self.map(k)] += s / (2.0 * h);
                 }
                 for k in 0..2 {
-                    grad[n + k] = self.mixed_p(&xp, &xm, p, k, |r| {
-                        (0..l).map(|i| u[i] * r[o * l + i]).sum()
-                    }, true)? / (2.0 * h);
+                    grad[n + k] = self.mixed_p(
+                        &xp,
+                        &xm,
+                        p,
+                        k,
+                        |r| (0..l).map(|i| u[i] * r[o * l + i]).sum(),
+                        true,
+                    )? / (2.0 * h);
                 }
             }
             PoCurveKind::PeriodDoubling => {
                 let xf = self.full(x);
-                let (d, nh, s) = (self.d, self.n_harm, self.samples);
+                let (nh, s) = (self.n_harm, self.samples);
                 let half = Table::new(Basis::Half, nh, s, 2);
                 let whole = Table::new(Basis::Whole, nh, s, 2);
                 let ep: Vec<f64> = v.iter().map(|b| h * b).collect();
@@ -425,8 +444,6 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 let gm = self.galerkin(&xf, Some(&em), p, &half, &whole, true, 2)?;
                 let uv = DVector::from_column_slice(u);
                 let row = (gp - gm).tr_mul(&uv) / (2.0 * h);
-                debug_assert_eq!(row.len(), self.nf());
-                let _ = d;
                 for (k, g) in row.iter().enumerate() {
                     grad[self.map(k)] += g;
                 }
@@ -479,12 +496,26 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
 
     /// Signs of the other kinds' determinants (rows scaled to unit max-norm: the sign is
     /// kept and the value stays in range), for codimension-two points.
-    fn secondary(&mut self, kind: PoCurveKind, x: &[f64], p: [f64; 2]) -> Result<Vec<(&'static str, f64)>> {
+    fn secondary(
+        &mut self,
+        kind: PoCurveKind,
+        x: &[f64],
+        p: [f64; 2],
+    ) -> Result<Vec<(&'static str, f64)>> {
         let mut out = vec![];
         let kinds: &[(PoCurveKind, &'static str)] = match kind {
-            PoCurveKind::Fold => &[(PoCurveKind::BranchPoint, "BP"), (PoCurveKind::PeriodDoubling, "LPPD")],
-            PoCurveKind::BranchPoint => &[(PoCurveKind::Fold, "LP"), (PoCurveKind::PeriodDoubling, "PD")],
-            PoCurveKind::PeriodDoubling => &[(PoCurveKind::Fold, "LPPD"), (PoCurveKind::BranchPoint, "BP")],
+            PoCurveKind::Fold => &[
+                (PoCurveKind::BranchPoint, "BP"),
+                (PoCurveKind::PeriodDoubling, "LPPD"),
+            ],
+            PoCurveKind::BranchPoint => &[
+                (PoCurveKind::Fold, "LP"),
+                (PoCurveKind::PeriodDoubling, "PD"),
+            ],
+            PoCurveKind::PeriodDoubling => &[
+                (PoCurveKind::Fold, "LPPD"),
+                (PoCurveKind::BranchPoint, "BP"),
+            ],
         };
         for &(k, label) in kinds {
             if k == PoCurveKind::BranchPoint && !self.reduced {
@@ -628,7 +659,11 @@ impl Border {
     /// `g` of `[[H, b], [c^T, 0]] [v; g] = e`; with `adjoint`, also `v` and the adjoint
     /// `w` (`[[H, b], [c^T, 0]]^T [w; g] = e`).
     #[allow(clippy::type_complexity)]
-    fn solve(&self, h: &DMatrix<f64>, adjoint: bool) -> Option<(f64, Option<(Vec<f64>, Vec<f64>)>)> {
+    fn solve(
+        &self,
+        h: &DMatrix<f64>,
+        adjoint: bool,
+    ) -> Option<(f64, Option<(Vec<f64>, Vec<f64>)>)> {
         let m = h.nrows();
         let bm = self.matrix(h);
         let mut e = DVector::zeros(m + 1);
@@ -644,7 +679,10 @@ impl Border {
         let t = bm.transpose().lu().solve(&e)?;
         Some((
             g,
-            Some((s.rows(0, m).iter().copied().collect(), t.rows(0, m).iter().copied().collect())),
+            Some((
+                s.rows(0, m).iter().copied().collect(),
+                t.rows(0, m).iter().copied().collect(),
+            )),
         ))
     }
 
@@ -680,7 +718,10 @@ impl<'a, D: Parametric> Augmented<'a, D> {
             Some((g, _)) => Ok(g * self.scale),
             None => Err(Error::param(
                 "test_function",
-                format!("the bordered test matrix is singular at ({}, {})", p[0], p[1]),
+                format!(
+                    "the bordered test matrix is singular at ({}, {})",
+                    p[0], p[1]
+                ),
             )),
         }
     }
@@ -692,7 +733,10 @@ impl<'a, D: Parametric> Augmented<'a, D> {
         let Some((g, Some((v, w)))) = self.border.solve(&h, true) else {
             return Err(Error::param(
                 "test_function",
-                format!("the bordered test matrix is singular at ({}, {})", p[0], p[1]),
+                format!(
+                    "the bordered test matrix is singular at ({}, {})",
+                    p[0], p[1]
+                ),
             ));
         };
         let grad = self.sys.contracted_gradient(self.kind, x, p, &w, &v)?;
@@ -708,13 +752,7 @@ impl<'a, D: Parametric> Augmented<'a, D> {
         if self.grad.as_ref().is_none_or(|c| c.key != key) {
             let n = self.sys.n();
             let (g, grad, v, w) = self.g_grad(&y[..n], [y[n], p2])?;
-            self.grad = Some(GradCache {
-                key,
-                g,
-                grad,
-                v,
-                w,
-            });
+            self.grad = Some(GradCache { key, g, grad, v, w });
         }
         Ok(self.grad.as_ref().unwrap())
     }
@@ -895,7 +933,10 @@ pub fn periodic_curve<D: Parametric>(
     opts.periodic.validate()?;
     crate::error::check_range("locate_tol", opts.locate_tol, 0.0, true, 1.0, true)?;
     if names[0] == names[1] {
-        return Err(Error::param("parameter2", "must differ from the first parameter"));
+        return Err(Error::param(
+            "parameter2",
+            "must differ from the first parameter",
+        ));
     }
     let mut p0 = [0.0; 2];
     for (k, (name, label)) in names.iter().zip(["parameter", "parameter2"]).enumerate() {
@@ -907,7 +948,10 @@ pub fn periodic_curve<D: Parametric>(
     if !(lo < hi) || !(lo..=hi).contains(&p0[0]) {
         return Err(Error::param_range(
             "range1",
-            format!("must contain the start's {} = {}, got ({lo}, {hi})", names[0], p0[0]),
+            format!(
+                "must contain the start's {} = {}, got ({lo}, {hi})",
+                names[0], p0[0]
+            ),
             format!("lo <= {} <= hi", p0[0]),
         ));
     }
@@ -1030,7 +1074,13 @@ fn half<'a, D: Parametric>(
             arc.finish("boundary");
             break;
         }
-        let omega = arc.problem().sys.full(&pt.x[..n]).last().copied().unwrap_or(f64::NAN);
+        let omega = arc
+            .problem()
+            .sys
+            .full(&pt.x[..n])
+            .last()
+            .copied()
+            .unwrap_or(f64::NAN);
         if !(omega > 1e-3) {
             arc.finish("omega_vanishes");
             break;
@@ -1058,7 +1108,13 @@ fn half<'a, D: Parametric>(
                     0.0,
                     &arc_opts,
                 )? {
-                    let om = arc.problem().sys.full(&e.x[..n]).last().copied().unwrap_or(f64::NAN);
+                    let om = arc
+                        .problem()
+                        .sys
+                        .full(&e.x[..n])
+                        .last()
+                        .copied()
+                        .unwrap_or(f64::NAN);
                     special.push(PoCodim2 {
                         kind: label,
                         p: [e.x[n], e.p],
@@ -1088,8 +1144,13 @@ fn half<'a, D: Parametric>(
                         0.0,
                         &arc_opts,
                     )? {
-                        let om =
-                            arc.problem().sys.full(&e.x[..n]).last().copied().unwrap_or(f64::NAN);
+                        let om = arc
+                            .problem()
+                            .sys
+                            .full(&e.x[..n])
+                            .last()
+                            .copied()
+                            .unwrap_or(f64::NAN);
                         special.push(PoCodim2 {
                             kind: "CP",
                             p: [e.x[n], e.p],
@@ -1242,5 +1303,88 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Along the PD curve in (eta, Omega), the monodromy of every point's series (the
+    /// variational equations integrated by RK45, not the half-harmonic Galerkin matrix
+    /// the curve is defined by) has a multiplier at -1.
+    #[test]
+    fn period_doubling_curve_points_have_a_monodromy_multiplier_at_minus_one() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[0.9, 0.9]).unwrap();
+        let mut o = branch_opts(6, 0.8, 0.9);
+        o.arc.forward = false;
+        o.arc.ds_max = 0.02;
+        let start = periodic(&p, &[true, true], None, &o.periodic);
+        let b = periodic_branch(&p, "eta", &start.sol, &o).unwrap();
+        let e = b
+            .events
+            .iter()
+            .find(|e| e.kind == PoEventKind::PeriodDoubling)
+            .expect("a PD event");
+        let base = p.with_param("eta", e.p).unwrap();
+        let mut co = curve_opts(6, (0.3, 1.5), (1.15, 1.25), 6);
+        (co.arc.ds, co.arc.ds_max) = (0.05, 0.2);
+        let c = periodic_curve(
+            &base,
+            ["eta", "Omega"],
+            PoCurveKind::PeriodDoubling,
+            &e.point.result.sol,
+            &co,
+        )
+        .unwrap();
+        assert!(c.points.len() >= 8, "{:?}", c.stop);
+        let (lo, hi) = c
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), pt| {
+                (a.min(pt.p[1]), b.max(pt.p[1]))
+            });
+        assert!(hi - lo > 0.02, "{lo} {hi}");
+        for pt in &c.points {
+            let m = &pt.result.floquet.as_ref().expect("multipliers").multipliers;
+            let d = m
+                .iter()
+                .map(|z| (z.0 + 1.0).hypot(z.1))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 1e-6, "{d} at {:?}", pt.p);
+        }
+    }
+
+    #[test]
+    fn bad_inputs_name_the_parameter() {
+        let (p, ev) = standard_events(1.0);
+        let (_, om, sol) = ev
+            .iter()
+            .find(|e| e.0 == PoEventKind::BranchPoint)
+            .unwrap()
+            .clone();
+        let base = p.with_param("Omega", om).unwrap();
+        let o = curve_opts(6, (1.0, 3.0), (0.9, 1.1), 4);
+        let name = |names: [&str; 2], sol: &HbSolution, o: &PoCurveOptions| match periodic_curve(
+            &base,
+            names,
+            PoCurveKind::BranchPoint,
+            sol,
+            o,
+        ) {
+            Err(Error::InvalidParameter { name, .. }) => name,
+            other => panic!("{:?}", other.map(|c| c.stop)),
+        };
+        assert_eq!(name(["nope", "eta"], &sol, &o), "parameter");
+        assert_eq!(name(["Omega", "nope"], &sol, &o), "parameter2");
+        assert_eq!(name(["Omega", "Omega"], &sol, &o), "parameter2");
+        let mut bad = sol.clone();
+        bad.omega = f64::NAN;
+        assert_eq!(name(["Omega", "eta"], &bad, &o), "start");
+        let mut o1 = o.clone();
+        o1.p1_range = (2.0, 3.0);
+        assert_eq!(name(["Omega", "eta"], &sol, &o1), "range1");
+        let mut o2 = o.clone();
+        (o2.arc.p_min, o2.arc.p_max) = (1.2, 1.3);
+        assert_eq!(name(["Omega", "eta"], &sol, &o2), "range");
+        let mut o3 = o.clone();
+        o3.locate_tol = -1.0;
+        assert_eq!(name(["Omega", "eta"], &sol, &o3), "locate_tol");
+        assert!(PoCurveKind::parse("NS").is_err());
     }
 }
