@@ -135,7 +135,8 @@ def test_pd_curve_points_have_a_multiplier_minus_one_by_shooting() -> None:
         b, T, ev = _shoot_row(c, k)
         assert b.eta[0] == pytest.approx(t["eta"][k], abs=0)
         assert abs(T - t["period"][k]) < 1e-4 * T
-        assert np.min(np.abs(ev + 1)) < 2e-3, (t["eta"][k], t["Omega"][k], ev)
+        # Measured 1e-9 at N = 8: the harmonic balance's truncation is far below this.
+        assert np.min(np.abs(ev + 1)) < 1e-6, (t["eta"][k], t["Omega"][k], ev)
 
 
 @pytest.mark.parametrize("kind", ["BP", "LP"])
@@ -149,7 +150,7 @@ def test_band_end_curves_agree_with_branches_at_fixed_eta(kind: str) -> None:
         br = band_end(eta)
         ev = br.events.filter(br.events["type"] == kind)
         assert ev.height >= 1, (eta, br.events)
-        assert abs(float(ev["Omega"][0]) - t["Omega"][k]) < 1e-6, (eta, ev, t[k])
+        assert abs(float(ev["Omega"][0]) - t["Omega"][k]) < 1e-7, (eta, ev, t[k])
 
 
 def test_branch_point_curve_against_shooting() -> None:
@@ -159,7 +160,7 @@ def test_branch_point_curve_against_shooting() -> None:
     k = c.table.height - 1
     _, _, ev = _shoot_row(c, k)
     near = np.sort(np.abs(ev - 1))
-    assert near[1] < 2e-3, ev
+    assert near[1] < 1e-6, ev  # measured 3e-8
     assert near[2] > 1e-2, ev
 
 
