@@ -1,10 +1,15 @@
-"""Periodic-branch continuation against a grid scan of the same points (issue 15):
-the thesis' standard merged R-R orbit (mu 0.2, zeta 0.05, zeta_b 0.05, delta 50, eta 1)
-continued in Omega with N = 8 by pseudo-arclength, 200 points with their certificates,
-Floquet multipliers and located events, against `ballbal.scan` (natural-parameter
-continuation on the scan's lattice, one thread) over 200 Omega values spanning the same
-range with the same harmonics and Floquet options. The requirement: the branch costs no
-more than 2x the scan.
+"""Periodic continuation speed (issue 15), printed side by side:
+
+* a 200-point branch of the thesis' standard merged R-R orbit (mu 0.2, zeta 0.05,
+  zeta_b 0.05, delta 50, eta 1, N = 8) continued in Omega by pseudo-arclength, every
+  point with its certificates, Floquet multipliers and located events, against
+  ``ballbal.scan`` (natural-parameter continuation on the scan's lattice, one thread)
+  over the same Omega values with the same harmonics and Floquet options (required:
+  branch <= 2x scan);
+* points per second of natural-parameter (scan) and pseudo-arclength (branch)
+  continuation, with and without the per-point Floquet analysis;
+* a 100-point two-parameter curve (the branch point of the band's upper end in
+  (Omega, eta)), with and without Floquet multipliers per point (required: seconds).
 
     python benchmarks/bench_po_continuation.py
 """
@@ -12,37 +17,60 @@ more than 2x the scan.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
 import ballbal
-from ballbal.continuation import Continuation, periodic_branch
+from ballbal.continuation import Continuation, periodic_branch, periodic_curve
+
+BASE = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, eta=(1.0, 1.0))
 
 
-def main() -> None:
-    base = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, eta=(1.0, 1.0))
-    b = ballbal.Balancer(**base, Omega=1.2)
-    opts = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8))
+def branch_vs_scan(opts: ballbal.PeriodicOptions, label: str) -> ballbal.continuation.Branch:
+    b = ballbal.Balancer(**BASE, Omega=1.2)
     start = ballbal.periodic(b, "R-R", options=opts)
     t = time.perf_counter()
     br = periodic_branch(start, "Omega", range=(1.2, 3.0), periodic_options=opts,
-                         options=Continuation(ds=0.01, ds_max=0.01, max_points=200))
+                         options=Continuation(ds=0.06, ds_max=0.06, max_points=200))
     t_branch = time.perf_counter() - t
     n = br.table.height
-    lo, hi = float(br.table["Omega"].min()), float(br.table["Omega"].max())
-    print(f"branch: {n} points over Omega {lo:.4f}..{hi:.4f} in {t_branch:.2f} s, "
-          f"stop {br.stop}, events {br.events['type'].to_list()}")
-    grid = np.linspace(lo, hi, n)
+    grid = np.sort(br.table["Omega"].to_numpy())
     so = ballbal.ScanOptions(harmonic_balance=ballbal.HarmonicBalance(N=8),
                              floquet=opts.floquet)
     t = time.perf_counter()
     df = ballbal.scan(b, Omega=grid, patterns=("R-R",), options=so, threads=1)
     t_scan = time.perf_counter() - t
     found = df.filter(df["status"] == "converged").height
-    print(f"scan:   {n} points ({found} converged R-R rows) in {t_scan:.2f} s")
-    print(f"points per second: natural-parameter (scan lattice) {n / t_scan:.1f}, "
-          f"pseudo-arclength {n / t_branch:.1f}; branch / scan = {t_branch / t_scan:.2f} "
-          f"(required <= 2)")
+    print(f"[{label}] pseudo-arclength branch: {n} points over Omega "
+          f"{grid[0]:.4f}..{grid[-1]:.4f} in {t_branch:.2f} s ({n / t_branch:.1f} points/s), "
+          f"stop {br.stop}, events {br.events['type'].to_list()}")
+    print(f"[{label}] natural-parameter scan:  {len(grid)} points ({found} converged) in "
+          f"{t_scan:.2f} s ({len(grid) / t_scan:.1f} points/s)")
+    print(f"[{label}] branch / scan = {t_branch / t_scan:.2f} (required <= 2)")
+    return br
+
+
+def curve(br: ballbal.continuation.Branch, opts: ballbal.PeriodicOptions, label: str) -> None:
+    i = br.events["type"].to_list().index("BP")
+    t = time.perf_counter()
+    c = periodic_curve(br, i, "eta", range=(0.3, 3.0), range1=(0.5, 5.0),
+                       periodic_options=opts,
+                       options=Continuation(ds=0.02, ds_max=0.02, max_points=51, grow=1.0))
+    dt = time.perf_counter() - t
+    n = c.table.height
+    print(f"[{label}] BP curve in (Omega, eta): {n} points in {dt:.2f} s "
+          f"({n / dt:.1f} points/s), eta {c.table['eta'].min():.3f}..{c.table['eta'].max():.3f},"
+          f" stop {c.stop}, codim-2 {c.points['type'].to_list()}")
+
+
+def main() -> None:
+    with_floquet = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8))
+    bare = replace(with_floquet, floquet=ballbal.Floquet(monodromy=False, hill=False))
+    br = branch_vs_scan(with_floquet, "Floquet")
+    branch_vs_scan(bare, "no Floquet")
+    curve(br, bare, "no Floquet")
+    curve(br, with_floquet, "Floquet")
 
 
 if __name__ == "__main__":

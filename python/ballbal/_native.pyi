@@ -25,7 +25,8 @@ __all__ = [
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
-    "groove_study", "periodic_branch", "switch_periodic", "switch_hopf", "__version__",
+    "groove_study", "periodic_branch", "periodic_curve", "switch_periodic", "switch_hopf",
+    "__version__",
 ]
 
 __version__: str
@@ -124,4 +125,11 @@ def periodic_branch(
     model: Balancer | Scene, parameter: str,
     start: tuple[float, npt.NDArray[np.float64], list[float]], p_range: tuple[float, float],
     continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
+) -> dict[str, Any]: ...
+# {"kind", "together", "points": [solution dict + p1, p2, test, test_*], "special", "stop"}
+def periodic_curve(
+    model: Balancer | Scene, kind: str, parameter: str, parameter2: str,
+    start: tuple[float, npt.NDArray[np.float64], list[float]], range: tuple[float, float],
+    range1: tuple[float, float], continuation: Continuation, options: PeriodicOptions,
+    locate_tol: float,
 ) -> dict[str, Any]: ...

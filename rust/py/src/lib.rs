@@ -14,6 +14,7 @@ mod eq_continuation;
 mod errors;
 mod groove;
 mod po_continuation;
+mod po_curves;
 mod po_switch;
 mod rotor;
 mod run;
@@ -79,6 +80,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     basins::register(m)?;
     eq_continuation::register(m)?;
     po_switch::register(m)?;
+    po_curves::register(m)?;
     m.add_function(wrap_pyfunction!(groove::groove_study, m)?)?;
     m.add_function(wrap_pyfunction!(po_continuation::periodic_branch, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -11,6 +11,7 @@ pub mod homotopy;
 pub mod journal;
 pub mod periodic;
 pub mod po_branch;
+pub mod po_curves;
 pub mod record;
 pub mod simulate;
 pub mod switch;

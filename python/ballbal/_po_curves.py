@@ -1,0 +1,138 @@
+"""Two-parameter curves of bifurcations of periodic solutions (folds ``LP``, branch
+points of merged balls ``BP``, period doublings ``PD``): a minimally augmented
+harmonic-balance system continued by pseudo-arclength
+(``rust/core/src/analysis/po_curves.rs``), from an event of a periodic branch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+from . import _check, _native
+from ._branch import Branch, Continuation, Curve, model_at, parameter_range
+from .analysis import _solution
+from .exceptions import ParameterError, ParameterTypeError
+from .options import PERIODIC_DEFAULTS, PeriodicOptions
+
+__all__ = ["periodic_curve"]
+
+#: Event types with a curve.
+_KINDS = ("LP", "BP", "PD")
+
+
+def _multipliers(d: dict[str, Any]) -> tuple[list[float] | None, list[float] | None]:
+    if d["mult_re"] is not None:
+        return list(d["mult_re"]), list(d["mult_im"])
+    if "hill_re" in d:
+        return list(d["hill_re"]), list(d["hill_im"])
+    return None, None
+
+
+def periodic_curve(
+    branch: Branch,
+    event_index: int,
+    parameter2: str,
+    *,
+    range: tuple[float, float],  # noqa: A002 - the documented keyword
+    range1: tuple[float, float] | None = None,
+    options: Continuation | None = None,
+    periodic_options: PeriodicOptions | None = None,
+    locate_tol: float = 1e-8,
+) -> Curve:
+    """The curve of the bifurcation ``branch.events[event_index]`` (``LP``, ``BP`` or
+    ``PD`` of a periodic branch) in (``branch.parameter``, ``parameter2``), continued
+    both ways from the event over ``range`` in ``parameter2`` and ``range1`` in the
+    branch's parameter (default: the branch's range), with the branch's harmonics.
+
+    The curve solves the harmonic-balance equations together with one scalar test
+    function from a bordered matrix that is singular on it: the harmonic-balance
+    Jacobian (``LP``), the separating mode's Galerkin block of merged balls (``BP``: the
+    separation multiplier at +1), the linearisation's Galerkin matrix on half harmonics
+    (``PD``: a multiplier at -1). A merged start is continued with its balls merged.
+
+    ``table``: one row per point (the two parameters, ``omega``, ``period``, status,
+    stability and multipliers with ``periodic_options``, ``test`` (the curve's own test
+    function, ~0), ``test_*`` (the other kinds' determinants, whose sign changes are the
+    codimension-two points), ``flag`` (the codimension-two points located since the
+    previous row)). ``points``: the codimension-two points (``CP`` cusp of an LP curve,
+    ``BP`` / ``LP`` / ``PD`` where the curve meets that curve, ``LPPD`` fold–flip).
+    ``meta["solutions"]``: the :class:`~ballbal.PeriodicSolution` of every row.
+    """
+    if not isinstance(branch, Branch) or branch.kind != "periodic":
+        raise ParameterTypeError("branch", "must be a periodic Branch (from periodic_branch)",
+                                 value=branch)
+    i = _check.integer("event_index", event_index, 0)
+    if i >= branch.events.height:
+        raise ParameterError("event_index", f"the branch has {branch.events.height} events",
+                             value=i)
+    kind = branch.events["type"][i]
+    if kind not in _KINDS:
+        raise ParameterError("event_index", f"event {i} is {kind!r}: no curve of it",
+                             allowed=", ".join(_KINDS))
+    p1 = branch.parameter
+    p2 = _check.string("parameter2", parameter2)
+    if p2 == p1:
+        raise ParameterError("parameter2", f"must differ from the branch's parameter {p1!r}")
+    lo, hi = parameter_range(range)
+    if range1 is None:
+        lo1, hi1 = branch.meta.get("range", (-np.inf, np.inf))
+    else:
+        try:
+            lo1, hi1 = parameter_range(range1)
+        except ParameterError as e:
+            raise type(e)("range1", e.message, value=range1) from None
+    options = _check.option("options", options, Continuation,
+                            Continuation(ds=0.01, ds_max=0.05, max_points=200),
+                            "ballbal.continuation.Continuation")
+    popts = _check.option("periodic_options", periodic_options, PeriodicOptions,
+                          PERIODIC_DEFAULTS, "ballbal.PeriodicOptions")
+    n = int(branch.meta.get("N", branch.event_solutions[i].N))
+    popts = replace(popts, harmonic_balance=replace(popts.harmonic_balance, N=n))
+    locate_tol = _check.real("locate_tol", locate_tol)
+    start = branch.event_solutions[i]
+    model = start.balancer
+    coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
+    winding = [float(w) for w in start.winding]
+    d = _native.periodic_curve(model, kind, p1, p2, (float(start.omega), coeffs, winding),
+                               (lo, hi), (lo1, hi1), options, popts, locate_tol)
+    pts = d["points"]
+    flags: list[str | None] = [None] * len(pts)
+    for s in d["special"]:
+        r = min(int(s["row"]), len(pts) - 1)
+        flags[r] = s["type"] if flags[r] is None else f"{flags[r]},{s['type']}"
+    tests = sorted({k for p in pts for k in p if k.startswith("test_")})
+    rows = []
+    for p, flag in zip(pts, flags, strict=True):
+        re_, im = _multipliers(p)
+        om = p["omega"]
+        rows.append({
+            p1: p["p1"], p2: p["p2"], "omega": om,
+            "period": None if om is None else 2 * np.pi / om,
+            "status": p["status"], "stability": p["stability"],
+            "max_modulus": p["max_modulus"], "mult_re": re_, "mult_im": im,
+            "trivial_error": p["trivial_error"], "closure": p["closure"],
+            "test": p["test"], **{t: p.get(t) for t in tests}, "flag": flag,
+        })
+    f, s_, lf = pl.Float64, pl.Utf8, pl.List(pl.Float64)
+    schema: dict[str, Any] = {p1: f, p2: f, "omega": f, "period": f, "status": s_,
+                              "stability": s_, "max_modulus": f, "mult_re": lf,
+                              "mult_im": lf, "trivial_error": f, "closure": f, "test": f,
+                              **{t: f for t in tests}, "flag": s_}
+    table = pl.DataFrame(rows, schema=schema, orient="row")
+    sp = d["special"]
+    points = pl.DataFrame({
+        "type": [s["type"] for s in sp], p1: [s["p1"] for s in sp],
+        p2: [s["p2"] for s in sp], "omega": [s["omega"] for s in sp],
+        "row": [s["row"] for s in sp],
+    }, schema={"type": pl.Utf8, p1: f, p2: f, "omega": f, "row": pl.Int64})
+    solutions = tuple(_solution(model_at(model_at(model, p1, p["p1"]), p2, p["p2"]), p)
+                      for p in pts)
+    return Curve(kind=d["kind"], parameters=(p1, p2), table=table, points=points,
+                 stop=d["stop"],
+                 meta={"model": model, "range": (lo, hi), "range1": (lo1, hi1),
+                       "options": options, "together": d["together"], "N": n,
+                       "solutions": solutions})

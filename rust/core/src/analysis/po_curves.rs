@@ -1,0 +1,1390 @@
+//! Two-parameter curves of bifurcations of periodic solutions: folds (`LP`), branch
+//! points of merged balls (`BP`) and period doublings (`PD`), continued in any two model
+//! parameters `(p1, p2)` by pseudo-arclength on a minimally augmented system
+//!
+//! ```text
+//!   F(x, p1, p2) = 0      (harmonic balance: coefficients and omega, phase condition)
+//!   g(x, p1, p2) = 0      (g from  [[H, b], [c^T, 0]] [v; g] = [0; 1])
+//! ```
+//!
+//! where `H` is a square matrix computed from the harmonic-balance data that is singular
+//! exactly on the curve, and `b`, `c` are borders (the left and right singular vectors at
+//! the start, then the previous point's adjoint and null vectors, so that the bordered
+//! matrix stays well conditioned). `g` is smooth, and its gradient is
+//! `g_y = -w^T H_y v` (`w` the adjoint solution): no differences over every unknown.
+//!
+//! * `LP`: `H = F_x`, the harmonic-balance Jacobian (with omega and the phase condition,
+//!   which removes the trivial multiplier's null vector). `F_xx` is symmetric, so
+//!   `w^T F_xx[v, .] = w^T (F_x(x + h v) - F_x(x - h v)) / 2h`: two Jacobians.
+//! * `BP` of merged balls: the separating mode `b_1 = -b_2 = e` leaves the rotor's
+//!   equations and the together subspace alone; its Galerkin block
+//!   `H = J_{b1 b1} - J_{b1 b2}` is singular when the separation multiplier is +1. The
+//!   curve is continued on the together subspace (unknowns: rotor and common ball
+//!   series, omega; equations: rotor rows, the balls' rows summed, phase), where the
+//!   branch point is a regular zero of `g` (on the full coordinates the separating null
+//!   vector would make the augmented system singular too).
+//! * `PD`: `H` is the Galerkin matrix of the linearisation on half harmonics
+//!   `cos (k + 1/2) tau, sin (k + 1/2) tau` (`k < N`): it is singular when the
+//!   linearisation has a solution of period 2T that changes sign over T, i.e. a
+//!   multiplier -1, to the harmonic balance's own truncation. Its derivative uses the
+//!   same symmetry, on the state perturbed along the half-harmonic null vector.
+//!
+//! Merged starts (all balls on one series) are continued on the together subspace for
+//! every kind, so that the balls stay merged. Codimension-two points flagged on the way
+//! (sign changes of the other kinds' determinants, located in arclength): on an `LP`
+//! curve `CP` (cusp: the curve reverses in the parameter plane), `BP` (it meets the
+//! branch-point curve) and `LPPD` (fold–flip); on a `BP` curve `LP` and `PD`; on a `PD`
+//! curve `LPPD` and `BP`.
+
+use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::error::{Error, Result};
+use crate::hb::{default_samples, eval_series_sc, HbSolution, HbSystem, Status};
+use crate::numerics::problem::{Parametric, Problem};
+use crate::periodic::{finish, Periodic, PeriodicOptions};
+use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
+
+/// The bifurcation a curve continues.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PoCurveKind {
+    Fold,
+    BranchPoint,
+    PeriodDoubling,
+}
+
+impl PoCurveKind {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            PoCurveKind::Fold => "LP",
+            PoCurveKind::BranchPoint => "BP",
+            PoCurveKind::PeriodDoubling => "PD",
+        }
+    }
+
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "LP" => Ok(PoCurveKind::Fold),
+            "BP" => Ok(PoCurveKind::BranchPoint),
+            "PD" => Ok(PoCurveKind::PeriodDoubling),
+            _ => Err(Error::param_range(
+                "kind",
+                format!("no curve of {name:?} events"),
+                "LP, BP, PD",
+            )),
+        }
+    }
+}
+
+/// The harmonic-balance equations of a model family in two parameters, on the full
+/// coordinates or on the together subspace of merged balls.
+pub struct PoSystem<'a, D: Parametric> {
+    base: &'a D,
+    names: [String; 2],
+    hb: HbSystem<'a, D>,
+    reduced: bool,
+    d: usize,
+    o: usize,
+    l: usize,
+    n_harm: usize,
+    samples: usize,
+    winding: Vec<f64>,
+    cache: Option<([u64; 2], D)>,
+}
+
+/// Step of the directional differences along a unit null vector.
+const DIR_STEP: f64 = 1e-5;
+
+impl<'a, D: Parametric> PoSystem<'a, D> {
+    pub fn new(
+        base: &'a D,
+        names: [&str; 2],
+        winding: &[f64],
+        n_harm: usize,
+        samples: usize,
+        reduced: bool,
+    ) -> Self {
+        let d = base.ndof();
+        PoSystem {
+            base,
+            names: [names[0].to_string(), names[1].to_string()],
+            hb: HbSystem::new(base, winding, n_harm, samples),
+            reduced,
+            d,
+            o: base.first_ball(),
+            l: 2 * n_harm + 1,
+            n_harm,
+            samples,
+            winding: winding.to_vec(),
+            cache: None,
+        }
+    }
+
+    pub fn is_reduced(&self) -> bool {
+        self.reduced
+    }
+
+    /// The model at `p`.
+    pub fn model(&mut self, p: [f64; 2]) -> Result<&D> {
+        let key = [p[0].to_bits(), p[1].to_bits()];
+        if self.cache.as_ref().is_none_or(|(k, _)| *k != key) {
+            let m = self
+                .base
+                .with_param(&self.names[0], p[0])?
+                .with_param(&self.names[1], p[1])?;
+            self.cache = Some((key, m));
+        }
+        Ok(&self.cache.as_ref().unwrap().1)
+    }
+
+    /// Unknowns of this system.
+    pub fn n(&self) -> usize {
+        if self.reduced {
+            (self.o + 1) * self.l + 1
+        } else {
+            self.nf()
+        }
+    }
+
+    fn nf(&self) -> usize {
+        self.d * self.l + 1
+    }
+
+    /// Full unknowns (coefficients of every coordinate, omega) from this system's.
+    pub fn full(&self, x: &[f64]) -> Vec<f64> {
+        if !self.reduced {
+            return x.to_vec();
+        }
+        let (o, l) = (self.o, self.l);
+        let mut f = Vec::with_capacity(self.nf());
+        f.extend_from_slice(&x[..(o + 1) * l]);
+        for _ in o + 1..self.d {
+            f.extend_from_slice(&x[o * l..(o + 1) * l]);
+        }
+        f.push(x[(o + 1) * l]);
+        f
+    }
+
+    /// This system's unknowns from full ones.
+    pub fn reduce(&self, xf: &[f64]) -> Vec<f64> {
+        if !self.reduced {
+            return xf.to_vec();
+        }
+        let mut x = xf[..(self.o + 1) * self.l].to_vec();
+        x.push(xf[self.d * self.l]);
+        x
+    }
+
+    /// The reduced index of full index `i` (rows: the balls' rows are summed; columns:
+    /// the common ball's coefficient moves every ball's).
+    fn map(&self, i: usize) -> usize {
+        if !self.reduced {
+            return i;
+        }
+        let (o, l) = (self.o, self.l);
+        if i == self.d * l {
+            (o + 1) * l
+        } else {
+            (i / l).min(o) * l + i % l
+        }
+    }
+
+    fn full_eval(
+        &mut self,
+        xf: &[f64],
+        p: [f64; 2],
+        r: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) -> Result<()> {
+        self.model(p)?;
+        let m = &self.cache.as_ref().unwrap().1;
+        self.hb.assemble_with(m, xf, r, jac);
+        if crate::cancel::cancelled() {
+            return Err(Error::Cancelled);
+        }
+        Ok(())
+    }
+
+    /// `F` and, when asked, `F_x` (row-major) in this system's unknowns.
+    pub fn eval(
+        &mut self,
+        x: &[f64],
+        p: [f64; 2],
+        r: &mut [f64],
+        jac: Option<&mut [f64]>,
+    ) -> Result<()> {
+        if !self.reduced {
+            return self.full_eval(x, p, r, jac);
+        }
+        let xf = self.full(x);
+        let (nf, n) = (self.nf(), self.n());
+        let mut rf = vec![0.0; nf];
+        let mut jf = jac.as_ref().map(|_| vec![0.0; nf * nf]);
+        self.full_eval(&xf, p, &mut rf, jf.as_deref_mut())?;
+        r.fill(0.0);
+        for (i, v) in rf.iter().enumerate() {
+            r[self.map(i)] += v;
+        }
+        if let (Some(jac), Some(jf)) = (jac, jf) {
+            jac.fill(0.0);
+            for i in 0..nf {
+                let row = self.map(i) * n;
+                for k in 0..nf {
+                    jac[row + self.map(k)] += jf[i * nf + k];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The separating mode's Galerkin block `J_{b1 b1} - J_{b1 b2}` of a full Jacobian.
+    fn separating(&self, jf: &[f64]) -> DMatrix<f64> {
+        let (nf, l, o) = (self.nf(), self.l, self.o);
+        DMatrix::from_fn(l, l, |i, k| {
+            let row = (o * l + i) * nf;
+            jf[row + o * l + k] - jf[row + (o + 1) * l + k]
+        })
+    }
+
+    fn full_jac(&mut self, xf: &[f64], p: [f64; 2]) -> Result<Vec<f64>> {
+        let nf = self.nf();
+        let (mut r, mut jf) = (vec![0.0; nf], vec![0.0; nf * nf]);
+        self.full_eval(xf, p, &mut r, Some(&mut jf))?;
+        Ok(jf)
+    }
+
+    fn sys_jac(&mut self, x: &[f64], p: [f64; 2]) -> Result<DMatrix<f64>> {
+        let n = self.n();
+        let (mut r, mut j) = (vec![0.0; n], vec![0.0; n * n]);
+        self.eval(x, p, &mut r, Some(&mut j))?;
+        Ok(DMatrix::from_row_slice(n, n, &j))
+    }
+
+    /// The matrix that is singular on a curve of `kind`, at this system's `x`.
+    pub fn test_matrix(
+        &mut self,
+        kind: PoCurveKind,
+        x: &[f64],
+        p: [f64; 2],
+    ) -> Result<DMatrix<f64>> {
+        match kind {
+            PoCurveKind::Fold => self.sys_jac(x, p),
+            PoCurveKind::BranchPoint => {
+                let xf = self.full(x);
+                let jf = self.full_jac(&xf, p)?;
+                Ok(self.separating(&jf))
+            }
+            PoCurveKind::PeriodDoubling => {
+                let xf = self.full(x);
+                let half = Table::new(Basis::Half, self.n_harm, self.samples, 1);
+                self.galerkin(&xf, None, p, &half, &half, false, 1)
+            }
+        }
+    }
+
+    /// The Galerkin matrix of the linearisation about the series `xf` (plus `pert`, a
+    /// half-harmonic series, when given): rows the basis `rows` per coordinate, columns
+    /// `cols` per coordinate and, with `omega_col`, the derivative in omega; sampled
+    /// `periods` times over `[0, 2 pi)`.
+    #[allow(clippy::too_many_arguments)]
+    fn galerkin(
+        &mut self,
+        xf: &[f64],
+        pert: Option<&[f64]>,
+        p: [f64; 2],
+        rows: &Table,
+        cols: &Table,
+        omega_col: bool,
+        periods: usize,
+    ) -> Result<DMatrix<f64>> {
+        let (d, l, nh) = (self.d, self.l, self.n_harm);
+        let s = self.samples * periods;
+        let om = xf[d * l];
+        let (nr, nc) = (rows.width, cols.width);
+        let mut h = DMatrix::zeros(d * nr, d * nc + usize::from(omega_col));
+        let half = Table::new(Basis::Half, nh, self.samples, periods);
+        self.model(p)?;
+        let m = &self.cache.as_ref().unwrap().1;
+        let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+        let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
+        let (mut kk, mut cc, mut mm) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        let mut g = vec![0.0; nc];
+        for i in 0..s {
+            let tau = 2.0 * PI * periods as f64 * i as f64 / s as f64;
+            let sc = tau.sin_cos();
+            for j in 0..d {
+                let (x0, x1, x2) =
+                    eval_series_sc(&xf[j * l..(j + 1) * l], self.winding[j], tau, sc);
+                (q[j], qt[j], qtt[j]) = (x0, x1, x2);
+                if let Some(e) = pert {
+                    let w = 2 * nh;
+                    for r in 0..w {
+                        let (f0, f1, f2) = half.at(i, r);
+                        q[j] += e[j * w + r] * f0;
+                        qt[j] += e[j * w + r] * f1;
+                        qtt[j] += e[j * w + r] * f2;
+                    }
+                }
+                v[j] = om * qt[j];
+                a[j] = om * om * qtt[j];
+            }
+            m.jacobians(tau / om, &q, &v, &a, &mut kk, &mut cc, &mut mm);
+            for j in 0..d {
+                for k in 0..d {
+                    let o = j * d + k;
+                    let (kv, cv, mv) = (kk[o], om * cc[o], om * om * mm[o]);
+                    if kv == 0.0 && cv == 0.0 && mv == 0.0 {
+                        continue;
+                    }
+                    for (c, gc) in g.iter_mut().enumerate() {
+                        let (f0, f1, f2) = cols.at(i, c);
+                        *gc = kv * f0 + cv * f1 + mv * f2;
+                    }
+                    for r in 0..nr {
+                        let wr = rows.weight(i, r);
+                        if wr == 0.0 {
+                            continue;
+                        }
+                        for (c, gc) in g.iter().enumerate() {
+                            h[(j * nr + r, k * nc + c)] += wr * gc;
+                        }
+                    }
+                }
+                if omega_col {
+                    let mut dfo = 0.0;
+                    for k in 0..d {
+                        let o = j * d + k;
+                        dfo += cc[o] * qt[k] + 2.0 * om * mm[o] * qtt[k];
+                    }
+                    for r in 0..nr {
+                        h[(j * nr + r, d * nc)] += rows.weight(i, r) * dfo;
+                    }
+                }
+            }
+        }
+        Ok(h)
+    }
+
+    /// `d/dy (u^T H(y) v)` over this system's unknowns, `p1` and `p2` (`u`, `v` fixed), for
+    /// the test matrix of `kind`: the second-derivative symmetry along `v` for the
+    /// unknowns, central differences for the parameters.
+    fn contracted_gradient(
+        &mut self,
+        kind: PoCurveKind,
+        x: &[f64],
+        p: [f64; 2],
+        u: &[f64],
+        v: &[f64],
+    ) -> Result<Vec<f64>> {
+        let n = self.n();
+        let mut grad = vec![0.0; n + 2];
+        let h = DIR_STEP;
+        match kind {
+            PoCurveKind::Fold => {
+                let xp: Vec<f64> = x.iter().zip(v).map(|(a, b)| a + h * b).collect();
+                let xm: Vec<f64> = x.iter().zip(v).map(|(a, b)| a - h * b).collect();
+                let jp = self.sys_jac(&xp, p)?;
+                let jm = self.sys_jac(&xm, p)?;
+                let uv = DVector::from_column_slice(u);
+                let row = (jp - jm).tr_mul(&uv) / (2.0 * h);
+                grad[..n].copy_from_slice(row.as_slice());
+                for k in 0..2 {
+                    grad[n + k] = self.mixed_p(
+                        &xp,
+                        &xm,
+                        p,
+                        k,
+                        |r| r.iter().zip(u).map(|(a, b)| a * b).sum(),
+                        false,
+                    )? / (2.0 * h);
+                }
+            }
+            PoCurveKind::BranchPoint => {
+                let (nf, l, o) = (self.nf(), self.l, self.o);
+                let xf = self.full(x);
+                // The full direction of the separating mode: +v on ball 1, -v on ball 2.
+                let mut ev = vec![0.0; nf];
+                for i in 0..l {
+                    ev[o * l + i] = v[i];
+                    ev[(o + 1) * l + i] = -v[i];
+                }
+                let xp: Vec<f64> = xf.iter().zip(&ev).map(|(a, b)| a + h * b).collect();
+                let xm: Vec<f64> = xf.iter().zip(&ev).map(|(a, b)| a - h * b).collect();
+                let jp = self.full_jac(&xp, p)?;
+                let jm = self.full_jac(&xm, p)?;
+                for k in 0..nf {
+                    let s: f64 = u
+                        .iter()
+                        .enumerate()
+                        .map(|(i, ui)| {
+                            let row = (o * l + i) * nf;
+                            ui * (jp[row + k] - jm[row + k])
+                        })
+                        .sum();
+                    grad[self.map(k)] += s / (2.0 * h);
+                }
+                for k in 0..2 {
+                    grad[n + k] = self.mixed_p(
+                        &xp,
+                        &xm,
+                        p,
+                        k,
+                        |r| (0..l).map(|i| u[i] * r[o * l + i]).sum(),
+                        true,
+                    )? / (2.0 * h);
+                }
+            }
+            PoCurveKind::PeriodDoubling => {
+                let xf = self.full(x);
+                let (nh, s) = (self.n_harm, self.samples);
+                let half = Table::new(Basis::Half, nh, s, 2);
+                let whole = Table::new(Basis::Whole, nh, s, 2);
+                let ep: Vec<f64> = v.iter().map(|b| h * b).collect();
+                let em: Vec<f64> = v.iter().map(|b| -h * b).collect();
+                let gp = self.galerkin(&xf, Some(&ep), p, &half, &whole, true, 2)?;
+                let gm = self.galerkin(&xf, Some(&em), p, &half, &whole, true, 2)?;
+                let uv = DVector::from_column_slice(u);
+                let row = (gp - gm).tr_mul(&uv) / (2.0 * h);
+                for (k, g) in row.iter().enumerate() {
+                    grad[self.map(k)] += g;
+                }
+                let vv = DVector::from_column_slice(v);
+                let one = Table::new(Basis::Half, nh, s, 1);
+                for k in 0..2 {
+                    let hp = 1e-6 * (1.0 + p[k].abs());
+                    let (mut pp, mut pm) = (p, p);
+                    pp[k] += hp;
+                    pm[k] -= hp;
+                    let a = self.galerkin(&xf, None, pp, &one, &one, false, 1)?;
+                    let b = self.galerkin(&xf, None, pm, &one, &one, false, 1)?;
+                    grad[n + k] = uv.dot(&((a - b) * &vv)) / (2.0 * hp);
+                }
+            }
+        }
+        Ok(grad)
+    }
+
+    /// `(phi(F(x+, p+) - F(x+, p-)) - phi(F(x-, p+) - F(x-, p-))) / (2 h_p)` for
+    /// parameter `k` (`full`: `x+-` are full unknowns and `F` the full residual).
+    fn mixed_p(
+        &mut self,
+        xp: &[f64],
+        xm: &[f64],
+        p: [f64; 2],
+        k: usize,
+        phi: impl Fn(&[f64]) -> f64,
+        full: bool,
+    ) -> Result<f64> {
+        let hp = 1e-4 * (1.0 + p[k].abs());
+        let (mut pp, mut pm) = (p, p);
+        pp[k] += hp;
+        pm[k] -= hp;
+        let n = if full { self.nf() } else { self.n() };
+        let mut r = vec![0.0; n];
+        let mut total = 0.0;
+        for (x, sx) in [(xp, 1.0), (xm, -1.0)] {
+            for (pv, sp) in [(pp, 1.0), (pm, -1.0)] {
+                if full {
+                    self.full_eval(x, pv, &mut r, None)?;
+                } else {
+                    self.eval(x, pv, &mut r, None)?;
+                }
+                total += sx * sp * phi(&r);
+            }
+        }
+        Ok(total / (2.0 * hp))
+    }
+
+    /// Signs of the other kinds' determinants (rows scaled to unit max-norm: the sign is
+    /// kept and the value stays in range), for codimension-two points.
+    fn secondary(
+        &mut self,
+        kind: PoCurveKind,
+        x: &[f64],
+        p: [f64; 2],
+    ) -> Result<Vec<(&'static str, f64)>> {
+        let mut out = vec![];
+        let kinds: &[(PoCurveKind, &'static str)] = match kind {
+            PoCurveKind::Fold => &[
+                (PoCurveKind::BranchPoint, "BP"),
+                (PoCurveKind::PeriodDoubling, "LPPD"),
+            ],
+            PoCurveKind::BranchPoint => &[
+                (PoCurveKind::Fold, "LP"),
+                (PoCurveKind::PeriodDoubling, "PD"),
+            ],
+            PoCurveKind::PeriodDoubling => &[
+                (PoCurveKind::Fold, "LPPD"),
+                (PoCurveKind::BranchPoint, "BP"),
+            ],
+        };
+        for &(k, label) in kinds {
+            if k == PoCurveKind::BranchPoint && !self.reduced {
+                continue;
+            }
+            let m = self.test_matrix(k, x, p)?;
+            out.push((label, scaled_det(m)));
+        }
+        Ok(out)
+    }
+
+    /// The full series at this system's `x`.
+    pub fn series(&self, x: &[f64], residual: f64) -> HbSolution {
+        let xf = self.full(x);
+        let nf = self.nf();
+        HbSolution {
+            omega: xf[nf - 1],
+            coeffs: xf[..nf - 1].to_vec(),
+            winding: self.winding.clone(),
+            n_harm: self.n_harm,
+            samples: self.samples,
+            residual,
+            step: 0.0,
+            iterations: 0,
+            status: if xf[nf - 1] > 0.0 && xf[nf - 1].is_finite() {
+                Status::Converged
+            } else {
+                Status::Diverged
+            },
+            pivot_ratio: f64::NAN,
+        }
+    }
+}
+
+fn scaled_det(mut m: DMatrix<f64>) -> f64 {
+    for i in 0..m.nrows() {
+        let s = m.row(i).iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if s > 0.0 {
+            m.row_mut(i).iter_mut().for_each(|v| *v /= s);
+        }
+    }
+    m.lu().determinant()
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Basis {
+    /// `1, cos k tau, sin k tau` (`k <= N`): the harmonic balance's own.
+    Whole,
+    /// `cos (k + 1/2) tau, sin (k + 1/2) tau` (`k < N`).
+    Half,
+}
+
+/// A basis's values and tau-derivatives at the samples, with the Galerkin weights.
+struct Table {
+    width: usize,
+    vals: Vec<(f64, f64, f64)>,
+    wgt: Vec<f64>,
+}
+
+impl Table {
+    fn new(basis: Basis, nh: usize, samples: usize, periods: usize) -> Self {
+        let s = samples * periods;
+        let width = match basis {
+            Basis::Whole => 2 * nh + 1,
+            Basis::Half => 2 * nh,
+        };
+        let mut vals = Vec::with_capacity(s * width);
+        let mut wgt = Vec::with_capacity(s * width);
+        for i in 0..s {
+            let tau = 2.0 * PI * periods as f64 * i as f64 / s as f64;
+            if basis == Basis::Whole {
+                vals.push((1.0, 0.0, 0.0));
+                wgt.push(1.0 / s as f64);
+            }
+            let (k0, k1) = match basis {
+                Basis::Whole => (1, nh + 1),
+                Basis::Half => (0, nh),
+            };
+            for k in k0..k1 {
+                let mu = match basis {
+                    Basis::Whole => k as f64,
+                    Basis::Half => k as f64 + 0.5,
+                };
+                let (sn, cs) = (mu * tau).sin_cos();
+                vals.push((cs, -mu * sn, -mu * mu * cs));
+                vals.push((sn, mu * cs, -mu * mu * sn));
+                wgt.push(2.0 * cs / s as f64);
+                wgt.push(2.0 * sn / s as f64);
+            }
+        }
+        Table { width, vals, wgt }
+    }
+
+    fn at(&self, i: usize, r: usize) -> (f64, f64, f64) {
+        self.vals[i * self.width + r]
+    }
+
+    fn weight(&self, i: usize, r: usize) -> f64 {
+        self.wgt[i * self.width + r]
+    }
+}
+
+/// Borders of a minimally augmented system: `b` (a column), `c` (a row).
+#[derive(Debug, Clone)]
+struct Border {
+    b: DVector<f64>,
+    c: DVector<f64>,
+}
+
+impl Border {
+    /// The smallest singular value's left and right vectors.
+    fn from_svd(h: &DMatrix<f64>) -> Result<Self> {
+        let svd = h.clone().svd(true, true);
+        let (u, vt) = match (svd.u, svd.v_t) {
+            (Some(u), Some(vt)) => (u, vt),
+            _ => return Err(Error::Eigen("SVD of the test matrix failed".into())),
+        };
+        let k = svd
+            .singular_values
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, _)| i)
+            .unwrap_or(0);
+        Ok(Border {
+            b: u.column(k).into_owned(),
+            c: vt.row(k).transpose(),
+        })
+    }
+
+    fn matrix(&self, h: &DMatrix<f64>) -> DMatrix<f64> {
+        let m = h.nrows();
+        DMatrix::from_fn(m + 1, m + 1, |i, j| match (i < m, j < m) {
+            (true, true) => h[(i, j)],
+            (true, false) => self.b[i],
+            (false, true) => self.c[j],
+            (false, false) => 0.0,
+        })
+    }
+
+    /// `g` of `[[H, b], [c^T, 0]] [v; g] = e`; with `adjoint`, also `v` and the adjoint
+    /// `w` (`[[H, b], [c^T, 0]]^T [w; g] = e`).
+    #[allow(clippy::type_complexity)]
+    fn solve(
+        &self,
+        h: &DMatrix<f64>,
+        adjoint: bool,
+    ) -> Option<(f64, Option<(Vec<f64>, Vec<f64>)>)> {
+        let m = h.nrows();
+        let bm = self.matrix(h);
+        let mut e = DVector::zeros(m + 1);
+        e[m] = 1.0;
+        let s = bm.clone().lu().solve(&e)?;
+        let g = s[m];
+        if !g.is_finite() {
+            return None;
+        }
+        if !adjoint {
+            return Some((g, None));
+        }
+        let t = bm.transpose().lu().solve(&e)?;
+        Some((
+            g,
+            Some((
+                s.rows(0, m).iter().copied().collect(),
+                t.rows(0, m).iter().copied().collect(),
+            )),
+        ))
+    }
+
+    /// New borders from a point's null and adjoint vectors (unit length).
+    fn update(&mut self, v: &[f64], w: &[f64]) {
+        let nv = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let nw = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if nv > 0.0 && nw > 0.0 && nv.is_finite() && nw.is_finite() {
+            self.c = DVector::from_iterator(v.len(), v.iter().map(|x| x / nv));
+            self.b = DVector::from_iterator(w.len(), w.iter().map(|x| x / nw));
+        }
+    }
+}
+
+/// `[F; g] = 0` as a [`Problem`] in `(x, p1)` with parameter `p2`.
+pub struct Augmented<'a, D: Parametric> {
+    pub sys: PoSystem<'a, D>,
+    kind: PoCurveKind,
+    border: Border,
+    /// `g` is divided by its gradient's norm at the start: `|g|` is then about the
+    /// distance from the curve, and the corrector's tolerance means the same for it.
+    scale: f64,
+    p2: f64,
+    /// The last gradient of `g` (over `x`, `p1`, `p2`) and where it was taken:
+    /// `jac_x` and `jac_p` of one point share it.
+    grad: Option<GradCache>,
+}
+
+impl<'a, D: Parametric> Augmented<'a, D> {
+    fn g(&mut self, x: &[f64], p: [f64; 2]) -> Result<f64> {
+        let h = self.sys.test_matrix(self.kind, x, p)?;
+        match self.border.solve(&h, false) {
+            Some((g, _)) => Ok(g * self.scale),
+            None => Err(Error::param(
+                "test_function",
+                format!(
+                    "the bordered test matrix is singular at ({}, {})",
+                    p[0], p[1]
+                ),
+            )),
+        }
+    }
+
+    /// `g` and its gradient over `(x, p1, p2)`, and the null / adjoint vectors.
+    #[allow(clippy::type_complexity)]
+    fn g_grad(&mut self, x: &[f64], p: [f64; 2]) -> Result<(f64, Vec<f64>, Vec<f64>, Vec<f64>)> {
+        let h = self.sys.test_matrix(self.kind, x, p)?;
+        let Some((g, Some((v, w)))) = self.border.solve(&h, true) else {
+            return Err(Error::param(
+                "test_function",
+                format!(
+                    "the bordered test matrix is singular at ({}, {})",
+                    p[0], p[1]
+                ),
+            ));
+        };
+        let grad = self.sys.contracted_gradient(self.kind, x, p, &w, &v)?;
+        let grad = grad.iter().map(|d| -d * self.scale).collect();
+        Ok((g * self.scale, grad, v, w))
+    }
+
+    /// `g`, its gradient and the null / adjoint vectors at `(y, p2)`, kept for the
+    /// next call at the same point (`jac_x`, `jac_p` and the border update share them).
+    fn at(&mut self, y: &[f64], p2: f64) -> Result<&GradCache> {
+        let mut key: Vec<u64> = y.iter().map(|v| v.to_bits()).collect();
+        key.push(p2.to_bits());
+        if self.grad.as_ref().is_none_or(|c| c.key != key) {
+            let n = self.sys.n();
+            let (g, grad, v, w) = self.g_grad(&y[..n], [y[n], p2])?;
+            self.grad = Some(GradCache { key, g, grad, v, w });
+        }
+        Ok(self.grad.as_ref().unwrap())
+    }
+
+    fn gradient(&mut self, y: &[f64], p2: f64) -> Result<Vec<f64>> {
+        Ok(self.at(y, p2)?.grad.clone())
+    }
+
+    /// Borders from the null and adjoint vectors at a curve point.
+    fn rebase(&mut self, y: &[f64], p2: f64) -> Result<()> {
+        let c = self.at(y, p2)?;
+        let (v, w) = (c.v.clone(), c.w.clone());
+        self.border.update(&v, &w);
+        self.grad = None;
+        Ok(())
+    }
+}
+
+struct GradCache {
+    key: Vec<u64>,
+    g: f64,
+    grad: Vec<f64>,
+    v: Vec<f64>,
+    w: Vec<f64>,
+}
+
+impl<D: Parametric> Problem for Augmented<'_, D> {
+    fn size(&self) -> usize {
+        self.sys.n() + 1
+    }
+    fn param(&self) -> f64 {
+        self.p2
+    }
+    fn residual(&mut self, y: &[f64], p2: f64, r: &mut [f64]) -> Result<()> {
+        let n = self.sys.n();
+        let p = [y[n], p2];
+        self.sys.eval(&y[..n], p, &mut r[..n], None)?;
+        r[n] = self.g(&y[..n], p)?;
+        Ok(())
+    }
+    fn jac_x(&mut self, y: &[f64], p2: f64, r: &mut [f64], jac: &mut [f64]) -> Result<()> {
+        let n = self.sys.n();
+        let n1 = n + 1;
+        let p = [y[n], p2];
+        let mut jx = vec![0.0; n * n];
+        self.sys.eval(&y[..n], p, &mut r[..n], Some(&mut jx))?;
+        let fp = self.f_p(&y[..n], p, 0)?;
+        for i in 0..n {
+            jac[i * n1..i * n1 + n].copy_from_slice(&jx[i * n..(i + 1) * n]);
+            jac[i * n1 + n] = fp[i];
+        }
+        let c = self.at(y, p2)?;
+        r[n] = c.g;
+        jac[n * n1..n * n1 + n1].copy_from_slice(&c.grad[..n1]);
+        Ok(())
+    }
+    fn jac_p(&mut self, y: &[f64], p2: f64, out: &mut [f64]) -> Result<()> {
+        let n = self.sys.n();
+        let fp = self.f_p(&y[..n], [y[n], p2], 1)?;
+        out[..n].copy_from_slice(&fp);
+        out[n] = self.gradient(y, p2)?[n + 1];
+        Ok(())
+    }
+}
+
+impl<D: Parametric> Augmented<'_, D> {
+    fn f_p(&mut self, x: &[f64], p: [f64; 2], k: usize) -> Result<Vec<f64>> {
+        let n = self.sys.n();
+        let h = 1e-6 * (1.0 + p[k].abs());
+        let (mut pp, mut pm) = (p, p);
+        pp[k] += h;
+        pm[k] -= h;
+        let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+        self.sys.eval(x, pp, &mut a, None)?;
+        self.sys.eval(x, pm, &mut b, None)?;
+        Ok(a.iter().zip(&b).map(|(a, b)| (a - b) / (2.0 * h)).collect())
+    }
+}
+
+/// Settings of [`periodic_curve`].
+#[derive(Debug, Clone)]
+pub struct PoCurveOptions {
+    /// Step control; `p_min`, `p_max` bound the second parameter.
+    pub arc: ArcOptions,
+    /// The first parameter's window: the curve stops where it leaves it.
+    pub p1_range: (f64, f64),
+    /// Harmonics (`hb.n_harm`, `hb.samples`) and the certificates and multipliers
+    /// reported per point (`auto` is ignored).
+    pub periodic: PeriodicOptions,
+    /// Arclength tolerance of codimension-two points.
+    pub locate_tol: f64,
+}
+
+impl Default for PoCurveOptions {
+    fn default() -> Self {
+        PoCurveOptions {
+            arc: ArcOptions::default(),
+            p1_range: (f64::NEG_INFINITY, f64::INFINITY),
+            periodic: PeriodicOptions::default(),
+            locate_tol: 1e-8,
+        }
+    }
+}
+
+/// One point of a curve.
+#[derive(Debug, Clone)]
+pub struct PoCurvePoint {
+    pub p: [f64; 2],
+    /// The series, certified and judged as `periodic()` does.
+    pub result: Periodic,
+    /// The curve's own test function (normalised), zero to the corrector's tolerance.
+    pub g: f64,
+    /// The other kinds' determinants (their sign changes are codimension-two points).
+    pub tests: Vec<(&'static str, f64)>,
+}
+
+/// A codimension-two point.
+#[derive(Debug, Clone)]
+pub struct PoCodim2 {
+    pub kind: &'static str,
+    pub p: [f64; 2],
+    pub omega: f64,
+    /// The row of the first curve point past it.
+    pub row: usize,
+}
+
+#[derive(Debug, Clone)]
+pub struct PoCurve {
+    pub kind: PoCurveKind,
+    pub points: Vec<PoCurvePoint>,
+    pub special: Vec<PoCodim2>,
+    /// Whether the curve was continued on the together subspace (merged balls).
+    pub together: bool,
+    /// Why each half ended: towards decreasing, then increasing second parameter.
+    pub stop: [String; 2],
+}
+
+fn stop_text(s: Option<&ArcStop>) -> String {
+    match s {
+        None | Some(ArcStop::MaxPoints) => "max_points".into(),
+        Some(ArcStop::Boundary) => "boundary".into(),
+        Some(ArcStop::StepTooSmall) => "step_too_small".into(),
+        Some(ArcStop::Finished(w)) => w.clone(),
+        Some(ArcStop::Failed(w)) => format!("failed: {w}"),
+    }
+}
+
+/// Whether every ball of `sol` runs the same series (the together subspace).
+fn all_merged(sol: &HbSolution, o: usize) -> bool {
+    let d = sol.ndof();
+    if d < o + 2 {
+        return false;
+    }
+    let scale = sol.coeffs.iter().fold(1.0f64, |m, c| m.max(c.abs()));
+    (o + 1..d).all(|j| {
+        sol.winding[j] == sol.winding[o]
+            && sol
+                .coord(j)
+                .iter()
+                .zip(sol.coord(o))
+                .all(|(a, b)| (a - b).abs() <= 1e-7 * scale)
+    })
+}
+
+/// Continues the curve of `kind` through the bifurcation point `start` (a periodic
+/// solution of `base` at a located event, e.g. a row of a periodic branch's events) in
+/// the parameters `names = [p1, p2]` of `base` (which has the event's values), both ways
+/// in `p2` from the start: the rows run from the end reached towards decreasing `p2` to
+/// the end reached towards increasing `p2`.
+pub fn periodic_curve<D: Parametric>(
+    base: &D,
+    names: [&str; 2],
+    kind: PoCurveKind,
+    start: &HbSolution,
+    opts: &PoCurveOptions,
+) -> Result<PoCurve> {
+    opts.arc.validate()?;
+    opts.periodic.validate()?;
+    crate::error::check_range("locate_tol", opts.locate_tol, 0.0, true, 1.0, true)?;
+    if names[0] == names[1] {
+        return Err(Error::param(
+            "parameter2",
+            "must differ from the first parameter",
+        ));
+    }
+    let mut p0 = [0.0; 2];
+    for (k, (name, label)) in names.iter().zip(["parameter", "parameter2"]).enumerate() {
+        p0[k] = base.param_value(name).map_err(|_| {
+            Error::param(label, format!("{name:?} is not a parameter of this model"))
+        })?;
+    }
+    let (lo, hi) = opts.p1_range;
+    if !(lo < hi) || !(lo..=hi).contains(&p0[0]) {
+        return Err(Error::param_range(
+            "range1",
+            format!(
+                "must contain the start's {} = {}, got ({lo}, {hi})",
+                names[0], p0[0]
+            ),
+            format!("lo <= {} <= hi", p0[0]),
+        ));
+    }
+    if !(opts.arc.p_min..=opts.arc.p_max).contains(&p0[1]) {
+        return Err(Error::param_range(
+            "range",
+            format!(
+                "must contain the start's {} = {}, got ({}, {})",
+                names[1], p0[1], opts.arc.p_min, opts.arc.p_max
+            ),
+            format!("lo <= {} <= hi", p0[1]),
+        ));
+    }
+    let d = base.ndof();
+    if start.winding.len() != d
+        || start.coeffs.len() != d * (2 * start.n_harm + 1)
+        || !(start.omega > 0.0 && start.omega.is_finite())
+        || start.coeffs.iter().any(|c| !c.is_finite())
+    {
+        return Err(Error::param(
+            "start",
+            "needs a converged periodic solution of this model (omega > 0, finite coefficients)",
+        ));
+    }
+    let mut popts = opts.periodic.clone();
+    popts.auto = None;
+    let n_harm = popts.hb.n_harm;
+    let samples = popts.hb.samples.unwrap_or_else(|| default_samples(n_harm));
+    popts.hb.samples = Some(samples);
+    // No Newton at fixed parameters here: at a fold its Jacobian is singular. The
+    // augmented system's first correction (in x and p1) converges the start.
+    let first = if start.n_harm == n_harm {
+        start.clone()
+    } else {
+        start.resized(n_harm)
+    };
+    let together = all_merged(&first, base.first_ball());
+    if kind == PoCurveKind::BranchPoint && !together {
+        return Err(Error::param(
+            "event",
+            "branch-point curves are continued for merged balls (the separation multiplier \
+             through +1); this solution's balls are not merged",
+        ));
+    }
+    let mut sys = PoSystem::new(base, names, &first.winding, n_harm, samples, together);
+    let x0 = sys.reduce(&first.unknowns());
+    let h0 = sys.test_matrix(kind, &x0, p0)?;
+    let border = Border::from_svd(&h0)?;
+    let mut o = opts.clone();
+    o.arc.forward = false;
+    let (back, sys) = half(sys, kind, &x0, p0, border.clone(), &o, &popts)?;
+    o.arc.forward = true;
+    let (fwd, _) = half(sys, kind, &x0, p0, border, &o, &popts)?;
+    let nb = back.points.len();
+    let mut points: Vec<PoCurvePoint> = back.points.into_iter().rev().collect();
+    points.extend(fwd.points.into_iter().skip(1));
+    let mut special: Vec<PoCodim2> = back
+        .special
+        .into_iter()
+        .rev()
+        .map(|mut c| {
+            c.row = nb - c.row;
+            c
+        })
+        .collect();
+    special.extend(fwd.special.into_iter().map(|mut c| {
+        c.row += nb - 1;
+        c
+    }));
+    Ok(PoCurve {
+        kind,
+        points,
+        special,
+        together,
+        stop: [back.stop[1].clone(), fwd.stop[1].clone()],
+    })
+}
+
+type Half<'a, D> = (PoCurve, PoSystem<'a, D>);
+
+fn half<'a, D: Parametric>(
+    sys: PoSystem<'a, D>,
+    kind: PoCurveKind,
+    x0: &[f64],
+    p0: [f64; 2],
+    border: Border,
+    opts: &PoCurveOptions,
+    popts: &PeriodicOptions,
+) -> Result<Half<'a, D>> {
+    let n = sys.n();
+    let mut ext = Augmented {
+        sys,
+        kind,
+        border,
+        scale: 1.0,
+        p2: p0[1],
+        grad: None,
+    };
+    let mut y0 = x0.to_vec();
+    y0.push(p0[0]);
+    let grad = ext.gradient(&y0, p0[1])?;
+    let norm = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return Err(Error::param(
+            "event",
+            "the test function is flat at the start: not a regular bifurcation point",
+        ));
+    }
+    ext.scale = 1.0 / norm;
+    ext.grad = None;
+    let arc_opts = opts.arc.clone();
+    let (lo, hi) = opts.p1_range;
+    let mut arc = Arclength::new(&mut ext, &y0, p0[1], None, arc_opts.clone())?;
+    let mut points: Vec<PoCurvePoint> = vec![];
+    let mut special: Vec<PoCodim2> = vec![];
+    let mut prev: Option<(ArcPoint, Vec<(&'static str, f64)>)> = None;
+    while let Some(pt) = arc.next() {
+        let p = [pt.x[n], pt.p];
+        if !(lo..=hi).contains(&p[0]) {
+            arc.finish("boundary");
+            break;
+        }
+        let omega = arc
+            .problem()
+            .sys
+            .full(&pt.x[..n])
+            .last()
+            .copied()
+            .unwrap_or(f64::NAN);
+        if !(omega > 1e-3) {
+            arc.finish("omega_vanishes");
+            break;
+        }
+        let tt = arc.problem().sys.secondary(kind, &pt.x[..n], p)?;
+        let row = points.len();
+        if let Some((a, ta)) = &prev {
+            for (i, ((label, ga), (_, gb))) in ta.iter().zip(&tt).enumerate() {
+                if ga * gb >= 0.0 {
+                    continue;
+                }
+                let g = |e: &mut Augmented<'_, D>, pt: &ArcPoint| {
+                    e.sys
+                        .secondary(kind, &pt.x[..n], [pt.x[n], pt.p])
+                        .map(|v| v[i].1)
+                };
+                if let Some((e, _)) = locate(
+                    arc.problem(),
+                    a,
+                    &pt,
+                    *ga,
+                    *gb,
+                    g,
+                    opts.locate_tol,
+                    0.0,
+                    &arc_opts,
+                )? {
+                    let om = arc
+                        .problem()
+                        .sys
+                        .full(&e.x[..n])
+                        .last()
+                        .copied()
+                        .unwrap_or(f64::NAN);
+                    special.push(PoCodim2 {
+                        kind: label,
+                        p: [e.x[n], e.p],
+                        omega: om,
+                        row,
+                    });
+                }
+            }
+            if kind == PoCurveKind::Fold {
+                // A cusp: the curve's direction in the parameter plane reverses.
+                let ua = [a.tangent[n], a.tangent[n + 1]];
+                let ub = [pt.tangent[n], pt.tangent[n + 1]];
+                let gb = ub[0] * ua[0] + ub[1] * ua[1];
+                if gb < 0.0 {
+                    let ga = ua[0] * ua[0] + ua[1] * ua[1];
+                    let g = |_: &mut Augmented<'_, D>, pt: &ArcPoint| {
+                        Ok(pt.tangent[n] * ua[0] + pt.tangent[n + 1] * ua[1])
+                    };
+                    if let Some((e, _)) = locate(
+                        arc.problem(),
+                        a,
+                        &pt,
+                        ga,
+                        gb,
+                        g,
+                        opts.locate_tol,
+                        0.0,
+                        &arc_opts,
+                    )? {
+                        let om = arc
+                            .problem()
+                            .sys
+                            .full(&e.x[..n])
+                            .last()
+                            .copied()
+                            .unwrap_or(f64::NAN);
+                        special.push(PoCodim2 {
+                            kind: "CP",
+                            p: [e.x[n], e.p],
+                            omega: om,
+                            row,
+                        });
+                    }
+                }
+            }
+        }
+        let prob = arc.problem();
+        let sol = prob.sys.series(&pt.x[..n], pt.residual);
+        let model = prob.sys.model(p)?.clone();
+        let result = finish(&model, sol, popts);
+        let g = prob.g(&pt.x[..n], p)?;
+        // New borders for the next step (the curve is the same set: g = 0 iff H is
+        // singular, whatever the borders).
+        prob.rebase(&pt.x, pt.p)?;
+        points.push(PoCurvePoint {
+            p,
+            result,
+            g,
+            tests: tt.clone(),
+        });
+        prev = Some((pt, tt));
+    }
+    let stop = stop_text(arc.stop());
+    if crate::cancel::cancelled() {
+        return Err(Error::Cancelled);
+    }
+    if points.is_empty() {
+        return Err(Error::param(
+            "event",
+            format!("the curve's start does not converge: {stop}"),
+        ));
+    }
+    drop(arc);
+    Ok((
+        PoCurve {
+            kind,
+            points,
+            special,
+            together: ext.sys.reduced,
+            stop: [stop.clone(), stop],
+        },
+        ext.sys,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::po_branch::{periodic_branch, PoBranchOptions, PoEventKind};
+    use crate::floquet::FloquetOptions;
+    use crate::hb::HbOptions;
+    use crate::periodic::periodic;
+    use crate::Planar;
+
+    fn popts(n: usize) -> PeriodicOptions {
+        PeriodicOptions {
+            hb: HbOptions {
+                n_harm: n,
+                ..Default::default()
+            },
+            floquet: Some(FloquetOptions::default()),
+            ..Default::default()
+        }
+    }
+
+    fn branch_opts(n: usize, lo: f64, hi: f64) -> PoBranchOptions {
+        PoBranchOptions {
+            arc: ArcOptions {
+                ds: 0.02,
+                ds_max: 0.05,
+                ds_min: 1e-6,
+                max_points: 200,
+                p_min: lo,
+                p_max: hi,
+                ..Default::default()
+            },
+            periodic: popts(n),
+            ..Default::default()
+        }
+    }
+
+    fn curve_opts(n: usize, p1: (f64, f64), p2: (f64, f64), points: usize) -> PoCurveOptions {
+        PoCurveOptions {
+            arc: ArcOptions {
+                ds: 0.01,
+                ds_max: 0.05,
+                ds_min: 1e-6,
+                max_points: points,
+                p_min: p2.0,
+                p_max: p2.1,
+                ..Default::default()
+            },
+            p1_range: p1,
+            periodic: popts(n),
+            ..Default::default()
+        }
+    }
+
+    /// The standard merged R-R band's upper end at N = 6: its LP and BP events.
+    fn standard_events(eta: f64) -> (Planar, Vec<(PoEventKind, f64, HbSolution)>) {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[eta, eta]).unwrap();
+        let o = branch_opts(6, 1.2, 1.9);
+        let start = periodic(&p, &[true, true], None, &o.periodic);
+        assert_eq!(start.sol.status, Status::Converged);
+        let b = periodic_branch(&p, "Omega", &start.sol, &o).unwrap();
+        let ev = b
+            .events
+            .iter()
+            .map(|e| (e.kind, e.p, e.point.result.sol.clone()))
+            .collect();
+        (p, ev)
+    }
+
+    /// Along the LP and BP curves in (Omega, eta), each point is a fold / branch point
+    /// of the branch continued in Omega at that point's eta: the second method is
+    /// po_branch's event location (bisection on dp/ds and on the bordered determinant).
+    #[test]
+    fn fold_and_branch_point_curves_agree_with_branch_events() {
+        let (p, ev) = standard_events(1.0);
+        for kind in [PoCurveKind::Fold, PoCurveKind::BranchPoint] {
+            let want = match kind {
+                PoCurveKind::Fold => PoEventKind::Fold,
+                _ => PoEventKind::BranchPoint,
+            };
+            let (_, om, sol) = ev.iter().find(|e| e.0 == want).expect("event").clone();
+            let base = p.with_param("Omega", om).unwrap();
+            let c = periodic_curve(
+                &base,
+                ["Omega", "eta"],
+                kind,
+                &sol,
+                &curve_opts(6, (1.0, 3.0), (0.9, 1.1), 8),
+            )
+            .unwrap();
+            assert!(c.together);
+            assert!(c.points.len() >= 10, "{:?} {:?}", c.stop, c.points.len());
+            for pt in [c.points.first().unwrap(), c.points.last().unwrap()] {
+                let eta = pt.p[1];
+                let (_, ev2) = standard_events(eta);
+                let e = ev2.iter().find(|e| e.0 == want).expect("event at eta");
+                assert!(
+                    (e.1 - pt.p[0]).abs() < 1e-6,
+                    "{kind:?} at eta {eta}: curve {} branch {}",
+                    pt.p[0],
+                    e.1
+                );
+            }
+        }
+    }
+
+    /// Along the PD curve in (eta, Omega), the monodromy of every point's series (the
+    /// variational equations integrated by RK45, not the half-harmonic Galerkin matrix
+    /// the curve is defined by) has a multiplier at -1.
+    #[test]
+    fn period_doubling_curve_points_have_a_monodromy_multiplier_at_minus_one() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[0.9, 0.9]).unwrap();
+        let mut o = branch_opts(6, 0.8, 0.9);
+        o.arc.forward = false;
+        o.arc.ds_max = 0.02;
+        let start = periodic(&p, &[true, true], None, &o.periodic);
+        let b = periodic_branch(&p, "eta", &start.sol, &o).unwrap();
+        let e = b
+            .events
+            .iter()
+            .find(|e| e.kind == PoEventKind::PeriodDoubling)
+            .expect("a PD event");
+        let base = p.with_param("eta", e.p).unwrap();
+        let mut co = curve_opts(6, (0.3, 1.5), (1.15, 1.25), 6);
+        (co.arc.ds, co.arc.ds_max) = (0.05, 0.2);
+        let c = periodic_curve(
+            &base,
+            ["eta", "Omega"],
+            PoCurveKind::PeriodDoubling,
+            &e.point.result.sol,
+            &co,
+        )
+        .unwrap();
+        assert!(c.points.len() >= 8, "{:?}", c.stop);
+        let (lo, hi) = c
+            .points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), pt| {
+                (a.min(pt.p[1]), b.max(pt.p[1]))
+            });
+        assert!(hi - lo > 0.02, "{lo} {hi}");
+        for pt in &c.points {
+            let m = &pt.result.floquet.as_ref().expect("multipliers").multipliers;
+            let d = m
+                .iter()
+                .map(|z| (z.0 + 1.0).hypot(z.1))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 1e-6, "{d} at {:?}", pt.p);
+        }
+    }
+
+    #[test]
+    fn bad_inputs_name_the_parameter() {
+        let (p, ev) = standard_events(1.0);
+        let (_, om, sol) = ev
+            .iter()
+            .find(|e| e.0 == PoEventKind::BranchPoint)
+            .unwrap()
+            .clone();
+        let base = p.with_param("Omega", om).unwrap();
+        let o = curve_opts(6, (1.0, 3.0), (0.9, 1.1), 4);
+        let name = |names: [&str; 2], sol: &HbSolution, o: &PoCurveOptions| match periodic_curve(
+            &base,
+            names,
+            PoCurveKind::BranchPoint,
+            sol,
+            o,
+        ) {
+            Err(Error::InvalidParameter { name, .. }) => name,
+            other => panic!("{:?}", other.map(|c| c.stop)),
+        };
+        assert_eq!(name(["nope", "eta"], &sol, &o), "parameter");
+        assert_eq!(name(["Omega", "nope"], &sol, &o), "parameter2");
+        assert_eq!(name(["Omega", "Omega"], &sol, &o), "parameter2");
+        let mut bad = sol.clone();
+        bad.omega = f64::NAN;
+        assert_eq!(name(["Omega", "eta"], &bad, &o), "start");
+        let mut o1 = o.clone();
+        o1.p1_range = (2.0, 3.0);
+        assert_eq!(name(["Omega", "eta"], &sol, &o1), "range1");
+        let mut o2 = o.clone();
+        (o2.arc.p_min, o2.arc.p_max) = (1.2, 1.3);
+        assert_eq!(name(["Omega", "eta"], &sol, &o2), "range");
+        let mut o3 = o.clone();
+        o3.locate_tol = -1.0;
+        assert_eq!(name(["Omega", "eta"], &sol, &o3), "locate_tol");
+        assert!(PoCurveKind::parse("NS").is_err());
+    }
+}
