@@ -12,7 +12,7 @@ use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{
-    closure_error, parse_pattern, parse_windings, periodic_wound, require_autonomous,
+    closure_error, parse_pattern, parse_windings, periodic_searched, require_autonomous,
     PeriodicOptions,
 };
 use ballbal_core::scan::{Family, ScanRow, ScanSpec};
@@ -267,7 +267,7 @@ pub fn periodic<'py>(
             Ok(match (&guess, &homotopy) {
                 (None, Some(starts)) => periodic_homotopy(d, &ball_winding, starts, &opts),
                 _ => (
-                    periodic_wound(d, &ball_winding, guess.as_ref(), &opts),
+                    periodic_searched(d, &ball_winding, guess.as_ref(), &opts),
                     source_of(guess.is_some()),
                 ),
             })

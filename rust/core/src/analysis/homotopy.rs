@@ -5,7 +5,7 @@
 //! predictor, Newton–IHB corrector, certified at every step, the step halved on
 //! failure).
 
-use crate::analysis::periodic::{certify, finish, periodic_wound, Periodic, PeriodicOptions};
+use crate::analysis::periodic::{certify, finish, periodic_searched, Periodic, PeriodicOptions};
 use crate::hb::{solve, HbSolution, Status};
 use crate::numerics::problem::Parametric;
 
@@ -66,7 +66,7 @@ fn walk<D: Parametric>(
     None
 }
 
-/// [`periodic_wound`] without a guess, then, if it found no orbit, from each of
+/// [`periodic_searched`] without a guess, then, if it found no orbit, from each of
 /// `starts` (`(parameter, value)`) in turn: the orbit found by simulation there,
 /// followed to `p`. Returns the result and how it was found (`"simulation"` or
 /// `"homotopy from NAME=VALUE"`).
@@ -76,7 +76,7 @@ pub fn periodic_homotopy<D: Parametric>(
     starts: &[(String, f64)],
     opts: &PeriodicOptions,
 ) -> (Periodic, String) {
-    let first = periodic_wound(p, ball_winding, None, opts);
+    let first = periodic_searched(p, ball_winding, None, opts);
     if first.sol.status == Status::Converged {
         return (first, source_of(false));
     }
@@ -97,7 +97,7 @@ pub fn periodic_homotopy<D: Parametric>(
         let Ok(m0) = p.with_param(name, *from) else {
             continue;
         };
-        let r0 = periodic_wound(&m0, ball_winding, None, &quiet);
+        let r0 = periodic_searched(&m0, ball_winding, None, &quiet);
         if r0.sol.status != Status::Converged {
             continue;
         }
@@ -114,6 +114,7 @@ pub fn periodic_homotopy<D: Parametric>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::periodic::periodic_wound;
     use crate::Planar;
 
     #[test]
