@@ -393,7 +393,10 @@ def periodic(
     (:class:`~ballbal.GuessSearch`), ``max_closure, max_tail``.
 
     Without ``guess`` the start comes from a time simulation (``settle`` time units for
-    transients, then up to ``window`` to measure the period). ``guess`` may be a previous
+    transients, then up to ``window`` to measure the period). One ball, when no start at
+    rest in the ground frame finds the pattern, is also started whirling with the support
+    at its natural frequency (its rotating motion past a few tenths above the resonance
+    is reached from rest only from a sliver of ball angles). ``guess`` may be a previous
     solution (any N; it is truncated or padded) or ``(omega, coeffs)``. ``rtol, atol`` are
     the RK45 tolerances of the monodromy integration, ``max_steps`` its step budget (a
     longer integration ends in ``floquet_error`` and an undetermined verdict); a verdict
