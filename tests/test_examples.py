@@ -141,6 +141,27 @@ def thesis_ch4(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "thesis_ch4.png"]
 
 
+def single_ball(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # eta = m_b r_t / (m_d e) with the thesis' 33.12 g mm (table 4-2)
+    etas = [float(v) for v in re.findall(r"-> (\S+?)(?:,|$)", stdout.splitlines()[0])]
+    assert np.allclose(etas, [1.05 * 17 / 33.12, 2.05 * 16 / 33.12, 4.09 * 15 / 33.12],
+                       atol=6e-4), etas
+    # the residual imbalance at the stable equilibrium against section 4-3's statements
+    res = dict(re.findall(r"residual imbalance at \S+ rpm, eta (\S+): (\S+) g mm", stdout))
+    assert abs(float(res["0.54"]) - 15.24) < 0.01 * 15.24
+    assert abs(float(res["1.85"]) - 28.15) < 0.01 * 28.15
+    # the thesis' orders hold wherever all three states exist (figure 4-7; figure 4-8
+    # with a dry track's zeta_b 0.01)
+    for label in ("fig. 4-7 balanced", "fig. 4-8 rotating, zeta_b 0.01"):
+        have, holds = (int(v) for v in re.search(
+            label + r": all three at (\d+) of \d+ speeds, the thesis' order holds at (\d+)",
+            stdout).groups())
+        assert have >= 3 and holds == have, (label, have, holds)
+    pair = re.search(r"eta 1.85 > 0.99 > no balls at (\d+) of the (\d+) speeds", stdout)
+    assert pair is not None and int(pair.group(1)) >= 1
+    return [out / "single_ball.png"]
+
+
 def bearing_balancer(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     # The plain film holds nothing at the centre (unstable at every speed, both film
     # models); grooves on the journal (depth > 0) open a stable speed window, depth 0 none.
@@ -167,6 +188,7 @@ CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
     "transients.py": transients,
     "seed004.py": seed004,
     "thesis_ch4.py": thesis_ch4,
+    "single_ball.py": single_ball,
     "bearing_balancer.py": bearing_balancer,
 }
 

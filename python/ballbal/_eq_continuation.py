@@ -8,11 +8,12 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 import polars as pl
 
 from ballbal import _check, _native
-from ballbal._branch import Branch, Continuation, Curve, parameter_range
-from ballbal.analysis import Equilibrium, _equilibrium, equilibria
+from ballbal._branch import Branch, Continuation, Curve, model_at, parameter_range
+from ballbal.analysis import Equilibrium, _equilibrium, capacities, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
 
 __all__ = ["equilibrium_branch", "equilibrium_curve", "switch_equilibrium"]
@@ -28,6 +29,13 @@ def _options(options: Any) -> Continuation:
     if not isinstance(options, Continuation):
         raise ParameterTypeError("options", f"must be a Continuation, got {type(options).__name__}")
     return options
+
+
+def _eta_at(model: Any, parameter: str, value: float) -> np.ndarray:
+    """The balls' capacities at a branch point (they vary only along an ``eta`` branch)."""
+    if parameter.startswith("eta"):
+        return capacities(model_at(model, parameter, value))
+    return capacities(model)
 
 
 def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, float],
@@ -67,8 +75,9 @@ def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, flo
                "omega": pl.Float64, "test": pl.Float64, "row": pl.Int64})
     return Branch(
         kind="equilibrium", parameter=parameter, table=table, events=events, stop=d["stop"],
-        solutions=tuple(_equilibrium(p) for p in pts),
-        event_solutions=tuple(_equilibrium(e) for e in evs),
+        solutions=tuple(_equilibrium(p, _eta_at(model, parameter, p["p"])) for p in pts),
+        event_solutions=tuple(_equilibrium(e, _eta_at(model, parameter, e["p"]))
+                              for e in evs),
         meta={"model": model, "range": rng, "options": options,
               "event_x": [list(e["x"]) for e in evs],
               "event_tangent": [list(e["tangent"]) for e in evs]},
@@ -100,7 +109,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
         if not found:
             raise ParameterError("start", f"the model has no {start!r} equilibrium",
                                  allowed="perfect_balance, balanced, together, opposite, "
-                                         "unbalanced")
+                                         "unbalanced, partial_balance, imbalance_side")
         start = found[0]
     if not isinstance(start, Equilibrium):
         raise ParameterTypeError("start", "must be an Equilibrium or a kind name")

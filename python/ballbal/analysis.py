@@ -164,6 +164,11 @@ class Equilibrium:
     #: False when the search's start budget (``max(600, 25 n)`` starts from 5 balls on)
     #: cut it short: other equilibria may exist.
     exhaustive: bool = True
+    #: ``|1 + sum eta_i exp(i b_i)|``: the imbalance the disk and its balls leave
+    #: together, in units of the disk's ``m_d e`` (0 at a perfect balance; ``|1 - eta|``
+    #: for one ball straight opposite the imbalance). ``ballbal.data.residual_imbalance``
+    #: gives it in mass x length. NaN only where the balls' capacities were not known.
+    residual_imbalance: float = float("nan")
 
 
 @_check.renamed_model("balancer")
@@ -175,6 +180,16 @@ def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
     track order (``b_1 <= ... <= b_n <= b_1 + 2 pi``: balls cannot pass each other),
     ``b_1`` in ``(-pi, pi]``, and identical balls relabelled round the ring count once;
     the one that continues the perfect balance (:func:`balanced_state`) is ``"balanced"``.
+
+    Kinds: ``perfect_balance`` (the disk at rest on the axis), ``together``, ``opposite``
+    (two balls), ``unbalanced``; for one ball (closed forms, as for two equal balls):
+    ``partial_balance`` (the ball on the far side of the track from the imbalance,
+    ``cos b < 0``: it cancels part of it; near ``Omega = 1`` both states can be on that
+    side), ``imbalance_side`` (``cos b >= 0``: it adds to it) and, with ``eta = 1``
+    exactly, ``perfect_balance`` at ``b = pi``. A ball heavier than the imbalance has no
+    equilibrium near the resonance (``eta Omega > sqrt(A^2 + Omega^2)``, ``A = (1 -
+    Omega^2) / (2 zeta)``): the list is empty and the ball keeps moving. Every
+    equilibrium carries its ``residual_imbalance``.
     Scenes with a ramp, gravity or an impulse have none (an error naming the effect).
 
     From three balls on the perfect balances form a family (``neutral > 0``), reported
@@ -182,15 +197,34 @@ def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
     five on the search tries ``max(600, 25 n)`` starts (balls together, then a
     low-discrepancy sequence) and says so with ``exhaustive=False``."""
     _check.model("model", model)
-    return [_equilibrium(d) for d in _native.equilibria(model)]
+    eta = capacities(model)
+    return [_equilibrium(d, eta) for d in _native.equilibria(model)]
 
 
-def _equilibrium(d: dict[str, Any]) -> Equilibrium:
+def capacities(model: Balancer | Scene) -> np.ndarray:
+    """The balls' balancing capacities ``eta_i`` of a balancer or a scene."""
+    bal = model.balancer if isinstance(model, Scene) else model
+    return np.asarray(bal.eta, dtype=float)
+
+
+def residual_imbalance(eta: Sequence[float] | np.ndarray,
+                       angles: Sequence[float] | np.ndarray) -> float:
+    """``|1 + sum eta_i exp(i b_i)|``: the disk's and balls' imbalance together, in units
+    of the disk's ``m_d e``, for balls at angles ``b_i`` from the disk's mass centre."""
+    e = np.asarray(eta, dtype=float)
+    b = np.asarray(angles, dtype=float)
+    return float(abs(1.0 + np.sum(e * np.exp(1j * b))))
+
+
+def _equilibrium(d: dict[str, Any], eta: np.ndarray | None = None) -> Equilibrium:
+    q = d["q"]
+    ri = float("nan") if eta is None else residual_imbalance(eta, q[len(q) - len(eta):])
     return Equilibrium(
-        kind=d["kind"], q=d["q"], residual=d["residual"],
+        kind=d["kind"], q=q, residual=d["residual"],
         eigenvalues=d["eig_re"] + 1j * d["eig_im"], stability_index=d["index"],
         stability=d["stability"], neutral=d["neutral"], routh_hurwitz=d["routh_hurwitz"],
         char_poly=d["char_poly"], exhaustive=d.get("exhaustive", True),
+        residual_imbalance=ri,
     )
 
 
@@ -359,7 +393,10 @@ def periodic(
     (:class:`~ballbal.GuessSearch`), ``max_closure, max_tail``.
 
     Without ``guess`` the start comes from a time simulation (``settle`` time units for
-    transients, then up to ``window`` to measure the period). ``guess`` may be a previous
+    transients, then up to ``window`` to measure the period). One ball, when no start at
+    rest in the ground frame finds the pattern, is also started whirling with the support
+    at its natural frequency (its rotating motion past a few tenths above the resonance
+    is reached from rest only from a sliver of ball angles). ``guess`` may be a previous
     solution (any N; it is truncated or padded) or ``(omega, coeffs)``. ``rtol, atol`` are
     the RK45 tolerances of the monodromy integration, ``max_steps`` its step budget (a
     longer integration ends in ``floquet_error`` and an undetermined verdict); a verdict

@@ -10,7 +10,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from .analysis import Equilibrium, _equilibrium
+from .analysis import Equilibrium, _equilibrium, capacities
 from .exceptions import ParameterError
 from .model import Balancer
 from .scene import Scene
@@ -26,7 +26,7 @@ def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
     spring stiffness. Needs an autonomous scene."""
     _check.model("model", model)
     d = _native.balanced_states([model])[0]
-    return None if d is None else _equilibrium(d)
+    return None if d is None else _equilibrium(d, capacities(model))
 
 
 def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -> pl.DataFrame:

@@ -17,6 +17,7 @@ Lab helpers: :func:`imbalance` (``m_d e``), :func:`eta` (``m_b r_t / (m_d e)``),
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -31,11 +32,16 @@ from .model import zeta_from_log_decrement
 __all__ = [
     "experiments", "peaks", "transitions", "imbalance", "eta", "rpm_to_ratio",
     "ratio_to_rpm", "leaf_spring_stiffness", "log_decrement", "LogDecrement",
-    "NATURAL_FREQUENCY_RPM",
+    "NATURAL_FREQUENCY_RPM", "MODEL_PARAMETERS", "residual_imbalance", "single_ball",
 ]
 
 #: The rig's measured first natural frequency without balls (section 4-1-2), rpm.
 NATURAL_FREQUENCY_RPM = 513.0
+
+#: The model parameters the thesis compares with its rig (section 4-4-2, fig. 4-13: its
+#: MIHB "at mu 0.2, zeta 0.05, zeta_b 0.05, delta 50" with f_n = 513 rpm). The rig's own
+#: disk mass and support damping without pads are not stated.
+MODEL_PARAMETERS: dict[str, float] = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 
 # (quantity, value, unit, case, source, notes)
 _ROWS: list[tuple[str, float, str, str, str, str]] = [
@@ -74,6 +80,18 @@ _ROWS: list[tuple[str, float, str, str, str, str]] = [
     ("residual_imbalance", 28.15, "g mm", "single ball eta 1.85", "4-3",
      "stated (over-balance); 4.09 x 15 - 33.12 = 28.23"),
     ("speed_step", 25.0, "rpm", "single ball", "4-3", "from 525 rpm up to 1000 rpm"),
+    ("speed_min", 513.0, "rpm", "single ball", "4-3", "the first record, at the natural "
+     "frequency; then 525 rpm"),
+    ("speed_max", 1000.0, "rpm", "single ball", "4-3", ""),
+    ("vibration_rank_balanced", 1.0, "", "single ball eta 1.85", "4-3, fig. 4-7",
+     "largest of the three at the balanced equilibrium (1 = largest); no balls larger still"),
+    ("vibration_rank_balanced", 2.0, "", "single ball eta 0.54", "4-3, fig. 4-7", ""),
+    ("vibration_rank_balanced", 3.0, "", "single ball eta 0.99", "4-3, fig. 4-7",
+     "close to the 2 mV baseline of no imbalance"),
+    ("vibration_rank_rotating", 1.0, "", "single ball eta 1.85", "4-3, fig. 4-8",
+     "in the rotating periodic motion; all three above no balls"),
+    ("vibration_rank_rotating", 2.0, "", "single ball eta 0.99", "4-3, fig. 4-8", ""),
+    ("vibration_rank_rotating", 3.0, "", "single ball eta 0.54", "4-3, fig. 4-8", ""),
     # 4-4: two balls
     ("ball_mass", 2.05, "g", "two balls eta 0.66", "4-4-1", "ball radius 4 mm, track 16 mm"),
     ("track_radius", 16.0, "mm", "two balls eta 0.66", "4-4-1", ""),
@@ -223,6 +241,51 @@ def eta(ball_mass: float, track_radius: float, imbalance: float) -> float:
     rt = _check.real("track_radius", track_radius, 0.0, lo_open=True)
     u = _check.real("imbalance", imbalance, 0.0, lo_open=True)
     return mb * rt / u
+
+
+def residual_imbalance(imbalance: float, eta: Any, angles: Any = math.pi) -> float:
+    """The imbalance ``m_d e |1 + sum eta_i exp(i b_i)|`` the disk and its balls leave
+    (units of ``imbalance``): ``eta`` one capacity or several, ``angles`` the balls' angles
+    from the disk's mass centre (default: straight opposite it, ``pi``). ``eta`` may also
+    be an :class:`~ballbal.Equilibrium`, whose own ``residual_imbalance`` is scaled.
+    The thesis' section 4-3: 33.12 g mm with one ball of eta 0.54 opposite leaves
+    15.24 g mm, with eta 1.85 (over-balance) 28.15 g mm."""
+    from .analysis import Equilibrium
+    from .analysis import residual_imbalance as relative
+
+    u = _check.real("imbalance", imbalance, 0.0, lo_open=True)
+    if isinstance(eta, Equilibrium):
+        return u * eta.residual_imbalance
+    e = np.asarray(_check.reals("eta", eta))
+    if not np.all(np.isfinite(e) & (e >= 0)):
+        raise ParameterError("eta", "must be finite and >= 0", allowed=">= 0", value=eta)
+    b = np.asarray(_check.reals("angles", angles))
+    if b.size not in (1, e.size) or not np.all(np.isfinite(b)):
+        raise ParameterError("angles", f"must be one finite angle or {e.size}",
+                             allowed="finite angles (rad)", value=angles)
+    return u * relative(e, np.broadcast_to(b, e.shape))
+
+
+def single_ball() -> pl.DataFrame:
+    """The single-ball experiment of section 4-3, one row per ball: ``ball_mass`` (g),
+    ``track_radius`` (mm), ``eta`` from them and the stated imbalance 33.12 g mm,
+    ``eta_stated`` (table 4-2), the stated ``residual_imbalance`` (g mm, null where the
+    text gives none) and the vibration ranks of figures 4-7 (balanced equilibrium) and
+    4-8 (rotating motion), 1 = largest."""
+    t = experiments().filter(pl.col("case").str.starts_with("single ball eta"))
+    rows = []
+    for case in sorted(set(t["case"].to_list())):
+        v = dict(t.filter(pl.col("case") == case).select("quantity", "value").iter_rows())
+        mb, rt = v["ball_mass"], v["track_radius"]
+        rows.append({"case": case, "ball_mass": mb, "track_radius": rt,
+                     "eta": eta(mb, rt, 33.12), "eta_stated": v["eta"],
+                     "residual_imbalance": v.get("residual_imbalance"),
+                     "rank_balanced": int(v["vibration_rank_balanced"]),
+                     "rank_rotating": int(v["vibration_rank_rotating"])})
+    return pl.DataFrame(rows, schema={
+        "case": pl.String, "ball_mass": pl.Float64, "track_radius": pl.Float64,
+        "eta": pl.Float64, "eta_stated": pl.Float64, "residual_imbalance": pl.Float64,
+        "rank_balanced": pl.Int64, "rank_rotating": pl.Int64}).sort("eta")
 
 
 def rpm_to_ratio(rpm: Any, natural_frequency_rpm: float = NATURAL_FREQUENCY_RPM) -> Any:

@@ -13,7 +13,7 @@ use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{
-    closure_error, parse_pattern, parse_windings, periodic_wound, require_autonomous,
+    closure_error, parse_pattern, parse_windings, periodic_searched, require_autonomous,
     PeriodicOptions,
 };
 use ballbal_core::scan::{Family, ScanRow, ScanSpec};
@@ -268,7 +268,7 @@ pub fn periodic<'py>(
             stiff_guess(d, guess.is_none(), &opts)?;
             Ok(match &guess {
                 None => periodic_discover(d, &ball_winding, homotopy.as_deref(), &opts),
-                Some(g) => (periodic_wound(d, &ball_winding, Some(g), &opts), source_of(true)),
+                Some(g) => (periodic_searched(d, &ball_winding, Some(g), &opts), source_of(true)),
             })
         })
     })?;

@@ -52,11 +52,14 @@ fn kind_from(name: &str) -> Result<EquilibriumKind> {
         "together" => EquilibriumKind::Together,
         "opposite" => EquilibriumKind::Opposite,
         "unbalanced" => EquilibriumKind::Unbalanced,
+        "partial_balance" => EquilibriumKind::PartialBalance,
+        "imbalance_side" => EquilibriumKind::ImbalanceSide,
         other => {
             return Err(Error::param_range(
                 "start",
                 format!("unknown equilibrium kind {other:?}"),
-                "perfect_balance, balanced, together, opposite, unbalanced",
+                "perfect_balance, balanced, together, opposite, unbalanced, partial_balance, \
+                 imbalance_side",
             ))
         }
     })

@@ -10,13 +10,13 @@
 use std::f64::consts::PI;
 
 use crate::analysis::homotopy::{homotopy_walks, source_of};
-use crate::analysis::periodic::{certify, finish, periodic_wound, Periodic, PeriodicOptions};
+use crate::analysis::periodic::{certify, finish, periodic_searched, Periodic, PeriodicOptions};
 use crate::hb::{solve, HbSolution, Status};
 use crate::numerics::floquet::Stability;
 use crate::numerics::problem::Parametric;
 use crate::Dynamics;
 
-/// `periodic()` without a guess: the simulated starts; if they reach no orbit of the
+/// `periodic()` without a guess: the simulated starts ([`periodic_searched`]); if they reach no orbit of the
 /// pattern, the `homotopy` starts (`(parameter, value)`, as [`homotopy_walks`] takes
 /// them); then, for one-turn patterns, the constructed starts. Returns the result and
 /// how it was found (the `guess_source` results report); when nothing converges, the
@@ -27,7 +27,7 @@ pub fn periodic_discover<D: Parametric>(
     homotopy: Option<&[(String, f64)]>,
     opts: &PeriodicOptions,
 ) -> (Periodic, String) {
-    let first = periodic_wound(p, ball_winding, None, opts);
+    let first = periodic_searched(p, ball_winding, None, opts);
     if first.sol.status == Status::Converged {
         return (first, source_of(false));
     }

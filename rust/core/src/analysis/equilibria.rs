@@ -43,6 +43,12 @@ pub enum EquilibriumKind {
     Together,
     /// Two balls half a turn apart.
     Opposite,
+    /// One ball on the far side of the track from the disk's imbalance (`cos b < 0`): it
+    /// cancels part of the imbalance, all of it only when `eta = 1` (then the state is
+    /// the [`PerfectBalance`](Self::PerfectBalance)).
+    PartialBalance,
+    /// One ball on the imbalance's side of the track (`cos b >= 0`): it adds to it.
+    ImbalanceSide,
     Unbalanced,
 }
 
@@ -54,6 +60,8 @@ impl EquilibriumKind {
             EquilibriumKind::Balanced => "balanced",
             EquilibriumKind::Together => "together",
             EquilibriumKind::Opposite => "opposite",
+            EquilibriumKind::PartialBalance => "partial_balance",
+            EquilibriumKind::ImbalanceSide => "imbalance_side",
             EquilibriumKind::Unbalanced => "unbalanced",
         }
     }
@@ -62,9 +70,9 @@ impl EquilibriumKind {
     fn rank(&self) -> u8 {
         match self {
             EquilibriumKind::PerfectBalance | EquilibriumKind::Balanced => 0,
-            EquilibriumKind::Together => 1,
+            EquilibriumKind::Together | EquilibriumKind::PartialBalance => 1,
             EquilibriumKind::Opposite => 2,
-            EquilibriumKind::Unbalanced => 3,
+            EquilibriumKind::Unbalanced | EquilibriumKind::ImbalanceSide => 3,
         }
     }
 }
@@ -258,6 +266,9 @@ fn classify(q: &[f64], o: usize) -> EquilibriumKind {
     if q[..o].iter().all(|v| v.abs() < 1e-6) {
         return EquilibriumKind::PerfectBalance;
     }
+    if q.len() == o + 1 {
+        return one_ball_kind(q[o]);
+    }
     if q.len() > o + 1 && q[o + 1..].iter().all(|&b| wrap(b - q[o]).abs() < 1e-7) {
         return EquilibriumKind::Together;
     }
@@ -268,6 +279,58 @@ fn classify(q: &[f64], o: usize) -> EquilibriumKind {
         }
     }
     EquilibriumKind::Unbalanced
+}
+
+/// The kind of a one-ball equilibrium off the axis, by the side of the track its ball
+/// is on (the disk's imbalance lies at `b = 0`).
+pub fn one_ball_kind(b: f64) -> EquilibriumKind {
+    if b.cos() < 0.0 {
+        EquilibriumKind::PartialBalance
+    } else {
+        EquilibriumKind::ImbalanceSide
+    }
+}
+
+/// `|1 + sum eta_i exp(i b_i)|`: the imbalance the disk and balls leave together, in
+/// units of the disk's own `m_d e` (0 at a perfect balance).
+pub fn residual_imbalance(eta: &[f64], balls: &[f64]) -> f64 {
+    let (re, im) = eta.iter().zip(balls).fold((1.0, 0.0), |(re, im), (e, b)| {
+        (re + e * b.cos(), im + e * b.sin())
+    });
+    re.hypot(im)
+}
+
+/// Closed-form equilibria of one ball (`zeta > 0`, `Omega > 0`). At rest the disk centre
+/// sits on the ball's line, `x + i y = r exp(i b)`, and `(1 - Omega^2 + 2 i zeta Omega)
+/// r = mu Omega^2 (exp(-i b) + eta)`: `r = -mu Omega sin b / (2 zeta)` and
+/// `A sin b + Omega cos b = -eta Omega`, `A = (1 - Omega^2) / (2 zeta)` (the two-ball
+/// together equation with `2 eta` replaced by `eta`). Two roots where `eta Omega <=
+/// sqrt(A^2 + Omega^2)`, none otherwise (a heavy ball near the resonance must move). For
+/// `eta = 1` one root is `b = pi` exactly with the disk on the axis: a perfect balance.
+fn closed_form_one(p: &Planar) -> Vec<(Vec<f64>, EquilibriumKind)> {
+    let (eta, om, z, mu) = (p.eta[0], p.omega_s, p.zeta, p.mu);
+    let a = (1.0 - om * om) / (2.0 * z);
+    let amp = a.hypot(om);
+    let phi = om.atan2(a);
+    let rhs = -eta * om / amp;
+    if rhs.abs() > 1.0 {
+        return vec![];
+    }
+    let s = rhs.asin();
+    let mut roots = vec![wrap(s - phi), wrap(PI - s - phi)];
+    if wrap(roots[0] - roots[1]).abs() < 1e-12 {
+        roots.pop();
+    }
+    roots
+        .into_iter()
+        .map(|b| {
+            if eta == 1.0 && (b.abs() - PI).abs() < 1e-9 {
+                return (vec![0.0, 0.0, PI], EquilibriumKind::PerfectBalance);
+            }
+            let r = -mu * om * b.sin() / (2.0 * z);
+            (vec![r * b.cos(), r * b.sin(), b], one_ball_kind(b))
+        })
+        .collect()
 }
 
 /// Closed-form equilibria of two equal balls.
@@ -389,6 +452,9 @@ pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
     let n = p.n_balls();
     if n == 2 && equal_balls(p) && p.zeta > 0.0 {
         return sorted_analysed(p, closed_form_two_equal(p), true);
+    }
+    if n == 1 && p.zeta > 0.0 && p.omega_s > 0.0 {
+        return sorted_analysed(p, closed_form_one(p), true);
     }
     equilibria_of(p, equal_balls(p), true)
 }
@@ -856,6 +922,79 @@ mod tests {
             q.iter().zip(&pb.q).all(|(a, b)| (a - b).abs() < 1e-10),
             "{q:?}"
         );
+    }
+
+    fn one(om: f64, eta: f64) -> Planar {
+        Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta]).unwrap()
+    }
+
+    /// One ball: the closed forms are equilibria, Newton from every start of the lattice
+    /// finds no other, each is named by the side of the track its ball is on, and with
+    /// `eta = 1` the ball opposite the imbalance balances the disk exactly.
+    #[test]
+    fn one_ball_closed_forms_kinds_and_perfect_balance() {
+        let mut seen: Vec<EquilibriumKind> = vec![];
+        for (om, eta) in [
+            (0.8, 0.54),
+            (1.5, 0.54),
+            (1.5, 0.99),
+            (1.2, 1.85),
+            (1.5, 1.0),
+        ] {
+            let p = one(om, eta);
+            let eqs = equilibria(&p);
+            assert!(
+                !eqs.is_empty() && eqs.len() <= 2,
+                "{om} {eta}: {}",
+                eqs.len()
+            );
+            for e in &eqs {
+                assert!(e.residual < 1e-13, "{} residual {}", e.kind, e.residual);
+                if !seen.contains(&e.kind) {
+                    seen.push(e.kind);
+                }
+                let b = e.q[2];
+                match e.kind {
+                    EquilibriumKind::PerfectBalance => {
+                        assert_eq!(eta, 1.0);
+                        assert!(e.q[0] == 0.0 && e.q[1] == 0.0 && b.cos() == -1.0);
+                        assert!(residual_imbalance(&p.eta, &e.q[2..]) < 1e-15);
+                    }
+                    EquilibriumKind::PartialBalance => assert!(b.cos() < 0.0),
+                    EquilibriumKind::ImbalanceSide => assert!(b.cos() >= 0.0),
+                    k => panic!("kind {k} for one ball"),
+                }
+            }
+            for q0 in starts(1, 2).0 {
+                if let Some(q) = newton_static(&p, &q0) {
+                    assert!(
+                        eqs.iter().any(|e| same_equilibrium(false, 2, &e.q, &q)),
+                        "{om} {eta}: numeric equilibrium {q:?} missing from closed forms"
+                    );
+                }
+            }
+        }
+        assert_eq!(seen.len(), 3);
+        // Near the resonance a ball heavier than the imbalance has nowhere to rest:
+        // eta Omega > sqrt(A^2 + Omega^2), and Newton agrees.
+        let p = one(1.0, 1.85);
+        assert!(equilibria(&p).is_empty());
+        assert!(starts(1, 2)
+            .0
+            .iter()
+            .all(|q0| newton_static(&p, q0).is_none()));
+    }
+
+    #[test]
+    fn residual_imbalance_closed_form() {
+        // a ball straight opposite leaves |1 - eta|, on the imbalance 1 + eta
+        assert!((residual_imbalance(&[0.54], &[PI]) - 0.46).abs() < 1e-15);
+        assert!((residual_imbalance(&[1.85], &[0.0]) - 2.85).abs() < 1e-15);
+        // two equal balls at the perfect balance's angles cancel it
+        let b = (-1.0 / (2.0 * 0.8f64)).acos();
+        assert!(residual_imbalance(&[0.8, 0.8], &[b, -b]) < 1e-15);
+        // at right angles: sqrt((1 + 0)^2 + eta^2)
+        assert!((residual_imbalance(&[0.75], &[PI / 2.0]) - 1.25).abs() < 1e-15);
     }
 
     #[test]

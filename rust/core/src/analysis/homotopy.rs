@@ -5,7 +5,7 @@
 //! predictor, Newton–IHB corrector, certified at every step, the step halved on
 //! failure).
 
-use crate::analysis::periodic::{certify, finish, periodic_wound, Periodic, PeriodicOptions};
+use crate::analysis::periodic::{certify, finish, periodic_searched, Periodic, PeriodicOptions};
 use crate::hb::{solve, HbSolution, Status};
 use crate::numerics::problem::Parametric;
 
@@ -92,7 +92,7 @@ pub fn homotopy_walks<D: Parametric>(
         let Ok(m0) = p.with_param(name, *from) else {
             continue;
         };
-        let r0 = periodic_wound(&m0, ball_winding, None, &quiet);
+        let r0 = periodic_searched(&m0, ball_winding, None, &quiet);
         if r0.sol.status != Status::Converged {
             continue;
         }
@@ -109,6 +109,7 @@ pub fn homotopy_walks<D: Parametric>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::periodic::periodic_wound;
     use crate::Planar;
 
     #[test]

@@ -7,6 +7,7 @@ use crate::error::check_range;
 use crate::floquet::{floquet, hill_multipliers, judge, Floquet, FloquetOptions, Stability};
 use crate::hb::{defect_closure, solve, HbOptions, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
+use crate::numerics::problem::Parametric;
 use crate::ode::{solve_at, Options};
 use std::f64::consts::PI;
 
@@ -354,6 +355,91 @@ pub fn periodic_wound<D: Dynamics + ?Sized>(
         }
     };
     finish(p, sol, opts)
+}
+
+/// [`periodic_wound`], and for one ball, when the usual starts find no orbit, also from
+/// [`whirl_starts`]: the starts of `periodic()` (the Python facade) and of homotopy.
+/// For two or more balls, or with a guess, it is [`periodic_wound`] itself.
+pub fn periodic_searched<D: Parametric>(
+    p: &D,
+    ball_winding: &[f64],
+    guess: Option<&HbSolution>,
+    opts: &PeriodicOptions,
+) -> Periodic {
+    let first = periodic_wound(p, ball_winding, guess, opts);
+    if guess.is_some()
+        || first.sol.status == Status::Converged
+        || ball_winding.iter().any(|w| w.abs() > 1.0)
+    {
+        return first;
+    }
+    let rotating: Vec<bool> = ball_winding.iter().map(|w| *w != 0.0).collect();
+    for y0 in whirl_starts(p) {
+        if crate::cancel::cancelled() {
+            break;
+        }
+        let Some(g) = guess_from_state(p, &y0, Some(&rotating), opts.hb.n_harm, &opts.guess) else {
+            continue;
+        };
+        let mut s = solve(p, &g, &opts.hb);
+        if opts.auto.is_none() {
+            certify(p, &mut s, opts);
+        }
+        if s.status == Status::Converged {
+            return finish(p, s, opts);
+        }
+    }
+    first
+}
+
+/// Starts for one ball whirling with the support at its natural frequency, which the
+/// starts at rest in the ground frame ([`initial_states`]) miss: past a few tenths above
+/// the resonance a single ball's rotating motion (its ground-frame rate locked just
+/// below the natural frequency, the disk whirling with it at resonant amplitude) is
+/// stable but reached from rest only from a sliver of ball angles (none of the 16 at
+/// the thesis' rig with `eta = 1.85`, `Omega` 1.5 to 1.7, or `eta = 0.99`, `Omega` 1.35).
+/// Each start puts the ball at angle `beta` turning at ground rate `s` (1 and 0.95,
+/// four angles) and the disk on the linear response to the ball and the imbalance,
+/// `Z = mu eta s^2 e^(i beta) / (1 - s^2 + 2 i zeta s) + mu Omega^2 / (1 - Omega^2 + 2 i
+/// zeta Omega)` (ground frame at `t = 0`). Empty for other ball counts and for models
+/// without `mu`, `zeta` and `eta`.
+pub fn whirl_starts<D: Parametric>(p: &D) -> Vec<Vec<f64>> {
+    use nalgebra::Complex;
+    let o = p.first_ball();
+    let d = p.ndof();
+    if d != o + 1 {
+        return vec![];
+    }
+    let (Ok(mu), Ok(z), Ok(eta)) = (
+        p.param_value("mu"),
+        p.param_value("zeta"),
+        p.param_value("eta"),
+    ) else {
+        return vec![];
+    };
+    let om = p.base_spin();
+    let i = Complex::new(0.0, 1.0);
+    let zi = mu * om * om / (1.0 - om * om + 2.0 * i * z * om);
+    let mut out = vec![];
+    for s in [1.0, 0.95] {
+        for k in 0..4 {
+            let beta = -PI + (k as f64 + 0.1) * PI / 2.0;
+            let zb =
+                mu * eta * s * s * Complex::from_polar(1.0, beta) / (1.0 - s * s + 2.0 * i * z * s);
+            let zz = zi + zb;
+            // rotating-frame velocity: the ground velocity less the frame's turn
+            let dz = i * om * zi + i * s * zb - i * om * zz;
+            let mut y = vec![0.0; 2 * d];
+            y[0] = zz.re;
+            y[1] = zz.im;
+            y[o] = beta;
+            y[d] = dz.re;
+            y[d + 1] = dz.im;
+            y[d + o] = s - om;
+            out.push(y);
+        }
+    }
+    out
 }
 
 /// The simulated search of [`periodic_wound`] for windings of more than one turn.
@@ -714,6 +800,31 @@ mod tests {
 
     fn thesis(om: f64, eta: f64) -> Planar {
         Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap()
+    }
+
+    /// The thesis' heaviest single ball (eta 1.85) at Omega 1.6: its rotating motion is
+    /// stable, but no start at rest in the ground frame reaches it; a start whirling
+    /// with the support does. Two balls get no such starts.
+    #[test]
+    fn one_ball_rotating_motion_from_whirl_starts() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.6, &[1.85]).unwrap();
+        let opts = PeriodicOptions {
+            floquet: Some(FloquetOptions::default()),
+            ..PeriodicOptions::default()
+        };
+        let plain = periodic_wound(&p, &[-1.0], None, &opts);
+        assert_eq!(plain.sol.status, Status::NoGuess);
+        let r = periodic_searched(&p, &[-1.0], None, &opts);
+        assert_eq!(r.sol.status, Status::Converged);
+        assert_eq!(
+            r.floquet.as_ref().map(|f| f.stability),
+            Some(Stability::Stable)
+        );
+        // the ball's ground-frame rate Omega - omega sits just below the natural frequency
+        let ground = 1.6 - r.sol.omega;
+        assert!(ground > 0.9 && ground < 1.0, "{ground}");
+        assert_eq!(whirl_starts(&p).len(), 8);
+        assert!(whirl_starts(&thesis(1.6, 1.0)).is_empty());
     }
 
     /// The reproduction: R-R continued at N = 8 from Omega 1 into the branch's

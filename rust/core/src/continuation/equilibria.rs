@@ -361,6 +361,9 @@ pub fn kind_of(q: &[f64], o: usize, start: EquilibriumKind) -> EquilibriumKind {
     if n == 2 && (wrap(q[o] - q[o + 1]).abs() - PI).abs() < 1e-7 {
         return EquilibriumKind::Opposite;
     }
+    if n == 1 {
+        return crate::analysis::equilibria::one_ball_kind(q[o]);
+    }
     EquilibriumKind::Unbalanced
 }
 
