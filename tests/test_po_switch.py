@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.optimize import minimize_scalar
 
 import ballbal as bb
 from ballbal.analysis import equilibria, periodic
@@ -248,3 +249,32 @@ def test_homotopy_keeps_results_simulation_finds_and_refuses_bad_starts() -> Non
         with pytest.raises(ParameterError) as e:
             periodic(b, "R-R", homotopy=bad)  # type: ignore[arg-type]
         assert e.value.parameter == "homotopy"
+
+
+def test_constructed_starts_find_the_thesis_ro_orbit_simulation_misses() -> None:
+    # Table 4-7's R-O row (zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.7; omega 0.30 in the
+    # thesis): every start at rest settles to the perfect balance, and only about one
+    # random start in sixty (with a knocked support) reaches the orbit.
+    b = bb.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50, Omega=1.3, eta=[0.7, 0.7])
+    s = periodic(b, "R-O", N=8)
+    assert s.converged and s.stability == "stable"
+    assert s.info["guess_source"].startswith("constructed")
+    assert abs(s.omega - 0.30) < 0.01
+    # Shooting (scipy) from the series' state converges to the same period.
+    y, T = shoot(b, s.state(0.0), s.period, s.winding, 2)
+    assert abs(T - s.period) < 1e-6 * T
+    assert np.max(np.abs(y - s.state(0.0))) < 1e-5
+    # Started off the orbit, a simulation comes back to it (to the orbit, not to the
+    # phase it started at: a kick along the orbit is never undone).
+    n = 40
+    y0 = s.state(0.0) + 1e-3 * np.array([1, 0, 0, -1, 0, 0, 0, 0])
+    df = bb.simulate(b, y0, [0.0, n * s.period])
+    end = np.asarray(df.drop("t", "theta", "X", "Y").row(-1))
+    shift = np.zeros(8)
+    shift[:4] = 2 * np.pi * n * s.winding
+    # The kick moves the phase by far less than a time unit: the nearest point of the
+    # orbit is near t = 0 (on either side).
+    gap = minimize_scalar(lambda t: float(np.sum((s.state(t) - (end - shift)) ** 2)),
+                          bounds=(-1.0, 1.0), method="bounded", options={"xatol": 1e-10})
+    assert np.sqrt(gap.fun) < 1e-6
+    assert np.max(np.abs(s.state(0.0) - (end - shift))) > 1e-4  # it did move along
