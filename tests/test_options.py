@@ -89,8 +89,11 @@ def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
            "atol": 1e-9, "margin": 1e-6, "max_steps": 20_000, "settle": 1000.0,
            "window": 2000.0, "guess_rtol": 1e-5, "seeds": 4, "starts": 4, "max_tail": 0.25,
            "max_closure": 6.0, "max_trivial": 0.1}
-    got = _meta_options(ScanOptions())
+    # They were computed with RK45 monodromies: only that method resumes them.
+    rk45 = dataclasses.replace(ScanOptions().floquet, method="rk45")
+    got = _meta_options(ScanOptions(floquet=rk45))
     assert json.dumps(got) == json.dumps(old)
+    assert _meta_options(ScanOptions()) == {**old, "floquet_method": "magnus"}
     hb = dataclasses.replace(ScanOptions().harmonic_balance, N="auto")
     auto = _meta_options(ScanOptions(harmonic_balance=hb))
     assert (auto["N"], auto["auto"]) == (3, 1e-4)  # the scan's default target

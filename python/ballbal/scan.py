@@ -167,9 +167,9 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
     """The options as ``meta.json`` records them (the scan's fingerprint): the flat
     keywords of before the option classes, in their order, so that directories written
     then resume; ``guess_atol`` only where it is not ``guess_rtol / 1000`` (what those
-    keywords implied). The Floquet method is always recorded: directories written before
-    it was an option hold RK45 multipliers and must not be completed with another
-    method's."""
+    keywords implied). The Floquet method only where it is not RK45: directories written
+    before it was an option hold RK45 multipliers; they resume with
+    ``floquet_method="rk45"`` and are refused with any other method."""
     h, f, g = o.harmonic_balance, o.floquet, o.guess
     d: dict[str, Any] = {
         "N": h._start, "auto": h._auto_target, "N_max": h.N_max, "hill": f.hill,
@@ -178,8 +178,9 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
         "max_steps": f.max_steps, "settle": g.settle, "window": g.window,
         "guess_rtol": g.rtol, "seeds": g.seeds, "starts": g.starts, "max_tail": o.max_tail,
         "max_closure": o.max_closure, "max_trivial": f.max_trivial,
-        "floquet_method": f.method,
     }
+    if f.method != "rk45":
+        d["floquet_method"] = f.method
     if g.atol != g.rtol * 1e-3:
         d["guess_atol"] = g.atol
     return d
