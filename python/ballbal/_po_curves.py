@@ -14,6 +14,7 @@ import polars as pl
 
 from . import _check, _native
 from ._branch import Branch, Continuation, Curve, model_at, parameter_range
+from ._po_continuation import _multipliers
 from .analysis import _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
@@ -22,14 +23,6 @@ __all__ = ["periodic_curve"]
 
 #: Event types with a curve.
 _KINDS = ("LP", "BP", "PD")
-
-
-def _multipliers(d: dict[str, Any]) -> tuple[list[float] | None, list[float] | None]:
-    if d["mult_re"] is not None:
-        return list(d["mult_re"]), list(d["mult_im"])
-    if "hill_re" in d:
-        return list(d["hill_re"]), list(d["hill_im"])
-    return None, None
 
 
 def periodic_curve(

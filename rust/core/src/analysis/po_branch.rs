@@ -339,22 +339,8 @@ pub fn periodic_branch<D: Parametric>(
             format!("lo <= {p0} <= hi"),
         ));
     }
-    let d = base.ndof();
-    if start.winding.len() != d
-        || start.coeffs.len() != d * (2 * start.n_harm + 1)
-        || !(start.omega > 0.0 && start.omega.is_finite())
-        || start.coeffs.iter().any(|c| !c.is_finite())
-    {
-        return Err(Error::param(
-            "start",
-            "needs a converged periodic solution of this model (omega > 0, finite coefficients)",
-        ));
-    }
-    let mut popts = opts.periodic.clone();
-    popts.auto = None;
-    let n_harm = popts.hb.n_harm;
-    let samples = popts.hb.samples.unwrap_or_else(|| default_samples(n_harm));
-    popts.hb.samples = Some(samples);
+    check_start(base, start)?;
+    let (popts, n_harm, samples) = branch_options(&opts.periodic);
     // The start at the branch's own harmonics and samples.
     let first = solve(base, start, &popts.hb);
     if first.status != Status::Converged {
@@ -614,6 +600,34 @@ fn between<P: Problem + ?Sized, D: Parametric>(
         s(x).total_cmp(&s(y))
     });
     Ok(out)
+}
+
+/// `Err` naming `start` unless it is a periodic solution of `base`'s shape with a
+/// positive frequency and finite coefficients.
+pub(crate) fn check_start<D: crate::Dynamics + ?Sized>(base: &D, start: &HbSolution) -> Result<()> {
+    let d = base.ndof();
+    if start.winding.len() != d
+        || start.coeffs.len() != d * (2 * start.n_harm + 1)
+        || !(start.omega > 0.0 && start.omega.is_finite())
+        || start.coeffs.iter().any(|c| !c.is_finite())
+    {
+        return Err(Error::param(
+            "start",
+            "needs a converged periodic solution of this model (omega > 0, finite coefficients)",
+        ));
+    }
+    Ok(())
+}
+
+/// The periodic options a branch or curve solves with: no `auto` (the harmonics stay
+/// fixed along it) and the sample count fixed; with the harmonics and samples.
+pub(crate) fn branch_options(periodic: &PeriodicOptions) -> (PeriodicOptions, usize, usize) {
+    let mut popts = periodic.clone();
+    popts.auto = None;
+    let n_harm = popts.hb.n_harm;
+    let samples = popts.hb.samples.unwrap_or_else(|| default_samples(n_harm));
+    popts.hb.samples = Some(samples);
+    (popts, n_harm, samples)
 }
 
 #[cfg(test)]

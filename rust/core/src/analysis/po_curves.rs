@@ -36,9 +36,10 @@
 //! branch-point curve) and `LPPD` (fold–flip); on a `BP` curve `LP` and `PD`; on a `PD`
 //! curve `LPPD` and `BP`.
 
+use crate::analysis::po_branch::{branch_options, check_start};
 use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::error::{Error, Result};
-use crate::hb::{default_samples, eval_series_sc, HbSolution, HbSystem, Status};
+use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
 use crate::numerics::problem::{Parametric, Problem};
 use crate::periodic::{finish, Periodic, PeriodicOptions};
 use nalgebra::{DMatrix, DVector};
@@ -965,22 +966,8 @@ pub fn periodic_curve<D: Parametric>(
             format!("lo <= {} <= hi", p0[1]),
         ));
     }
-    let d = base.ndof();
-    if start.winding.len() != d
-        || start.coeffs.len() != d * (2 * start.n_harm + 1)
-        || !(start.omega > 0.0 && start.omega.is_finite())
-        || start.coeffs.iter().any(|c| !c.is_finite())
-    {
-        return Err(Error::param(
-            "start",
-            "needs a converged periodic solution of this model (omega > 0, finite coefficients)",
-        ));
-    }
-    let mut popts = opts.periodic.clone();
-    popts.auto = None;
-    let n_harm = popts.hb.n_harm;
-    let samples = popts.hb.samples.unwrap_or_else(|| default_samples(n_harm));
-    popts.hb.samples = Some(samples);
+    check_start(base, start)?;
+    let (popts, n_harm, samples) = branch_options(&opts.periodic);
     // No Newton at fixed parameters here: at a fold its Jacobian is singular. The
     // augmented system's first correction (in x and p1) converges the start.
     let first = if start.n_harm == n_harm {
