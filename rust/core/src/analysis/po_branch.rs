@@ -176,16 +176,6 @@ pub struct PoBranch {
     pub stop: String,
 }
 
-fn stop_text(s: Option<&ArcStop>) -> String {
-    match s {
-        None | Some(ArcStop::MaxPoints) => "max_points".into(),
-        Some(ArcStop::Boundary) => "boundary".into(),
-        Some(ArcStop::StepTooSmall) => "step_too_small".into(),
-        Some(ArcStop::Finished(w)) => w.clone(),
-        Some(ArcStop::Failed(w)) => format!("failed: {w}"),
-    }
-}
-
 /// What a point needs besides its `ArcPoint`: the model family and the series' shape.
 struct Ctx<'a, D> {
     base: &'a D,
@@ -392,7 +382,7 @@ pub fn periodic_branch<D: Parametric>(
         }
         points.push(po);
     }
-    let stop = stop_text(arc.stop());
+    let stop = ArcStop::text(arc.stop());
     Ok(PoBranch {
         points,
         events,

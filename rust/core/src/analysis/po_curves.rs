@@ -37,6 +37,7 @@
 //! curve `LPPD` and `BP`.
 
 use crate::analysis::po_branch::{branch_options, check_start};
+use crate::continuation::curves::join_halves;
 use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::error::{Error, Result};
 use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
@@ -891,16 +892,6 @@ pub struct PoCurve {
     pub stop: [String; 2],
 }
 
-fn stop_text(s: Option<&ArcStop>) -> String {
-    match s {
-        None | Some(ArcStop::MaxPoints) => "max_points".into(),
-        Some(ArcStop::Boundary) => "boundary".into(),
-        Some(ArcStop::StepTooSmall) => "step_too_small".into(),
-        Some(ArcStop::Finished(w)) => w.clone(),
-        Some(ArcStop::Failed(w)) => format!("failed: {w}"),
-    }
-}
-
 /// Whether every ball of `sol` runs the same series (the together subspace).
 fn all_merged(sol: &HbSolution, o: usize) -> bool {
     let d = sol.ndof();
@@ -992,28 +983,18 @@ pub fn periodic_curve<D: Parametric>(
     let (back, sys) = half(sys, kind, &x0, p0, border.clone(), &o, &popts)?;
     o.arc.forward = true;
     let (fwd, _) = half(sys, kind, &x0, p0, border, &o, &popts)?;
-    let nb = back.points.len();
-    let mut points: Vec<PoCurvePoint> = back.points.into_iter().rev().collect();
-    points.extend(fwd.points.into_iter().skip(1));
-    let mut special: Vec<PoCodim2> = back
-        .special
-        .into_iter()
-        .rev()
-        .map(|mut c| {
-            c.row = nb - c.row;
-            c
-        })
-        .collect();
-    special.extend(fwd.special.into_iter().map(|mut c| {
-        c.row += nb - 1;
-        c
-    }));
+    let stop = [back.stop[1].clone(), fwd.stop[1].clone()];
+    let (points, special) = join_halves(
+        (back.points, back.special),
+        (fwd.points, fwd.special),
+        |c: &mut PoCodim2| &mut c.row,
+    );
     Ok(PoCurve {
         kind,
         points,
         special,
         together,
-        stop: [back.stop[1].clone(), fwd.stop[1].clone()],
+        stop,
     })
 }
 
@@ -1164,7 +1145,7 @@ fn half<'a, D: Parametric>(
         });
         prev = Some((pt, tt));
     }
-    let stop = stop_text(arc.stop());
+    let stop = ArcStop::text(arc.stop());
     if crate::cancel::cancelled() {
         return Err(Error::Cancelled);
     }

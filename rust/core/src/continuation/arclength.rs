@@ -157,6 +157,21 @@ pub enum ArcStop {
     Failed(String),
 }
 
+impl ArcStop {
+    /// How tables report the end of a run (`None`: still running, reported as
+    /// `max_points`): `"max_points"`, `"boundary"`, `"step_too_small"`, the caller's
+    /// reason, or `"failed: ..."`.
+    pub fn text(s: Option<&ArcStop>) -> String {
+        match s {
+            None | Some(ArcStop::MaxPoints) => "max_points".into(),
+            Some(ArcStop::Boundary) => "boundary".into(),
+            Some(ArcStop::StepTooSmall) => "step_too_small".into(),
+            Some(ArcStop::Finished(w)) => w.clone(),
+            Some(ArcStop::Failed(w)) => format!("failed: {w}"),
+        }
+    }
+}
+
 fn weights(opts: &ArcOptions, n1: usize) -> Vec<f64> {
     match &opts.weights {
         Some(w) if w.len() == n1 => w.clone(),

@@ -55,6 +55,34 @@ impl<T: TwoParameter + ?Sized, G: FnMut(&mut T, &[f64], [f64; 2]) -> Result<f64>
 }
 
 /// `[F; g] = 0` as a [`Problem`] in `(x, p1)` with parameter `p2`.
+/// One curve from its two halves, continued from the same start backwards and forwards:
+/// the backward points reversed, then the forward ones (the start, first of both, once);
+/// the special points in that order, their `row` (index into the half's points,
+/// reached through `row`) renumbered into the whole curve.
+pub fn join_halves<P, C>(
+    back: (Vec<P>, Vec<C>),
+    fwd: (Vec<P>, Vec<C>),
+    row: impl Fn(&mut C) -> &mut usize,
+) -> (Vec<P>, Vec<C>) {
+    let nb = back.0.len();
+    let mut points: Vec<P> = back.0.into_iter().rev().collect();
+    points.extend(fwd.0.into_iter().skip(1));
+    let mut special: Vec<C> = back
+        .1
+        .into_iter()
+        .rev()
+        .map(|mut c| {
+            *row(&mut c) = nb - *row(&mut c);
+            c
+        })
+        .collect();
+    special.extend(fwd.1.into_iter().map(|mut c| {
+        *row(&mut c) += nb - 1;
+        c
+    }));
+    (points, special)
+}
+
 pub struct Extended<T, G> {
     pub system: T,
     pub test: G,

@@ -27,7 +27,7 @@
 
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
 use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
-use crate::continuation::curves::{Extended, TwoParameter};
+use crate::continuation::curves::{join_halves, Extended, TwoParameter};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::Dynamics;
@@ -834,28 +834,17 @@ pub fn curve<D: Dynamics + Clone>(
     (back, sys) = curve_half(sys, kind, q, p1, p2, &o)?;
     o.arc.forward = true;
     let (fwd, _) = curve_half(sys, kind, q, p1, p2, &o)?;
-    let nb = back.points.len();
-    let mut points: Vec<CurvePoint> = back.points.into_iter().rev().collect();
-    // the start is in both halves
-    points.extend(fwd.points.into_iter().skip(1));
-    let mut special: Vec<Codim2> = back
-        .special
-        .into_iter()
-        .rev()
-        .map(|mut c| {
-            c.row = nb - c.row;
-            c
-        })
-        .collect();
-    special.extend(fwd.special.into_iter().map(|mut c| {
-        c.row += nb - 1;
-        c
-    }));
+    let stop = [back.stop[1].clone(), fwd.stop[1].clone()];
+    let (points, special) = join_halves(
+        (back.points, back.special),
+        (fwd.points, fwd.special),
+        |c: &mut Codim2| &mut c.row,
+    );
     Ok(EqCurve {
         kind,
         points,
         special,
-        stop: [back.stop[1].clone(), fwd.stop[1].clone()],
+        stop,
     })
 }
 
