@@ -8,7 +8,7 @@ use crate::equilibria::wrap;
 use crate::error::check_range;
 use crate::hb::{fit_coefficients, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
-use crate::ode::{solve_at, Dopri5, Options};
+use crate::ode::{solve_at, solve_at_from, Dopri5, Options};
 use std::f64::consts::PI;
 
 #[derive(Debug, Clone)]
@@ -275,6 +275,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     if at_rest || ys[d..].iter().all(|v| v.abs() < 1e-9) {
         return Rest;
     }
+    let settled = solver.take_checkpoint();
     // Observe: record every ball's crossings of whole turns, and x for oscillations.
     let dt = 0.05;
     let mut t_prev = g.settle;
@@ -358,16 +359,17 @@ fn classify_with<D: Dynamics + ?Sized>(
     let times: Vec<f64> = (0..=s).map(|i| t0 + period * i as f64 / s as f64).collect();
     let mut all_t = vec![g.settle];
     all_t.extend(times.iter().copied());
-    // From t = 0 even when quick: re-simulating from the observation's start instead
-    // perturbs the guess at the integration tolerance, enough to send the harmonic
-    // balance to another of the coexisting O-O orbits on the thesis maps.
-    let Ok((traj, _)) = solve_at(
-        |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
-        0.0,
-        y0,
-        &all_t,
-        &opts,
-    ) else {
+    // As if from t = 0 even when quick: re-simulating from the observation's start
+    // instead perturbs the guess at the integration tolerance, enough to send the
+    // harmonic balance to another of the coexisting O-O orbits on the thesis maps. The
+    // settling run's steps up to its last one are those steps, so it continues from
+    // there rather than integrating them again.
+    let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
+    let traj = match &settled {
+        Some(cp) => solve_at_from(rhs, cp, &all_t, &opts),
+        None => solve_at(rhs, 0.0, y0, &all_t, &opts),
+    };
+    let Ok((traj, _)) = traj else {
         return Failed;
     };
     let first = &traj[1];

@@ -144,6 +144,30 @@ pub struct Stats {
     pub rhs_evals: usize,
 }
 
+/// Everything the step loop carries from one step to the next: an integration resumed
+/// from it ([`Dopri5::resume`]) takes exactly the steps the original would have taken
+/// had it been asked for a later end time.
+#[derive(Debug, Clone)]
+pub struct Checkpoint {
+    /// Where the integration started (its step forecast averages over `t - start`).
+    start: f64,
+    t: f64,
+    y: Vec<f64>,
+    /// `f(t, y)`: the first stage of the next step (FSAL).
+    k0: Vec<f64>,
+    h: f64,
+    rejected_last: bool,
+    stiff_run: usize,
+    calm: usize,
+    stats: Stats,
+}
+
+impl Checkpoint {
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+}
+
 /// Reusable stage storage for one state dimension.
 pub struct Dopri5 {
     n: usize,
@@ -151,6 +175,10 @@ pub struct Dopri5 {
     y_new: Vec<f64>,
     tmp: Vec<f64>,
     err: Vec<f64>,
+    /// The state just before the last integration first had to shorten a step to land
+    /// on its end time: everything up to there is what an integration to a later end
+    /// would have done too.
+    before_end: Option<Checkpoint>,
 }
 
 impl Dopri5 {
@@ -162,7 +190,15 @@ impl Dopri5 {
             y_new: z(),
             tmp: z(),
             err: z(),
+            before_end: None,
         }
+    }
+
+    /// The state of the last integration just before it first shortened a step to end
+    /// on its end time (`None` if it stopped before that). Taken: a second call gives
+    /// `None`.
+    pub fn take_checkpoint(&mut self) -> Option<Checkpoint> {
+        self.before_end.take()
     }
 
     fn rms_scaled(&self, v: &[f64], y: &[f64], opts: &Options) -> f64 {
@@ -216,7 +252,7 @@ impl Dopri5 {
         y0: &[f64],
         t1: f64,
         opts: &Options,
-        mut observe: O,
+        observe: O,
     ) -> Result<(f64, Vec<f64>, Stats)>
     where
         F: FnMut(f64, &[f64], &mut [f64]),
@@ -224,25 +260,87 @@ impl Dopri5 {
     {
         assert_eq!(y0.len(), self.n);
         opts.validate(self.n)?;
+        self.before_end = None;
         let mut stats = Stats::default();
-        let mut y = y0.to_vec();
-        let mut t = t0;
         if t1 == t0 {
-            return Ok((t, y, stats));
+            return Ok((t0, y0.to_vec(), stats));
         }
         let dir = if t1 > t0 { 1.0 } else { -1.0 };
-        f(t, &y, &mut self.k[0]);
+        f(t0, y0, &mut self.k[0]);
         stats.rhs_evals += 1;
-        let mut h = match opts.first_step {
+        let h = match opts.first_step {
             Some(h) => h.abs(),
             None => {
                 stats.rhs_evals += 1;
-                self.initial_step(&mut f, t0, &y, dir, opts)
+                self.initial_step(&mut f, t0, y0, dir, opts)
             }
         };
+        let from = Checkpoint {
+            start: t0,
+            t: t0,
+            y: y0.to_vec(),
+            k0: vec![],
+            h,
+            rejected_last: false,
+            stiff_run: 0,
+            calm: 0,
+            stats,
+        };
+        self.steps(f, from, t1, opts, observe)
+    }
+
+    /// Continues an integration of the same right-hand side, with the same options,
+    /// from `cp` (taken from an integration that ended at an earlier time) to `t1`, in
+    /// the direction it went: bit for bit the steps and dense output an integration
+    /// from the original start to `t1` takes after `cp`.
+    pub fn resume<F, O>(
+        &mut self,
+        f: F,
+        cp: &Checkpoint,
+        t1: f64,
+        opts: &Options,
+        observe: O,
+    ) -> Result<(f64, Vec<f64>, Stats)>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]),
+        O: FnMut(f64, f64, &Dense<'_>) -> bool,
+    {
+        assert_eq!(cp.y.len(), self.n);
+        opts.validate(self.n)?;
+        self.before_end = None;
+        if t1 == cp.t {
+            return Ok((cp.t, cp.y.clone(), cp.stats.clone()));
+        }
+        self.k[0].copy_from_slice(&cp.k0);
+        self.steps(f, cp.clone(), t1, opts, observe)
+    }
+
+    /// The step loop from `at` (whose `k0` is already in `self.k[0]`) to `t1`.
+    fn steps<F, O>(
+        &mut self,
+        mut f: F,
+        at: Checkpoint,
+        t1: f64,
+        opts: &Options,
+        mut observe: O,
+    ) -> Result<(f64, Vec<f64>, Stats)>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]),
+        O: FnMut(f64, f64, &Dense<'_>) -> bool,
+    {
+        let Checkpoint {
+            start: t0,
+            mut t,
+            mut y,
+            mut h,
+            mut rejected_last,
+            mut stiff_run,
+            mut calm,
+            mut stats,
+            ..
+        } = at;
+        let dir = if t1 > t { 1.0 } else { -1.0 };
         let n = self.n;
-        let mut rejected_last = false;
-        let (mut stiff_run, mut calm) = (0usize, 0usize);
         loop {
             if (stats.accepted + stats.rejected) % 8 == 0 {
                 cancel::check()?;
@@ -263,6 +361,19 @@ impl Dopri5 {
             let mut hs = h * dir;
             let mut last = false;
             if dir * (t + hs - t1) >= 0.0 {
+                if self.before_end.is_none() {
+                    self.before_end = Some(Checkpoint {
+                        start: t0,
+                        t,
+                        y: y.clone(),
+                        k0: self.k[0].clone(),
+                        h,
+                        rejected_last,
+                        stiff_run,
+                        calm,
+                        stats: stats.clone(),
+                    });
+                }
                 hs = t1 - t;
                 last = true;
             }
@@ -482,6 +593,36 @@ pub fn solve_at<F>(
 where
     F: FnMut(f64, &[f64], &mut [f64]),
 {
+    sample_at(t0, y0, t_eval, |solver, t1, observe| {
+        solver.integrate(f, t0, y0, t1, opts, observe)
+    })
+}
+
+/// [`solve_at`] continued from a checkpoint of an earlier integration of `f` with the
+/// same options (every time in `t_eval` at or past the checkpoint's): the states an
+/// integration from that integration's start would give, without its first part.
+pub fn solve_at_from<F>(
+    f: F,
+    cp: &Checkpoint,
+    t_eval: &[f64],
+    opts: &Options,
+) -> Result<(Vec<Vec<f64>>, Stats)>
+where
+    F: FnMut(f64, &[f64], &mut [f64]),
+{
+    sample_at(cp.t, &cp.y, t_eval, |solver, t1, observe| {
+        solver.resume(f, cp, t1, opts, observe)
+    })
+}
+
+type Observer<'o> = &'o mut dyn FnMut(f64, f64, &Dense<'_>) -> bool;
+
+/// The states at `t_eval` (checked, starting at or after `t0`) of the integration
+/// `run(solver, last time, observer)` starting at `(t0, y0)`.
+fn sample_at<R>(t0: f64, y0: &[f64], t_eval: &[f64], run: R) -> Result<(Vec<Vec<f64>>, Stats)>
+where
+    R: FnOnce(&mut Dopri5, f64, Observer<'_>) -> Result<(f64, Vec<f64>, Stats)>,
+{
     let n = y0.len();
     if t_eval.is_empty() {
         return Ok((vec![], Stats::default()));
@@ -496,7 +637,7 @@ where
         idx += 1;
     }
     let mut solver = Dopri5::new(n);
-    let (_, _, stats) = solver.integrate(f, t0, y0, t1, opts, |_, tb, dense| {
+    let (_, _, stats) = run(&mut solver, t1, &mut |_, tb, dense| {
         while idx < t_eval.len() && dir * (t_eval[idx] - tb) <= 0.0 {
             let mut v = vec![0.0; n];
             dense.eval(t_eval[idx], &mut v);
@@ -572,6 +713,39 @@ mod tests {
     fn osc(_t: f64, y: &[f64], dy: &mut [f64]) {
         dy[0] = y[1];
         dy[1] = -y[0];
+    }
+
+    /// Van der Pol: nonlinear, so a step sequence that differed anywhere would show in
+    /// the last bits.
+    fn vdp(_t: f64, y: &[f64], dy: &mut [f64]) {
+        dy[0] = y[1];
+        dy[1] = 2.0 * (1.0 - y[0] * y[0]) * y[1] - y[0];
+    }
+
+    #[test]
+    fn resuming_from_the_checkpoint_repeats_the_longer_integration_bit_for_bit() {
+        let opts = Options::new(1e-6, 1e-9);
+        let y0 = [2.0, 0.0];
+        let times: Vec<f64> = (0..=40).map(|i| 7.3 + 0.31 * i as f64).collect();
+        let (whole, stats) = solve_at(vdp, 0.0, &y0, &times, &opts).unwrap();
+        let mut first = Dopri5::new(2);
+        first
+            .integrate(vdp, 0.0, &y0, 7.3, &opts, |_, _, _| true)
+            .unwrap();
+        let cp = first.take_checkpoint().unwrap();
+        assert!(cp.time() < 7.3 && cp.time() > 6.0);
+        assert!(first.take_checkpoint().is_none());
+        let (resumed, stats2) = solve_at_from(vdp, &cp, &times, &opts).unwrap();
+        assert_eq!(whole, resumed);
+        // the counters carry on too (max_steps counts from the original start)
+        assert_eq!(stats.accepted, stats2.accepted);
+        // an integration stopped by its observer before the end has no checkpoint
+        first
+            .integrate(vdp, 0.0, &y0, 7.3, &opts, |_, tb, _| tb < 3.0)
+            .unwrap();
+        assert!(first.take_checkpoint().is_none());
+        // times before the checkpoint are refused, not extrapolated
+        assert!(solve_at_from(vdp, &cp, &[1.0, 8.0], &opts).is_err());
     }
 
     fn err_with_fixed_step(h: f64) -> f64 {
