@@ -8,7 +8,7 @@ use crate::equilibria::wrap;
 use crate::error::check_range;
 use crate::hb::{fit_coefficients, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
-use crate::ode::{solve_at, solve_at_from, Dopri5, Options};
+use crate::ode::{solve_at, solve_at_from, Dense, Dopri5, Options};
 use std::f64::consts::PI;
 
 #[derive(Debug, Clone)]
@@ -230,6 +230,82 @@ impl RestWatch {
     }
 }
 
+/// Watches a scan seed's settling run for a motion with a rotating ball that is
+/// periodic already: at every whole turn of a ball (located on the dense output), the
+/// state (positions with ball angles taken modulo a turn, and velocities) is compared
+/// with the state at that ball's previous turn. `RETURNS` returns in a row within
+/// `TOL` (relative) end the settling there: what remains of the settling time would
+/// only shrink a transient that no longer shows.
+struct ReturnWatch {
+    o: usize,
+    d: usize,
+    /// Per ball: its whole-turn count at the last step's end, and the state at its
+    /// last whole turn.
+    turn: Vec<f64>,
+    last: Vec<Option<Vec<f64>>>,
+    calm: Vec<usize>,
+    tmp: Vec<f64>,
+}
+
+impl ReturnWatch {
+    const TOL: f64 = 1e-7;
+    const RETURNS: usize = 3;
+
+    fn new(y0: &[f64], o: usize, d: usize) -> Self {
+        ReturnWatch {
+            o,
+            d,
+            turn: y0[o..d].iter().map(|b| (b / (2.0 * PI)).floor()).collect(),
+            last: vec![None; d - o],
+            calm: vec![0; d - o],
+            tmp: vec![0.0; 2 * d],
+        }
+    }
+
+    /// Takes the step `[ta, tb]`; true once some ball's turns returned `RETURNS` times.
+    fn settled(&mut self, ta: f64, tb: f64, dense: &Dense<'_>) -> bool {
+        let (o, d) = (self.o, self.d);
+        let end = dense.end();
+        let mut done = false;
+        for i in 0..d - o {
+            let k = (end[o + i] / (2.0 * PI)).floor();
+            if k == self.turn[i] {
+                continue;
+            }
+            let level = 2.0 * PI * k.max(self.turn[i]);
+            self.turn[i] = k;
+            // The crossing time by secant steps on the dense output.
+            dense.eval(ta, &mut self.tmp);
+            let (mut t0, mut f0) = (ta, self.tmp[o + i] - level);
+            let (mut t1, mut f1) = (tb, end[o + i] - level);
+            for _ in 0..8 {
+                if f1 == f0 {
+                    break;
+                }
+                let t = t1 - f1 * (t1 - t0) / (f1 - f0);
+                dense.eval(t, &mut self.tmp);
+                (t0, f0, t1, f1) = (t1, f1, t, self.tmp[o + i] - level);
+                if f1.abs() < 1e-12 {
+                    break;
+                }
+            }
+            dense.eval(t1, &mut self.tmp);
+            for b in &mut self.tmp[o..d] {
+                *b = wrap(*b);
+            }
+            let close = self.last[i].as_ref().is_some_and(|p| {
+                p.iter()
+                    .zip(&self.tmp)
+                    .all(|(a, b)| (a - b).abs() <= Self::TOL * (1.0 + a.abs()))
+            });
+            self.calm[i] = if close { self.calm[i] + 1 } else { 0 };
+            self.last[i] = Some(self.tmp.clone());
+            done |= self.calm[i] >= Self::RETURNS;
+        }
+        done
+    }
+}
+
 /// [`classify`], stopping early (as `OtherPattern`) when `want` is given and the
 /// rotation pattern differs.
 fn classify_as<D: Dynamics + ?Sized>(
@@ -265,17 +341,28 @@ fn classify_with<D: Dynamics + ?Sized>(
     // rather than settle for the whole time.
     let mut at_rest = false;
     let mut watch = RestWatch::new(0.0);
-    let Ok((_, ys, _)) = solver.integrate(rhs, 0.0, y0, g.settle, &opts, |_, tb, dense| {
-        at_rest = tb > 50.0 && dense.end()[d..].iter().all(|v| v.abs() < 1e-7)
-            || quick && watch.at_rest(tb, dense.end(), d);
-        !at_rest
-    }) else {
+    let mut returns = ReturnWatch::new(y0, o, d);
+    let mut early = false;
+    let Ok((t_settled, ys, _)) =
+        solver.integrate(rhs, 0.0, y0, g.settle, &opts, |ta, tb, dense| {
+            at_rest = tb > 50.0 && dense.end()[d..].iter().all(|v| v.abs() < 1e-7)
+                || quick && watch.at_rest(tb, dense.end(), d);
+            early = quick && !at_rest && returns.settled(ta, tb, dense);
+            !at_rest && !early
+        })
+    else {
         return Failed;
     };
     if at_rest || ys[d..].iter().all(|v| v.abs() < 1e-9) {
         return Rest;
     }
     let settled = solver.take_checkpoint();
+    // Observation and collocation start where settling ended: `g.settle`, or earlier
+    // when the motion was already periodic.
+    let g = &GuessOptions {
+        settle: t_settled,
+        ..g.clone()
+    };
     // Observe: record every ball's crossings of whole turns, and x for oscillations.
     let dt = 0.05;
     let mut t_prev = g.settle;
@@ -366,8 +453,10 @@ fn classify_with<D: Dynamics + ?Sized>(
     // there rather than integrating them again.
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
     let traj = match &settled {
-        Some(cp) => solve_at_from(rhs, cp, &all_t, &opts),
-        None => solve_at(rhs, 0.0, y0, &all_t, &opts),
+        Some(cp) if !early => solve_at_from(rhs, cp, &all_t, &opts),
+        // the observation's own start: it integrated from there with a fresh solver
+        _ if early => solve_at(rhs, g.settle, &ys, &all_t, &opts),
+        _ => solve_at(rhs, 0.0, y0, &all_t, &opts),
     };
     let Ok((traj, _)) = traj else {
         return Failed;
@@ -480,6 +569,42 @@ mod tests {
     use super::*;
     use crate::equilibria::{equilibria, EquilibriumKind, Verdict};
     use crate::Planar;
+
+    /// A ball turning at rate 1 that forces a damped oscillator: `x'' + 2 z x' + x =
+    /// cos b`. Returns at whole turns differ by the free transient `~ e^(-z t)`, so the
+    /// watch may fire only once that is below its tolerance, and must fire soon after.
+    #[test]
+    fn return_watch_fires_once_the_transient_is_gone_and_not_before() {
+        let z = 0.05;
+        let rhs = |_t: f64, y: &[f64], dy: &mut [f64]| {
+            // state (x, b, x', b')
+            dy[0] = y[2];
+            dy[1] = y[3];
+            dy[2] = y[1].cos() - 2.0 * z * y[2] - y[0];
+            dy[3] = 0.0;
+        };
+        let y0 = [1.0, 0.3, 0.0, 1.0];
+        let mut watch = ReturnWatch::new(&y0, 1, 2);
+        let mut fired = None;
+        let opts = Options::new(1e-10, 1e-12);
+        Dopri5::new(4)
+            .integrate(rhs, 0.0, &y0, 2000.0, &opts, |ta, tb, dense| {
+                if watch.settled(ta, tb, dense) {
+                    fired = Some(tb);
+                }
+                fired.is_none()
+            })
+            .unwrap();
+        let t = fired.expect("a periodic motion is recognised");
+        // the transient's size at t: amplitude ~1, decay e^(-z t); the watch's tolerance
+        // is 1e-7 relative on every state entry
+        let transient = (-z * t).exp();
+        assert!(
+            transient < 1e-6,
+            "fired at t = {t} with a transient of {transient:.1e}"
+        );
+        assert!(transient > 1e-10, "fired late, at t = {t}");
+    }
 
     #[test]
     fn standard_case_settles_on_the_rr_orbit_with_its_period() {
