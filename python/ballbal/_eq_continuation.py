@@ -42,7 +42,7 @@ def _native_model(model: Any) -> tuple[Balancer | Scene, Seed003 | None]:
 
 
 def _seed_at(seed: Seed003, names: tuple[str, ...], values: tuple[float, ...]) -> Seed003:
-    return replace(seed, **dict(zip(names, values, strict=True)))
+    return seed.replace(**dict(zip(names, values, strict=True)))
 
 
 def _eta_at(model: Any, parameter: str, value: float) -> np.ndarray:
