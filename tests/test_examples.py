@@ -176,6 +176,10 @@ def bearing_balancer(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
 def seed003(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     # both planes get the together saddle-node and the perfect balance's Hopf curve
     assert stdout.count("saddle_node curve") == 2 and stdout.count("hopf curve") == 2, stdout
+    # figure 4 in the seed's own parameters: the three curves and their meeting point
+    for name in ("SN_2+", "PF", "H_1"):
+        assert f"figure 4: {name} of" in stdout, stdout
+    assert "figure 4: pitchfork at (omega0, m0) = (0.5774, 1.0000)" in stdout, stdout
     return [out / "seed003.png"]
 
 

@@ -6,7 +6,8 @@ two-parameter curves of those bifurcations (the core's
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import replace
+from typing import Any, Literal
 
 import numpy as np
 import polars as pl
@@ -15,6 +16,8 @@ from ballbal import _check, _native
 from ballbal._branch import Branch, Continuation, Curve, model_at, parameter_range
 from ballbal.analysis import Equilibrium, _equilibrium, capacities, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
+from ballbal.model import Balancer, Seed003
+from ballbal.scene import Scene
 
 __all__ = ["equilibrium_branch", "equilibrium_curve", "switch_equilibrium"]
 
@@ -31,17 +34,60 @@ def _options(options: Any) -> Continuation:
     return options
 
 
+def _native_model(model: Any) -> tuple[Balancer | Scene, Seed003 | None]:
+    """What the binding takes: the model, and seed 003's parameters when continued in them."""
+    if isinstance(model, Seed003):
+        return model.balancer, model
+    return model, None
+
+
+def _seed_at(seed: Seed003, names: tuple[str, ...], values: tuple[float, ...]) -> Seed003:
+    return seed.replace(**dict(zip(names, values, strict=True)))
+
+
 def _eta_at(model: Any, parameter: str, value: float) -> np.ndarray:
-    """The balls' capacities at a branch point (they vary only along an ``eta`` branch)."""
+    """The balls' capacities at a branch point (they vary only along an ``eta`` branch, or
+    ``m0`` / ``e`` in seed 003's units)."""
+    if isinstance(model, Seed003):
+        return capacities(_seed_at(model, (parameter,), (value,)).balancer)
     if parameter.startswith("eta"):
         return capacities(model_at(model, parameter, value))
     return capacities(model)
+
+
+def _to_seed(rows: list[dict[str, Any]], seed: Seed003, names: tuple[str, ...],
+             keys: tuple[str, ...]) -> list[dict[str, Any]]:
+    """Rows in seed 003's units: ``x, y`` times ``e`` (lengths by the track radius), rates
+    (eigenvalues, ``max_real``, ``omega``) over ``S = sqrt(1 + n m0)`` (its time unit)."""
+    out = []
+    for r in rows:
+        at = _seed_at(seed, names, tuple(float(r[k]) for k in keys))
+        s, e = at.scale, at.e
+        r = dict(r)
+        q = np.array(r["q"], dtype=float)
+        q[:2] *= e
+        r["q"] = q
+        for k in ("eig_re", "eig_im"):
+            r[k] = np.asarray(r[k], dtype=float) / s
+        r["index"] = r["index"] / s
+        if "omega" in r:
+            r["omega"] = r["omega"] / s
+        out.append(r)
+    return out
 
 
 def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, float],
             options: Continuation) -> Branch:
     pts = d["points"]
     evs = d["events"]
+    solutions = tuple(_equilibrium(p, _eta_at(model, parameter, p["p"])) for p in pts)
+    event_solutions = tuple(_equilibrium(e, _eta_at(model, parameter, e["p"])) for e in evs)
+    meta = {"model": model, "range": rng, "options": options,
+            "event_x": [list(e["x"]) for e in evs],
+            "event_tangent": [list(e["tangent"]) for e in evs]}
+    if isinstance(model, Seed003):
+        pts = _to_seed(pts, model, (parameter,), ("p",))
+        evs = _to_seed(evs, model, (parameter,), ("p",))
     marks: list[str | None] = [None] * len(pts)
     for e in evs:
         r = e["row"]
@@ -75,23 +121,32 @@ def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, flo
                "omega": pl.Float64, "test": pl.Float64, "row": pl.Int64})
     return Branch(
         kind="equilibrium", parameter=parameter, table=table, events=events, stop=d["stop"],
-        solutions=tuple(_equilibrium(p, _eta_at(model, parameter, p["p"])) for p in pts),
-        event_solutions=tuple(_equilibrium(e, _eta_at(model, parameter, e["p"]))
-                              for e in evs),
-        meta={"model": model, "range": rng, "options": options,
-              "event_x": [list(e["x"]) for e in evs],
-              "event_tangent": [list(e["tangent"]) for e in evs]},
+        solutions=solutions, event_solutions=event_solutions, meta=meta,
     )
 
 
 def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str = "perfect_balance",
-                       range: tuple[float, float], options: Continuation = _DEFAULT
+                       range: tuple[float, float], options: Continuation = _DEFAULT,
+                       direction: Literal["forward", "backward", "both"] | None = None
                        ) -> Branch:
     """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
     ``model``, or a kind name: the first equilibrium of that kind) continued in
     ``parameter`` (any name ``with_param`` takes: ``"Omega"``, ``"eta"`` (all balls),
     ``"eta[1]"``, ``"zeta"``, ``"zeta_b"``, ``"mu"``, ``"delta"``, scene parameters) by
     pseudo-arclength over ``range``, through folds.
+
+    ``model`` may also be a :class:`~ballbal.model.Seed003`: then ``parameter`` is one of
+    seed 003's (``"omega0"``, ``"m0"``, ``"e"``, ``"C0"``, ``"D0"``), ``start`` an
+    equilibrium of ``model.balancer`` or a kind name, and the tables are in the seed's
+    units: its parameter, ``q`` with ``x, y`` over the track radius, eigenvalues,
+    ``max_real`` and ``omega`` in its time unit (ballbal's over ``S = sqrt(1 + n m0)``);
+    ``solutions`` stay ballbal's :class:`~ballbal.Equilibrium` objects.
+
+    ``direction``: ``"forward"`` (towards increasing ``parameter``), ``"backward"``, or
+    ``"both"``: both ways from the start, the rows running from the end reached
+    downwards to the end reached upwards (the start once; tangents and ``test_fold``
+    oriented along the rows), ``stop`` then ``"<lower end>/<upper end>"``. Default:
+    ``options.forward``.
 
     ``table``: one row per point (the parameter, ``q``, ``kind``, ``stability``,
     ``max_real``, the eigenvalues, the test functions ``test_fold`` (dp/ds),
@@ -100,12 +155,18 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     determinant) and ``event``, the events located since the previous row). ``events``:
     fold, Hopf (with its frequency ``omega``) and branch points, located to ~1e-11 in
     arclength."""
-    _check.model("model", model)
+    native, seed = _native_model(model)
+    _check.model("model", native)
     parameter = _check.string("parameter", parameter)
     rng = parameter_range(range)
     options = _options(options)
+    if direction not in (None, "forward", "backward", "both"):
+        raise ParameterError("direction", f"must be 'forward', 'backward' or 'both', got "
+                             f"{direction!r}", allowed="forward, backward, both")
+    if direction in ("forward", "backward"):
+        options = replace(options, forward=direction == "forward")
     if isinstance(start, str):
-        found = [e for e in equilibria(model) if e.kind == start]
+        found = [e for e in equilibria(native) if e.kind == start]
         if not found:
             raise ParameterError("start", f"the model has no {start!r} equilibrium",
                                  allowed="perfect_balance, balanced, together, opposite, "
@@ -113,8 +174,8 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
         start = found[0]
     if not isinstance(start, Equilibrium):
         raise ParameterTypeError("start", "must be an Equilibrium or a kind name")
-    d = _native.equilibrium_branch(model, parameter, [float(v) for v in start.q], start.kind,
-                                   rng, options)
+    d = _native.equilibrium_branch(native, parameter, [float(v) for v in start.q], start.kind,
+                                   rng, options, direction == "both", seed)
     return _branch(d, parameter, model, rng, options)
 
 
@@ -138,9 +199,10 @@ def switch_equilibrium(branch: Branch, event_index: int) -> Branch:
         raise ParameterError("event_index", f"event {i} is a {branch.events['type'][i]}, "
                              "not a branch point", allowed="branch_point")
     m = branch.meta
-    d = _native.equilibrium_switch(m["model"], branch.parameter, m["event_x"][i],
+    native, seed = _native_model(m["model"])
+    d = _native.equilibrium_switch(native, branch.parameter, m["event_x"][i],
                                    float(branch.events[branch.parameter][i]),
-                                   m["event_tangent"][i], m["range"], m["options"])
+                                   m["event_tangent"][i], m["range"], m["options"], seed)
     return _branch(d, branch.parameter, m["model"], m["range"], m["options"])
 
 
@@ -153,10 +215,17 @@ def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
     branch point of the balls-together branch the pitchfork curve (folds and pitchforks
     of that branch are continued on its invariant subspace ``b_1 = ... = b_n``).
 
-    ``points`` lists the codimension-two points found: ``"BT"`` (a double zero
-    eigenvalue, e.g. (Omega, eta) = (1, 1/2) for two balls), ``"ZH"`` (zero-Hopf),
+    With a branch continued in seed 003's units (a :class:`~ballbal.model.Seed003`
+    model), ``parameter2`` is one of the seed's parameters and the tables are in its
+    units, as for :func:`equilibrium_branch`.
+
+    ``points`` lists the codimension-two points found, each once: ``"BT"`` (a double
+    zero eigenvalue with a Jordan block: Bogdanov–Takens), ``"ZH"`` (zero-Hopf),
     ``"cusp"`` (the curve reverses in the parameter plane), ``"pitchfork"`` (a
-    saddle-node curve meets the pitchfork)."""
+    saddle-node curve meets the pitchfork; for two balls at (Omega, eta) = (1, 1/2),
+    seed 003's (omega0, m0) = (1/sqrt(1 + 2 m0), e/2), where the second zero
+    eigenvalue is the antisymmetric ball mode's), ``"saddle_node"`` (a pitchfork curve
+    meets the saddle-node curve)."""
     i = _event(branch, event_index)
     parameter2 = _check.string("parameter2", parameter2)
     rng = parameter_range(range)
@@ -170,11 +239,17 @@ def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
                              "pitchfork of the balls-together branch only",
                              allowed="fold, hopf, or a together branch point")
     m = branch.meta
-    d = _native.equilibrium_curve(m["model"], kind, branch.parameter, parameter2,
+    native, seed = _native_model(m["model"])
+    d = _native.equilibrium_curve(native, kind, branch.parameter, parameter2,
                                   m["event_x"][i], float(branch.events[branch.parameter][i]),
-                                  together, rng, options)
+                                  together, rng, options, seed)
     p1, p2 = branch.parameter, parameter2
     pts = d["points"]
+    sp = d["special"]
+    if seed is not None:
+        pts = _to_seed(pts, seed, (p1, p2), ("p1", "p2"))
+        sp = [{**s, "q": _to_seed([{**s, "eig_re": [], "eig_im": [], "index": 0.0}], seed,
+                                  (p1, p2), ("p1", "p2"))[0]["q"]} for s in sp]
     table = pl.DataFrame({
         p1: [p["p1"] for p in pts],
         p2: [p["p2"] for p in pts],
@@ -185,7 +260,6 @@ def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
         "omega": [p["omega"] for p in pts],
         "test": [p["test"] for p in pts],
     }, schema_overrides={"q": pl.List(pl.Float64)})
-    sp = d["special"]
     points = pl.DataFrame({
         "type": [s["type"] for s in sp],
         p1: [s["p1"] for s in sp],

@@ -10,7 +10,8 @@ from ballbal._eq_continuation import (
 from ballbal._po_continuation import periodic_branch
 from ballbal._po_curves import periodic_curve
 from ballbal._po_switch import switch
-from ballbal.model import from_seed003
+from ballbal.model import Seed003, from_seed003
 
-__all__ = ["Branch", "Continuation", "Curve", "equilibrium_branch", "equilibrium_curve",
-           "from_seed003", "periodic_branch", "periodic_curve", "switch", "switch_equilibrium"]
+__all__ = ["Branch", "Continuation", "Curve", "Seed003", "equilibrium_branch",
+           "equilibrium_curve", "from_seed003", "periodic_branch", "periodic_curve", "switch",
+           "switch_equilibrium"]

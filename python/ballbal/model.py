@@ -183,3 +183,57 @@ def from_seed003(
         Omega=omega0 * s,
         eta=(m0 / e,) * n,
     )
+
+
+#: Seed 003's parameter names, the ones continuation in its units takes.
+SEED003_PARAMETERS = ("omega0", "m0", "e", "C0", "D0")
+
+
+@dataclass(frozen=True)
+class Seed003:
+    """A balancer in seed 003's own parameters, a family continuation can vary in them.
+
+    ``omega0`` spin speed over ``sqrt(K / M)`` of the disk alone, ``m0 = m / M`` (each of
+    the ``n`` balls over the disk), ``e = eps / R`` (eccentricity over track radius),
+    ``C0 = C / (2 sqrt(K M))``, ``D0 = D / (m R^2 omega_n)``; see :func:`from_seed003`
+    for the conversion. ``balancer`` is the same balancer in ballbal's parameters.
+
+    The equilibrium-continuation functions of :mod:`ballbal.continuation` accept it as
+    their model and then take and report the seed's parameter names
+    (``equilibrium_branch(Seed003(0.3, 2.0, 2.0, 0.35, 0.35), "m0", ...)``): one of them
+    moves several of ballbal's at once (``m0`` moves ``mu``, ``eta``, ``Omega``, ``zeta``
+    and ``zeta_b``), and the model is rebuilt from the seed's values at every point.
+    """
+
+    omega0: float
+    m0: float
+    e: float
+    C0: float = 0.05
+    D0: float = 0.1
+    n: int = 2
+
+    def __post_init__(self) -> None:
+        for k, lo, is_open in (("omega0", 0.0, False), ("m0", 0.0, True), ("e", 0.0, True),
+                               ("C0", 0.0, False), ("D0", 0.0, False)):
+            object.__setattr__(self, k, _check.real(k, getattr(self, k), lo, lo_open=is_open,
+                                                    finite=True))
+        object.__setattr__(self, "n", _check.integer("n", self.n, 1, 1024))
+
+    @property
+    def balancer(self) -> Balancer:
+        """The same balancer in ballbal's parameters (:func:`from_seed003`)."""
+        return from_seed003(self.omega0, self.m0, self.e, C0=self.C0, D0=self.D0, n=self.n)
+
+    @property
+    def scale(self) -> float:
+        """``S = sqrt(1 + n m0)``: ballbal's ``Omega`` over ``omega0``; the seed's time is
+        ``S`` times ballbal's (its rates and eigenvalues are ballbal's over ``S``)."""
+        return math.sqrt(1.0 + self.n * self.m0)
+
+    def replace(self, **changes: Any) -> Seed003:
+        """A copy with some of the seed's parameters changed."""
+        for k in changes:
+            if k not in (*SEED003_PARAMETERS, "n"):
+                raise ParameterError(k, "is not a parameter of seed 003's units",
+                                     allowed=", ".join(SEED003_PARAMETERS))
+        return replace(self, **changes)

@@ -8,12 +8,14 @@ use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
 use crate::tables::equilibrium_dict;
 use ballbal_core::continuation::equilibria::{
-    branch, curve, switch, CurveKind, EqBranch, EqCurve, EqOptions, EqSystem,
+    branch, branch_both_ways, curve, switch, CurveKind, EqBranch, EqCurve, EqOptions, EqSystem,
 };
 use ballbal_core::continuation::ArcStop;
 use ballbal_core::equilibria::EquilibriumKind;
-use ballbal_core::numerics::problem::Parametric;
+use ballbal_core::model::Seed003;
+use ballbal_core::numerics::problem::{Parametric, Problem};
 use ballbal_core::periodic::require_autonomous;
+use ballbal_core::Planar;
 use ballbal_core::{Error, Result};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -75,21 +77,78 @@ fn check_q(q: &[f64], d: usize) -> Result<()> {
     Ok(())
 }
 
+/// Seed 003's parameters (`ballbal.continuation.Seed003`'s fields): when given, the
+/// continued parameters are the seed's own and the model is rebuilt from them.
+#[derive(FromPyObject)]
+pub struct Seed003Args {
+    omega0: f64,
+    m0: f64,
+    e: f64,
+    #[pyo3(attribute("C0"))]
+    c0: f64,
+    #[pyo3(attribute("D0"))]
+    d0: f64,
+    n: usize,
+}
+
+impl Seed003Args {
+    fn core(&self) -> Result<Seed003> {
+        Seed003::new(self.omega0, self.m0, self.e, self.c0, self.d0, self.n)
+    }
+}
+
+/// The equilibrium family in `names`: the model's own parameters, or seed 003's.
+fn family<'a, D: Parametric>(
+    d: &'a D,
+    seed: Option<&Seed003Args>,
+    names: &[&str],
+) -> Result<Family<'a, D>> {
+    Ok(match seed {
+        None => Family::Model(EqSystem::family(d, names)?),
+        Some(s) => Family::Seed(EqSystem::seed003(s.core()?, names)?),
+    })
+}
+
+enum Family<'a, D> {
+    Model(EqSystem<'a, D>),
+    Seed(EqSystem<'static, Planar>),
+}
+
+/// `$e` with `$s` the family's system (each arm its own monomorphisation).
+macro_rules! with_family {
+    ($f:expr, $s:ident => $e:expr) => {
+        match $f {
+            Family::Model($s) => $e,
+            Family::Seed($s) => $e,
+        }
+    };
+}
+
 fn run_branch<D: Parametric>(
     d: &D,
+    seed: Option<&Seed003Args>,
     parameter: &str,
     q: &[f64],
     kind: EquilibriumKind,
+    both: bool,
     opts: &EqOptions,
 ) -> Result<EqBranch> {
     check_q(q, d.ndof())?;
-    let mut sys = EqSystem::family(d, &[parameter])?;
-    let p0 = d.param_value(parameter)?;
-    branch(&mut sys, q, p0, kind, None, opts)
+    with_family!(family(d, seed, &[parameter])?, sys => {
+        let mut sys = sys;
+        let p0 = Problem::param(&sys);
+        if both {
+            branch_both_ways(&mut sys, q, p0, kind, opts)
+        } else {
+            branch(&mut sys, q, p0, kind, None, opts)
+        }
+    })
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_switch<D: Parametric>(
     d: &D,
+    seed: Option<&Seed003Args>,
     parameter: &str,
     x: &[f64],
     p: f64,
@@ -100,13 +159,16 @@ fn run_switch<D: Parametric>(
     if tangent.len() != x.len() + 1 {
         return Err(Error::param("event", "tangent of the wrong length"));
     }
-    let mut sys = EqSystem::family(d, &[parameter])?;
-    switch(&mut sys, x, p, tangent, opts)
+    with_family!(family(d, seed, &[parameter])?, sys => {
+        let mut sys = sys;
+        switch(&mut sys, x, p, tangent, opts)
+    })
 }
 
 #[allow(clippy::too_many_arguments)]
 fn run_curve<D: Parametric>(
     d: &D,
+    seed: Option<&Seed003Args>,
     kind: CurveKind,
     names: (&str, &str),
     q: &[f64],
@@ -121,12 +183,14 @@ fn run_curve<D: Parametric>(
             format!("must differ from the branch's parameter {:?}", names.0),
         ));
     }
-    let p2 = d.param_value(names.1)?;
-    let mut sys = EqSystem::family(d, &[names.0, names.1])?;
-    if together {
-        sys = sys.on_together()?;
-    }
-    curve(sys, kind, q, p1, p2, opts)
+    let p2 = match seed {
+        None => d.param_value(names.1)?,
+        Some(s) => s.core()?.param_value(names.1)?,
+    };
+    with_family!(family(d, seed, &[names.0, names.1])?, sys => {
+        let sys = if together { sys.on_together()? } else { sys };
+        curve(sys, kind, q, p1, p2, opts)
+    })
 }
 
 fn branch_dict(py: Python<'_>, b: EqBranch) -> PyResult<Bound<'_, PyDict>> {
@@ -156,7 +220,11 @@ fn branch_dict(py: Python<'_>, b: EqBranch) -> PyResult<Bound<'_, PyDict>> {
     }
     out.set_item("points", points)?;
     out.set_item("events", events)?;
-    out.set_item("stop", stop_str(&b.stop))?;
+    let stop = match &b.stop_back {
+        None => stop_str(&b.stop),
+        Some(back) => format!("{}/{}", stop_str(back), stop_str(&b.stop)),
+    };
+    out.set_item("stop", stop)?;
     Ok(out)
 }
 
@@ -194,7 +262,8 @@ fn curve_dict(py: Python<'_>, c: EqCurve) -> PyResult<Bound<'_, PyDict>> {
 /// A branch of equilibria from `q` (the model's equilibrium of kind `kind`) in
 /// `parameter` over `range`: a dict of `points`, `events` and `stop`.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, q, kind, range, options))]
+#[pyo3(signature = (model, parameter, q, kind, range, options, both=false, seed003=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn equilibrium_branch<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -203,20 +272,22 @@ pub fn equilibrium_branch<'py>(
     kind: String,
     range: (f64, f64),
     options: ContinuationArgs,
+    both: bool,
+    seed003: Option<Seed003Args>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let k = kind_from(&kind).py()?;
     let opts = options_checked(&m, &options, range)?;
     let b = guarded(
         py,
-        || dispatch!(&m, d => run_branch(d, &parameter, &q, k, &opts)),
+        || dispatch!(&m, d => run_branch(d, seed003.as_ref(), &parameter, &q, k, both, &opts)),
     )?;
     branch_dict(py, b)
 }
 
 /// The other branch through a branch point `(x, p)` reached along `tangent`.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, x, p, tangent, range, options))]
+#[pyo3(signature = (model, parameter, x, p, tangent, range, options, seed003=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn equilibrium_switch<'py>(
     py: Python<'py>,
@@ -227,12 +298,13 @@ pub fn equilibrium_switch<'py>(
     tangent: Vec<f64>,
     range: (f64, f64),
     options: ContinuationArgs,
+    seed003: Option<Seed003Args>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let opts = options_checked(&m, &options, range)?;
     let b = guarded(
         py,
-        || dispatch!(&m, d => run_switch(d, &parameter, &x, p, &tangent, &opts)),
+        || dispatch!(&m, d => run_switch(d, seed003.as_ref(), &parameter, &x, p, &tangent, &opts)),
     )?;
     branch_dict(py, b)
 }
@@ -241,7 +313,7 @@ pub fn equilibrium_switch<'py>(
 /// `(q, p1)` in `(parameter, parameter2)`, `range` bounding `parameter2`; `together`:
 /// on the balls-together subspace.
 #[pyfunction]
-#[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options))]
+#[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options, seed003=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn equilibrium_curve<'py>(
     py: Python<'py>,
@@ -254,6 +326,7 @@ pub fn equilibrium_curve<'py>(
     together: bool,
     range: (f64, f64),
     options: ContinuationArgs,
+    seed003: Option<Seed003Args>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let k = match kind.as_str() {
@@ -272,7 +345,7 @@ pub fn equilibrium_curve<'py>(
     let opts = options_checked(&m, &options, range)?;
     let c = guarded(
         py,
-        || dispatch!(&m, d => run_curve(d, k, (&parameter, &parameter2), &q, p1, together, &opts)),
+        || dispatch!(&m, d => run_curve(d, seed003.as_ref(), k, (&parameter, &parameter2), &q, p1, together, &opts)),
     )?;
     curve_dict(py, c)
 }

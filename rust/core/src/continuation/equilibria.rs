@@ -30,7 +30,8 @@ use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, Arc
 use crate::continuation::curves::{join_halves, Extended, TwoParameter};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
-use crate::model::Dynamics;
+use crate::model::seed003::Seed003;
+use crate::model::{Dynamics, Planar};
 use crate::numerics::problem::{Parametric, Problem};
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
@@ -74,7 +75,8 @@ impl<'a, D: Dynamics + Clone> EqSystem<'a, D> {
         Ok(Self::new(make, base.ndof(), base.first_ball(), p0))
     }
 
-    /// A family given by its builder (e.g. another nondimensionalisation's parameters).
+    /// A family given by its builder (e.g. another nondimensionalisation's parameters,
+    /// as [`EqSystem::seed003`]).
     pub fn new(make: Maker<'a, D>, d: usize, o: usize, p0: f64) -> Self {
         EqSystem {
             make,
@@ -271,6 +273,32 @@ impl<'a, D: Dynamics + Clone> EqSystem<'a, D> {
     }
 }
 
+impl EqSystem<'static, Planar> {
+    /// The family of seed 003's balancer `base` in its own parameters `names` (one or
+    /// two of [`crate::model::seed003::SEED003_PARAMS`]): the planar model is rebuilt from the seed's values at
+    /// every point, so that `m0` moves `mu`, `eta`, `Omega`, `zeta` and `zeta_b` together.
+    /// Unknowns and coordinates stay the model's.
+    pub fn seed003(base: Seed003, names: &[&str]) -> Result<Self> {
+        if names.is_empty() || names.len() > 2 {
+            return Err(Error::param("parameter", "one or two parameters"));
+        }
+        let p0 = base.param_value(names[0])?;
+        for n in names {
+            base.param_value(n)?;
+        }
+        let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+        let make: Maker<'static, Planar> = Box::new(move |ps: &[f64]| {
+            let mut s = base;
+            for (n, v) in names.iter().zip(ps) {
+                s = s.with_param(n, *v)?;
+            }
+            s.planar()
+        });
+        let p = base.planar()?;
+        Ok(Self::new(make, p.ndof(), p.first_ball(), p0))
+    }
+}
+
 impl<'a, D: Dynamics + Clone> Problem for EqSystem<'a, D> {
     fn size(&self) -> usize {
         self.n()
@@ -330,6 +358,14 @@ pub fn bialternate(a: &[f64], n: usize) -> DMatrix<f64> {
 
 fn bialternate_det(a: &[f64], n: usize) -> f64 {
     bialternate(a, n).lu().determinant()
+}
+
+/// The number of singular values of the row-major `d x d` `k` below `1e-5` times the
+/// largest (the tolerance of the zero-eigenvalue count at a located point).
+fn kernel_dim(k: &[f64], d: usize) -> usize {
+    let sv = DMatrix::from_row_slice(d, d, k).singular_values();
+    let big = sv.iter().copied().fold(0.0, f64::max);
+    sv.iter().filter(|&&v| v <= 1e-5 * big).count()
 }
 
 /// `prod_{i<j} (l_i + l_j)` from the eigenvalues (real for a real matrix).
@@ -439,7 +475,10 @@ pub struct EqEvent {
 pub struct EqBranch {
     pub points: Vec<EqPoint>,
     pub events: Vec<EqEvent>,
+    /// Why the branch ended (for [`branch_both_ways`]: the half towards increasing `p`).
     pub stop: ArcStop,
+    /// For [`branch_both_ways`]: why the half towards decreasing `p` ended.
+    pub stop_back: Option<ArcStop>,
 }
 
 struct Tests {
@@ -612,6 +651,56 @@ pub fn branch<D: Dynamics + Clone>(
         points,
         events,
         stop,
+        stop_back: None,
+    })
+}
+
+/// [`branch`] both ways from the start (`opts.arc.forward` ignored): the rows run from
+/// the end reached towards decreasing `p` to the end reached towards increasing `p`, the
+/// start once, as one branch: the backward half's tangents, and the test functions that
+/// depend on their orientation (`dp/ds`, the bordered determinant), are reversed, and
+/// the events' `row`s renumbered.
+pub fn branch_both_ways<D: Dynamics + Clone>(
+    sys: &mut EqSystem<'_, D>,
+    x0: &[f64],
+    p0: f64,
+    start: EquilibriumKind,
+    opts: &EqOptions,
+) -> Result<EqBranch> {
+    let mut o = opts.clone();
+    o.arc.forward = false;
+    let mut back = branch(sys, x0, p0, start, None, &o)?;
+    o.arc.forward = true;
+    let fwd = branch(sys, x0, p0, start, None, &o)?;
+    let neg = |v: &mut Vec<f64>| v.iter_mut().for_each(|t| *t = -*t);
+    for pt in &mut back.points {
+        neg(&mut pt.tangent);
+        pt.fold = -pt.fold;
+        if pt.eq.kind != EquilibriumKind::Together {
+            pt.bp = -pt.bp;
+        }
+    }
+    for e in &mut back.events {
+        neg(&mut e.tangent);
+        let oriented = match e.kind {
+            EventKind::Fold => true,
+            EventKind::BranchPoint => e.eq.kind != EquilibriumKind::Together,
+            EventKind::Hopf => false,
+        };
+        if oriented {
+            e.test = -e.test;
+        }
+    }
+    let (points, events) = join_halves(
+        (back.points, back.events),
+        (fwd.points, fwd.events),
+        |e: &mut EqEvent| &mut e.row,
+    );
+    Ok(EqBranch {
+        points,
+        events,
+        stop: fwd.stop,
+        stop_back: Some(back.stop),
     })
 }
 
@@ -737,8 +826,10 @@ pub struct CurvePoint {
 /// A codimension-two point on a curve.
 #[derive(Debug, Clone)]
 pub struct Codim2 {
-    /// `"BT"` (double zero: Bogdanov–Takens type), `"ZH"` (zero-Hopf), `"cusp"`,
-    /// `"pitchfork"` / `"hopf"` (the curve meets that curve).
+    /// `"BT"` (a double zero eigenvalue with a Jordan block: Bogdanov–Takens), `"ZH"`
+    /// (zero-Hopf), `"cusp"`, `"pitchfork"` / `"saddle_node"` (the curve meets that
+    /// curve: for two balls at `(Omega, eta) = (1, 1/2)`, where the saddle-node and the
+    /// pitchfork share a double zero across the together subspace).
     pub kind: &'static str,
     pub p: [f64; 2],
     pub q: Vec<f64>,
@@ -808,7 +899,8 @@ fn codim_tests<D: Dynamics + Clone>(
             out.push(("ZH", s.det_jac(x, &p)?));
         }
         CurveKind::Pitchfork => {
-            out.push(("BT", s.det_jac(x, &p)?));
+            // the pitchfork curve meets the saddle-node curve (see `kernel_dim`)
+            out.push(("saddle_node", s.det_jac(x, &p)?));
             out.push(("hopf_test", s.hopf_test(&q, &p)?));
         }
     }
@@ -946,6 +1038,16 @@ fn curve_half<'a, D: Dynamics + Clone>(
                             let scale = ev.iter().map(|z| z.0.hypot(z.1)).fold(1.0, f64::max);
                             let zeros = ev.iter().filter(|z| z.0.hypot(z.1) < 1e-5 * scale).count();
                             if zeros >= 2 {
+                                // Two zero eigenvalues with a two-dimensional kernel of K
+                                // are two simultaneous zero-eigenvalue bifurcations, not a
+                                // Bogdanov–Takens point (a Jordan block, a one-dimensional
+                                // kernel): where the together branch's fold meets its
+                                // pitchfork the second zero belongs to the antisymmetric
+                                // ball mode, and the curve's other test flags the point.
+                                let (k, _, _) = s.kcm(&q, &[e.x[n], e.p])?;
+                                if kernel_dim(&k, s.d) >= 2 {
+                                    continue;
+                                }
                                 "BT"
                             } else if kappa > 0.0 {
                                 "ZH"
@@ -1176,13 +1278,67 @@ mod tests {
             worst = worst.max((pt.p[0] - eta_fold(pt.p[1], zeta)).abs());
         }
         assert!(worst < 1e-9, "{worst}");
-        assert!(
-            c.special
+        // The fold meets the pitchfork at (eta, Omega) = (1/2, 1): flagged once, as that
+        // (the Hopf test vanishes there too, by the antisymmetric mode's zero).
+        let at: Vec<_> = c
+            .special
+            .iter()
+            .filter(|s| (s.p[0] - 0.5).abs() < 1e-6 && (s.p[1] - 1.0).abs() < 1e-6)
+            .map(|s| s.kind)
+            .collect();
+        assert_eq!(at, ["pitchfork"], "{:?}", c.special);
+    }
+
+    #[test]
+    fn a_branch_both_ways_is_one_branch_through_its_start() {
+        let (om, zeta) = (1.05, 0.05);
+        let p = planar(om, 0.6, zeta);
+        let start = equilibria(&p)
+            .into_iter()
+            .find(|e| e.kind == EquilibriumKind::Together)
+            .unwrap();
+        let mut sys = EqSystem::family(&p, &["eta"]).unwrap();
+        let br = branch_both_ways(
+            &mut sys,
+            &start.q,
+            0.6,
+            EquilibriumKind::Together,
+            &opts(0.2, 1.0),
+        )
+        .unwrap();
+        // both halves: the pitchfork (eta = 1/2) lies below the start, the fold above
+        let bp = br
+            .events
+            .iter()
+            .find(|e| e.kind == EventKind::BranchPoint)
+            .unwrap();
+        let fold = br
+            .events
+            .iter()
+            .find(|e| e.kind == EventKind::Fold)
+            .unwrap();
+        assert!((bp.p - 0.5).abs() < 1e-9, "{}", bp.p);
+        assert!((fold.p - eta_fold(om, zeta)).abs() < 1e-8, "{}", fold.p);
+        assert!(br.stop_back.is_some());
+        for e in &br.events {
+            let (a, b) = (&br.points[e.row - 1], &br.points[e.row]);
+            assert!((a.p - e.p) * (b.p - e.p) <= 0.0 || e.kind == EventKind::Fold);
+        }
+        // consecutive tangents agree in orientation along the rows
+        for w in br.points.windows(2) {
+            let d: f64 = w[0]
+                .tangent
                 .iter()
-                .any(|s| (s.p[0] - 0.5).abs() < 1e-6 && (s.p[1] - 1.0).abs() < 1e-6),
-            "{:?}",
-            c.special.iter().map(|s| (s.kind, s.p)).collect::<Vec<_>>()
-        );
+                .zip(&w[1].tangent)
+                .map(|(a, b)| a * b)
+                .sum();
+            assert!(d > 0.0);
+        }
+        let i0 = br.points.iter().position(|q| q.p == 0.6).unwrap();
+        assert_eq!(br.points.iter().filter(|q| q.p == 0.6).count(), 1);
+        assert!(br.points[..i0]
+            .iter()
+            .all(|q| q.p < 0.6 || q.tangent[4] < 0.0));
     }
 
     #[test]

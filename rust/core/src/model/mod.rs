@@ -15,6 +15,7 @@ pub mod layout;
 pub mod params;
 pub mod planar;
 pub mod scene;
+pub mod seed003;
 #[rustfmt::skip]
 pub mod tilt_terms;
 
@@ -24,3 +25,4 @@ pub use layout::Layout;
 pub use params::{ParamId, ParamRef};
 pub use planar::Planar;
 pub use scene::{Scene, SpringLayout};
+pub use seed003::Seed003;
