@@ -248,6 +248,8 @@ struct ReturnWatch {
     /// crossing and how many returns in a row were close.
     last: Vec<Option<Vec<f64>>>,
     calm: Vec<usize>,
+    /// `x'` at the last step's end.
+    xdot: f64,
     tmp: Vec<f64>,
 }
 
@@ -262,6 +264,7 @@ impl ReturnWatch {
             turn: y0[o..d].iter().map(|b| (b / (2.0 * PI)).floor()).collect(),
             last: vec![None; d - o + 1],
             calm: vec![0; d - o + 1],
+            xdot: y0[d],
             tmp: vec![0.0; 2 * d],
         }
     }
@@ -280,10 +283,10 @@ impl ReturnWatch {
             self.turn[i] = k;
             done |= self.section(i, ta, tb, dense, |y| y[o + i] - level);
         }
-        dense.eval(ta, &mut self.tmp);
-        if self.tmp[d] > 0.0 && end[d] <= 0.0 {
+        if self.xdot > 0.0 && end[d] <= 0.0 {
             done |= self.section(d - o, ta, tb, dense, |y| y[d]);
         }
+        self.xdot = end[d];
         done
     }
 
