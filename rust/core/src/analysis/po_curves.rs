@@ -1905,6 +1905,59 @@ mod tests {
             .unwrap()
     }
 
+    /// The whirl branch in zeta from 0.3 down to `lo` at rho 0.5 (N harmonics).
+    fn whirl_branch(n: usize, lo: f64) -> (crate::Scene, crate::analysis::po_branch::PoBranch) {
+        let sc = whirl_scene(0.3, 0.5);
+        let mut o = branch_opts(n, lo, 0.3);
+        o.arc.forward = false;
+        // zeta 0.3: the whirl attracts strongly (pair 0.95), a short simulation finds it
+        o.periodic.guess.settle = 200.0;
+        o.periodic.guess.window = 100.0;
+        let start = periodic(&sc, &[false, false], None, &o.periodic);
+        assert_eq!(start.sol.status, Status::Converged);
+        let b = periodic_branch(&sc, "zeta", &start.sol, &o).unwrap();
+        (sc, b)
+    }
+
+    /// Along the NS curve in (zeta, rho), the monodromy of every point's series (the
+    /// variational equations integrated by RK45, not the Hill matrix the curve is defined
+    /// by) has a complex pair on the unit circle at the curve's angle.
+    #[test]
+    fn neimark_sacker_curve_points_have_a_monodromy_pair_on_the_unit_circle() {
+        let (sc, b) = whirl_branch(5, 0.12);
+        let e = b
+            .events
+            .iter()
+            .find(|e| e.kind == PoEventKind::NeimarkSacker)
+            .expect("an NS event");
+        let base = sc.with_param("zeta", e.p).unwrap();
+        let mut co = curve_opts(5, (0.05, 0.3), (0.48, 0.52), 3);
+        (co.arc.ds, co.arc.ds_max) = (0.01, 0.02);
+        let c = periodic_curve(
+            &base,
+            ["zeta", "rho"],
+            PoCurveKind::NeimarkSacker,
+            &e.point.result.sol,
+            &co,
+        )
+        .unwrap();
+        assert!(c.points.len() >= 4, "{:?}", c.stop);
+        for pt in &c.points {
+            let theta = pt.theta.expect("an NS curve's angle");
+            let m = &pt.result.floquet.as_ref().expect("multipliers").multipliers;
+            let z = m
+                .iter()
+                .filter(|z| z.1 > 1e-9)
+                .min_by(|a, b| {
+                    let d = |z: &&(f64, f64)| (z.0.hypot(z.1) - 1.0).abs();
+                    d(a).total_cmp(&d(b))
+                })
+                .expect("a complex pair");
+            assert!((z.0.hypot(z.1) - 1.0).abs() < 1e-6, "{z:?} at {:?}", pt.p);
+            assert!((z.1.atan2(z.0) - theta).abs() < 1e-5, "{z:?} {theta}");
+        }
+    }
+
     /// Measurement: `cargo test --release -p ballbal-core explore_ns -- --ignored
     /// --nocapture`.
     #[test]
@@ -1912,12 +1965,7 @@ mod tests {
     fn explore_ns() {
         let n: usize = std::env::var("N").ok().and_then(|v| v.parse().ok()).unwrap_or(6);
         let t = std::time::Instant::now();
-        let sc = whirl_scene(0.3, 0.5);
-        let mut o = branch_opts(n, 0.05, 0.3);
-        o.arc.forward = false;
-        let start = periodic(&sc, &[false, false], None, &o.periodic);
-        println!("start {:?} omega {} {:?}", start.sol.status, start.sol.omega, t.elapsed());
-        let b = periodic_branch(&sc, "zeta", &start.sol, &o).unwrap();
+        let (sc, b) = whirl_branch(n, 0.05);
         println!("{} points {:?} stop {}", b.points.len(), t.elapsed(), b.stop);
         for e in &b.events {
             println!("EVENT {} p={:.9} w={}", e.kind.as_str(), e.p, e.point.omega());
@@ -1998,6 +2046,7 @@ mod tests {
         let mut o3 = o.clone();
         o3.locate_tol = -1.0;
         assert_eq!(name(["Omega", "eta"], &sol, &o3), "locate_tol");
-        assert!(PoCurveKind::parse("NS").is_err());
+        assert!(PoCurveKind::parse("XX").is_err());
+        assert_eq!(PoCurveKind::parse("NS").ok(), Some(PoCurveKind::NeimarkSacker));
     }
 }
