@@ -4,9 +4,9 @@ Omega 2, an external damper zeta; the balls rock, O-O) has a complex pair of mul
 that leaves the unit circle between zeta 0.100 and 0.136. Checked against shooting
 written here (flows over one period by ballbal.simulate, the monodromy by central
 differences of the flows, Newton on the closure: no harmonic balance, Hill matrix or
-variational equations of the package), and against one-parameter branches run at a curve point's second
-parameter (event location on the monodromy's multipliers, a different computation from
-the curve's Hill matrix)."""
+variational equations of the package), and against one-parameter branches run at a curve
+point's second parameter (event location on the monodromy's multipliers, a different
+computation from the curve's Hill matrix)."""
 
 from __future__ import annotations
 

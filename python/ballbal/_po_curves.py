@@ -1,6 +1,6 @@
 """Two-parameter curves of bifurcations of periodic solutions (folds ``LP``, branch
-points of merged balls ``BP``, period doublings ``PD``, Neimark–Sacker ``NS``): a minimally augmented
-harmonic-balance system continued by pseudo-arclength
+points of merged balls ``BP``, period doublings ``PD``, Neimark–Sacker ``NS``): a
+minimally augmented harmonic-balance system continued by pseudo-arclength
 (``rust/core/src/analysis/po_curves.rs``), from an event of a periodic branch.
 """
 

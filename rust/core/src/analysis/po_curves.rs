@@ -664,7 +664,6 @@ struct Sampled {
     qtt: Vec<f64>,
 }
 
-
 impl<'a, D: Parametric> PoSystem<'a, D> {
     /// The linearisation about the full series `xf` (plus `pert`, per sample) at `p`.
     fn sampled(&mut self, xf: &[f64], pert: Option<&[[f64; 3]]>, p: [f64; 2]) -> Result<Sampled> {
@@ -958,7 +957,11 @@ impl CBorder {
     /// `g` of `[[H, b], [c^H, 0]] [v; g] = e`; with `adjoint`, also `v` and `w` of
     /// `[[H, b], [c^H, 0]]^H [w; h] = e` (then `dg = -w^H dH v`).
     #[allow(clippy::type_complexity)]
-    fn solve(&self, h: &DMatrix<C64>, adjoint: bool) -> Option<(C64, Option<(Vec<C64>, Vec<C64>)>)> {
+    fn solve(
+        &self,
+        h: &DMatrix<C64>,
+        adjoint: bool,
+    ) -> Option<(C64, Option<(Vec<C64>, Vec<C64>)>)> {
         let m = h.nrows();
         let bm = self.matrix(h);
         let mut e = DVector::zeros(m + 1);
@@ -1198,7 +1201,10 @@ impl<'a, D: Parametric> Augmented<'a, D> {
     fn g_grad_ns(&mut self, y: &[f64], p2: f64) -> Result<GradCache> {
         let n = self.sys.n();
         let (p, theta) = ([y[n], p2], y[n + 1]);
-        let cb = self.cborder.clone().expect("complex borders of an NS curve");
+        let cb = self
+            .cborder
+            .clone()
+            .expect("complex borders of an NS curve");
         let xf = self.sys.full(&y[..n]);
         let h = self.sys.hill_ns(&xf, p, theta)?;
         let Some((g, Some((v, w)))) = cb.solve(&h, true) else {
@@ -1244,12 +1250,7 @@ impl<'a, D: Parametric> Augmented<'a, D> {
     /// The norm of the test functions' gradient over every unknown and `p2`.
     fn gradient_norm(&mut self, y: &[f64], p2: f64) -> Result<f64> {
         let c = self.at(y, p2)?;
-        Ok(c.grad
-            .iter()
-            .flatten()
-            .map(|g| g * g)
-            .sum::<f64>()
-            .sqrt())
+        Ok(c.grad.iter().flatten().map(|g| g * g).sum::<f64>().sqrt())
     }
 
     /// Borders from the null and adjoint vectors at a curve point.
@@ -1963,12 +1964,25 @@ mod tests {
     #[test]
     #[ignore]
     fn explore_ns() {
-        let n: usize = std::env::var("N").ok().and_then(|v| v.parse().ok()).unwrap_or(6);
+        let n: usize = std::env::var("N")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(6);
         let t = std::time::Instant::now();
         let (sc, b) = whirl_branch(n, 0.05);
-        println!("{} points {:?} stop {}", b.points.len(), t.elapsed(), b.stop);
+        println!(
+            "{} points {:?} stop {}",
+            b.points.len(),
+            t.elapsed(),
+            b.stop
+        );
         for e in &b.events {
-            println!("EVENT {} p={:.9} w={}", e.kind.as_str(), e.p, e.point.omega());
+            println!(
+                "EVENT {} p={:.9} w={}",
+                e.kind.as_str(),
+                e.p,
+                e.point.omega()
+            );
         }
         let e = b
             .events
@@ -2047,6 +2061,9 @@ mod tests {
         o3.locate_tol = -1.0;
         assert_eq!(name(["Omega", "eta"], &sol, &o3), "locate_tol");
         assert!(PoCurveKind::parse("XX").is_err());
-        assert_eq!(PoCurveKind::parse("NS").ok(), Some(PoCurveKind::NeimarkSacker));
+        assert_eq!(
+            PoCurveKind::parse("NS").ok(),
+            Some(PoCurveKind::NeimarkSacker)
+        );
     }
 }
