@@ -1,5 +1,6 @@
 //! Two-parameter curves of bifurcations of periodic solutions: folds (`LP`), branch
-//! points of merged balls (`BP`) and period doublings (`PD`), continued in any two model
+//! points of merged balls (`BP`), period doublings (`PD`) and Neimark–Sacker points
+//! (`NS`), continued in any two model
 //! parameters `(p1, p2)` by pseudo-arclength on a minimally augmented system
 //!
 //! ```text
@@ -28,6 +29,14 @@
 //!   linearisation has a solution of period 2T that changes sign over T, i.e. a
 //!   multiplier -1, to the harmonic balance's own truncation. Its derivative uses the
 //!   same symmetry, on the state perturbed along the half-harmonic null vector.
+//!
+//! * `NS`: `H` is Hill's matrix of the linearisation on `e^{i (k + theta/2pi) tau}`
+//!   (`|k| <= N`), complex, singular when `e^{i theta}` is a multiplier. The bordered
+//!   system is complex; `Re g = Im g = 0` with `theta` an extra unknown next to
+//!   `(x, p1)`. `w^H H v` is a sampled sum over one period of the Floquet solution and
+//!   the adjoint (`PoSystem::ns_gradient`): its gradient needs four sweeps of the
+//!   model's Jacobians along `+-Re U`, `+-Im U`. The curve ends where `theta` reaches 0
+//!   or pi (strong resonances 1:1, 1:2); `R4`, `R3`, `LPNS`, `PDNS`, `BPNS` are flagged.
 //!
 //! Merged starts (all balls on one series) are continued on the together subspace for
 //! every kind, so that the balls stay merged. Codimension-two points flagged on the way
