@@ -1,6 +1,6 @@
 """Two-parameter curves of bifurcations of periodic solutions (folds ``LP``, branch
-points of merged balls ``BP``, period doublings ``PD``): a minimally augmented
-harmonic-balance system continued by pseudo-arclength
+points of merged balls ``BP``, period doublings ``PD``, Neimark–Sacker ``NS``): a
+minimally augmented harmonic-balance system continued by pseudo-arclength
 (``rust/core/src/analysis/po_curves.rs``), from an event of a periodic branch.
 """
 
@@ -22,7 +22,7 @@ from .options import PERIODIC_DEFAULTS, PeriodicOptions
 __all__ = ["periodic_curve"]
 
 #: Event types with a curve.
-_KINDS = ("LP", "BP", "PD")
+_KINDS = ("LP", "BP", "PD", "NS")
 
 
 def periodic_curve(
@@ -36,8 +36,8 @@ def periodic_curve(
     periodic_options: PeriodicOptions | None = None,
     locate_tol: float = 1e-8,
 ) -> Curve:
-    """The curve of the bifurcation ``branch.events[event_index]`` (``LP``, ``BP`` or
-    ``PD`` of a periodic branch) in (``branch.parameter``, ``parameter2``), continued
+    """The curve of the bifurcation ``branch.events[event_index]`` (``LP``, ``BP``, ``PD``
+    or ``NS`` of a periodic branch) in (``branch.parameter``, ``parameter2``), continued
     both ways from the event over ``range`` in ``parameter2`` and ``range1`` in the
     branch's parameter (default: the branch's range), with the branch's harmonics.
 
@@ -45,14 +45,23 @@ def periodic_curve(
     function from a bordered matrix that is singular on it: the harmonic-balance
     Jacobian (``LP``), the separating mode's Galerkin block of merged balls (``BP``: the
     separation multiplier at +1), the linearisation's Galerkin matrix on half harmonics
-    (``PD``: a multiplier at -1). A merged start is continued with its balls merged.
+    (``PD``: a multiplier at -1), Hill's matrix on the harmonics ``k + theta / 2 pi``
+    (``NS``: a complex pair ``e^{+-i theta}`` on the unit circle; the test function is
+    complex, and ``theta`` is an unknown of the curve next to the branch's parameter,
+    started where Hill's matrix at the event is closest to singular). A merged start is
+    continued with its balls merged.
 
     ``table``: one row per point (the two parameters, ``omega``, ``period``, status,
     stability and multipliers with ``periodic_options``, ``test`` (the curve's own test
     function, ~0), ``test_*`` (the other kinds' determinants, whose sign changes are the
     codimension-two points), ``flag`` (the codimension-two points located since the
-    previous row)). ``points``: the codimension-two points (``CP`` cusp of an LP curve,
-    ``BP`` / ``LP`` / ``PD`` where the curve meets that curve, ``LPPD`` fold–flip).
+    previous row)); an ``NS`` curve also has ``theta``, the critical pair's angle in
+    ``(0, pi)``. ``points``: the codimension-two points (``CP`` cusp of an LP curve,
+    ``BP`` / ``LP`` / ``PD`` where the curve meets that curve, ``LPPD`` fold–flip; on an
+    ``NS`` curve ``LPNS`` fold–Neimark–Sacker, ``PDNS`` flip–Neimark–Sacker, ``BPNS`` and
+    the strong resonances ``R4`` (``theta = pi/2``) and ``R3`` (``theta = 2 pi/3``)). An
+    ``NS`` curve ends with ``"resonance_1:1"`` / ``"resonance_1:2"`` where ``theta``
+    reaches 0 or pi (the pair meets the real axis).
     ``meta["solutions"]``: the :class:`~ballbal.PeriodicSolution` of every row.
     """
     if not isinstance(branch, Branch) or branch.kind != "periodic":
@@ -98,6 +107,7 @@ def periodic_curve(
         r = min(int(s["row"]), len(pts) - 1)
         flags[r] = s["type"] if flags[r] is None else f"{flags[r]},{s['type']}"
     tests = sorted({k for p in pts for k in p if k.startswith("test_")})
+    ns = kind == "NS"
     rows = []
     for p, flag in zip(pts, flags, strict=True):
         re_, im = _multipliers(p)
@@ -108,13 +118,15 @@ def periodic_curve(
             "status": p["status"], "stability": p["stability"],
             "max_modulus": p["max_modulus"], "mult_re": re_, "mult_im": im,
             "trivial_error": p["trivial_error"], "closure": p["closure"],
-            "test": p["test"], **{t: p.get(t) for t in tests}, "flag": flag,
+            "test": p["test"], **({"theta": p["theta"]} if ns else {}),
+            **{t: p.get(t) for t in tests}, "flag": flag,
         })
     f, s_, lf = pl.Float64, pl.Utf8, pl.List(pl.Float64)
     schema: dict[str, Any] = {p1: f, p2: f, "omega": f, "period": f, "status": s_,
                               "stability": s_, "max_modulus": f, "mult_re": lf,
                               "mult_im": lf, "trivial_error": f, "closure": f, "test": f,
-                              **{t: f for t in tests}, "flag": s_}
+                              **({"theta": f} if ns else {}), **{t: f for t in tests},
+                              "flag": s_}
     table = pl.DataFrame(rows, schema=schema, orient="row")
     sp = d["special"]
     points = pl.DataFrame({

@@ -16,10 +16,11 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// Continues the curve of `kind` (`"LP"`, `"BP"`, `"PD"`) through the event solution
+/// Continues the curve of `kind` (`"LP"`, `"BP"`, `"PD"`, `"NS"`) through the event solution
 /// `start = (omega, coeffs, winding)` of `model` (at the event's parameter values) in
 /// `(parameter, parameter2)`; `range` bounds `parameter2`, `range1` `parameter`. Returns
-/// `{"kind", "together", "points": [dict], "special": [dict], "stop": str}`.
+/// `{"kind", "together", "points": [dict], "special": [dict], "stop": str}`; an `NS`
+/// curve's points carry `"theta"`, the critical pair's angle.
 #[pyfunction]
 #[pyo3(signature = (model, kind, parameter, parameter2, start, range, range1, continuation, options, locate_tol))]
 #[allow(clippy::too_many_arguments)]
@@ -84,6 +85,9 @@ pub fn periodic_curve<'py>(
         d.set_item("p1", pt.p[0])?;
         d.set_item("p2", pt.p[1])?;
         d.set_item("test", pt.g)?;
+        if let Some(t) = pt.theta {
+            d.set_item("theta", t)?;
+        }
         for (name, v) in pt.tests {
             d.set_item(format!("test_{name}"), v)?;
         }

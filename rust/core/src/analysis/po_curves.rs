@@ -1,5 +1,6 @@
 //! Two-parameter curves of bifurcations of periodic solutions: folds (`LP`), branch
-//! points of merged balls (`BP`) and period doublings (`PD`), continued in any two model
+//! points of merged balls (`BP`), period doublings (`PD`) and Neimark–Sacker points
+//! (`NS`), continued in any two model
 //! parameters `(p1, p2)` by pseudo-arclength on a minimally augmented system
 //!
 //! ```text
@@ -29,6 +30,14 @@
 //!   multiplier -1, to the harmonic balance's own truncation. Its derivative uses the
 //!   same symmetry, on the state perturbed along the half-harmonic null vector.
 //!
+//! * `NS`: `H` is Hill's matrix of the linearisation on `e^{i (k + theta/2pi) tau}`
+//!   (`|k| <= N`), complex, singular when `e^{i theta}` is a multiplier. The bordered
+//!   system is complex; `Re g = Im g = 0` with `theta` an extra unknown next to
+//!   `(x, p1)`. `w^H H v` is a sampled sum over one period of the Floquet solution and
+//!   the adjoint (`PoSystem::ns_gradient`): its gradient needs four sweeps of the
+//!   model's Jacobians along `+-Re U`, `+-Im U`. The curve ends where `theta` reaches 0
+//!   or pi (strong resonances 1:1, 1:2); `R4`, `R3`, `LPNS`, `PDNS`, `BPNS` are flagged.
+//!
 //! Merged starts (all balls on one series) are continued on the together subspace for
 //! every kind, so that the balls stay merged. Codimension-two points flagged on the way
 //! (sign changes of the other kinds' determinants, located in arclength): on an `LP`
@@ -43,7 +52,7 @@ use crate::error::{Error, Result};
 use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
 use crate::numerics::problem::{Parametric, Problem};
 use crate::periodic::{finish, Periodic, PeriodicOptions};
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{Complex, DMatrix, DVector};
 use std::f64::consts::PI;
 
 /// The bifurcation a curve continues.
@@ -52,6 +61,7 @@ pub enum PoCurveKind {
     Fold,
     BranchPoint,
     PeriodDoubling,
+    NeimarkSacker,
 }
 
 impl PoCurveKind {
@@ -60,6 +70,7 @@ impl PoCurveKind {
             PoCurveKind::Fold => "LP",
             PoCurveKind::BranchPoint => "BP",
             PoCurveKind::PeriodDoubling => "PD",
+            PoCurveKind::NeimarkSacker => "NS",
         }
     }
 
@@ -68,10 +79,11 @@ impl PoCurveKind {
             "LP" => Ok(PoCurveKind::Fold),
             "BP" => Ok(PoCurveKind::BranchPoint),
             "PD" => Ok(PoCurveKind::PeriodDoubling),
+            "NS" => Ok(PoCurveKind::NeimarkSacker),
             _ => Err(Error::param_range(
                 "kind",
                 format!("no curve of {name:?} events"),
-                "LP, BP, PD",
+                "LP, BP, PD, NS",
             )),
         }
     }
@@ -280,6 +292,7 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 let half = Table::new(Basis::Half, self.n_harm, self.samples, 1);
                 self.galerkin(&xf, None, p, &half, &half, false, 1)
             }
+            PoCurveKind::NeimarkSacker => Err(complex_kind()),
         }
     }
 
@@ -461,6 +474,7 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                     grad[n + k] = uv.dot(&((a - b) * &vv)) / (2.0 * hp);
                 }
             }
+            PoCurveKind::NeimarkSacker => return Err(complex_kind()),
         }
         Ok(grad)
     }
@@ -497,12 +511,15 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
     }
 
     /// Signs of the other kinds' determinants (rows scaled to unit max-norm: the sign is
-    /// kept and the value stays in range), for codimension-two points.
+    /// kept and the value stays in range), for codimension-two points; on an `NS` curve
+    /// (`theta` its angle) also `theta - pi/2` and `theta - 2 pi/3`, the strong
+    /// resonances 1:4 and 1:3.
     fn secondary(
         &mut self,
         kind: PoCurveKind,
         x: &[f64],
         p: [f64; 2],
+        theta: Option<f64>,
     ) -> Result<Vec<(&'static str, f64)>> {
         let mut out = vec![];
         let kinds: &[(PoCurveKind, &'static str)] = match kind {
@@ -518,6 +535,11 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 (PoCurveKind::Fold, "LPPD"),
                 (PoCurveKind::BranchPoint, "BP"),
             ],
+            PoCurveKind::NeimarkSacker => &[
+                (PoCurveKind::Fold, "LPNS"),
+                (PoCurveKind::PeriodDoubling, "PDNS"),
+                (PoCurveKind::BranchPoint, "BPNS"),
+            ],
         };
         for &(k, label) in kinds {
             if k == PoCurveKind::BranchPoint && !self.reduced {
@@ -525,6 +547,10 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
             }
             let m = self.test_matrix(k, x, p)?;
             out.push((label, scaled_det(m)));
+        }
+        if let Some(t) = theta {
+            out.push(("R4", t - PI / 2.0));
+            out.push(("R3", t - 2.0 * PI / 3.0));
         }
         Ok(out)
     }
@@ -550,6 +576,13 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
             pivot_ratio: f64::NAN,
         }
     }
+}
+
+fn complex_kind() -> Error {
+    Error::param(
+        "kind",
+        "the Neimark–Sacker test matrix is complex: it has no real test matrix",
+    )
 }
 
 fn scaled_det(mut m: DMatrix<f64>) -> f64 {
@@ -618,6 +651,419 @@ impl Table {
     fn weight(&self, i: usize, r: usize) -> f64 {
         self.wgt[i * self.width + r]
     }
+}
+
+/// Complex numbers of the Neimark–Sacker test matrix.
+type C64 = Complex<f64>;
+
+/// The orbit's linearisation sampled over one period, `L u = K u + omega C u' +
+/// omega^2 M u''` (tau-derivatives): per sample `K`, `omega C` and `omega^2 M`
+/// (row-major `d x d`), with the state `(q, q', q'')` it was taken at.
+struct Sampled {
+    s: usize,
+    d: usize,
+    om: f64,
+    k: Vec<f64>,
+    c: Vec<f64>,
+    m: Vec<f64>,
+    /// The unscaled `C` and `M` and the state's tau-derivatives, for the omega column.
+    cc: Vec<f64>,
+    mm: Vec<f64>,
+    qt: Vec<f64>,
+    qtt: Vec<f64>,
+}
+
+impl<'a, D: Parametric> PoSystem<'a, D> {
+    /// The linearisation about the full series `xf` (plus `pert`, per sample) at `p`.
+    fn sampled(&mut self, xf: &[f64], pert: Option<&[[f64; 3]]>, p: [f64; 2]) -> Result<Sampled> {
+        let (d, l, s) = (self.d, self.l, self.samples);
+        let om = xf[d * l];
+        self.model(p)?;
+        let m = &self.cache.as_ref().unwrap().1;
+        let mut out = Sampled {
+            s,
+            d,
+            om,
+            k: vec![0.0; s * d * d],
+            c: vec![0.0; s * d * d],
+            m: vec![0.0; s * d * d],
+            cc: vec![0.0; s * d * d],
+            mm: vec![0.0; s * d * d],
+            qt: vec![0.0; s * d],
+            qtt: vec![0.0; s * d],
+        };
+        let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+        let (mut v, mut a) = (vec![0.0; d], vec![0.0; d]);
+        for i in 0..s {
+            let tau = 2.0 * PI * i as f64 / s as f64;
+            let sc = tau.sin_cos();
+            for j in 0..d {
+                let (x0, x1, x2) =
+                    eval_series_sc(&xf[j * l..(j + 1) * l], self.winding[j], tau, sc);
+                (q[j], qt[j], qtt[j]) = (x0, x1, x2);
+                if let Some(e) = pert {
+                    let [u0, u1, u2] = e[i * d + j];
+                    q[j] += u0;
+                    qt[j] += u1;
+                    qtt[j] += u2;
+                }
+                v[j] = om * qt[j];
+                a[j] = om * om * qtt[j];
+            }
+            let o = i * d * d;
+            m.jacobians(
+                tau / om,
+                &q,
+                &v,
+                &a,
+                &mut out.k[o..o + d * d],
+                &mut out.cc[o..o + d * d],
+                &mut out.mm[o..o + d * d],
+            );
+            for r in o..o + d * d {
+                out.c[r] = om * out.cc[r];
+                out.m[r] = om * om * out.mm[r];
+            }
+            out.qt[i * d..(i + 1) * d].copy_from_slice(&qt);
+            out.qtt[i * d..(i + 1) * d].copy_from_slice(&qtt);
+        }
+        if crate::cancel::cancelled() {
+            return Err(Error::Cancelled);
+        }
+        Ok(out)
+    }
+
+    /// Hill's matrix of the linearisation at the multiplier `e^{i theta}`: the Galerkin
+    /// matrix on `e^{i (c + nu) tau}` (`|c| <= N`, `nu = theta / 2 pi`), rows
+    /// `e^{-i (r + nu) tau}`, index `j (2N + 1) + c + N` per coordinate `j`. It is
+    /// singular when the linearisation has a solution `e^{i nu tau} P(tau)` with `P`
+    /// periodic, i.e. a multiplier `e^{i theta}`, to the harmonic balance's truncation.
+    fn hill_ns(&mut self, xf: &[f64], p: [f64; 2], theta: f64) -> Result<DMatrix<C64>> {
+        let lin = self.sampled(xf, None, p)?;
+        Ok(hill_from(&lin, self.n_harm, theta))
+    }
+
+    /// The phase-free Floquet solution's sample values: per sample and coordinate
+    /// `(U, U', U'')` of `U = e^{i nu tau} P(tau)`, `P` the series `v` on `e^{i c tau}`,
+    /// and `conj(W)/S` of the adjoint series `w` likewise.
+    fn ns_samples(&self, theta: f64, v: &[C64], w: &[C64]) -> (Vec<[C64; 3]>, Vec<C64>) {
+        let (d, s, nh) = (self.d, self.samples, self.n_harm as i64);
+        let l = self.l;
+        let nu = theta / (2.0 * PI);
+        let iu = C64::new(0.0, 1.0);
+        let mut u = vec![[C64::new(0.0, 0.0); 3]; s * d];
+        let mut wc = vec![C64::new(0.0, 0.0); s * d];
+        for i in 0..s {
+            let tau = 2.0 * PI * i as f64 / s as f64;
+            let rot = C64::from_polar(1.0, nu * tau);
+            for j in 0..d {
+                let (mut p0, mut p1, mut p2) = (C64::default(), C64::default(), C64::default());
+                let mut ww = C64::default();
+                for c in -nh..=nh {
+                    let e = C64::from_polar(1.0, c as f64 * tau);
+                    let idx = j * l + (c + nh) as usize;
+                    let cf = c as f64;
+                    let t = v[idx] * e;
+                    p0 += t;
+                    p1 += t * iu * cf;
+                    p2 -= t * cf * cf;
+                    ww += w[idx] * e;
+                }
+                u[i * d + j] = [
+                    rot * p0,
+                    rot * (p1 + iu * nu * p0),
+                    rot * (p2 + 2.0 * iu * nu * p1 - nu * nu * p0),
+                ];
+                wc[i * d + j] = (rot * ww).conj() / s as f64;
+            }
+        }
+        (u, wc)
+    }
+
+    /// `d/dy (w^H H(y) v)` for the Neimark–Sacker matrix [`Self::hill_ns`], over this
+    /// system's unknowns, `p1`, `p2` and `theta` (in that order). `w^H H v` is the
+    /// sampled sum `sum_i conj(W(tau_i)) (L U)(tau_i) / S` of the Floquet solution `U`
+    /// and the adjoint `W` (the factors `e^{+- i nu tau}` cancel), and `L U` is the
+    /// residual's derivative along `U`: by the symmetry of second derivatives, its
+    /// gradient over the orbit is the harmonic-balance Jacobian's pointwise rows
+    /// differenced along `Re U` and `Im U`.
+    fn ns_gradient(
+        &mut self,
+        x: &[f64],
+        p: [f64; 2],
+        theta: f64,
+        v: &[C64],
+        w: &[C64],
+    ) -> Result<Vec<C64>> {
+        let n = self.n();
+        let (d, l, s, nh) = (self.d, self.l, self.samples, self.n_harm);
+        let xf = self.full(x);
+        let (u, wc) = self.ns_samples(theta, v, w);
+        let mut grad = vec![C64::default(); n + 3];
+        let h = DIR_STEP;
+        let whole = Table::new(Basis::Whole, nh, s, 1);
+        let mut gf = vec![C64::default(); self.nf()];
+        for (part, unit) in [(0usize, C64::new(1.0, 0.0)), (1, C64::new(0.0, 1.0))] {
+            for sign in [1.0, -1.0] {
+                let e: Vec<[f64; 3]> = u
+                    .iter()
+                    .map(|z| {
+                        let pick = |c: C64| sign * h * if part == 0 { c.re } else { c.im };
+                        [pick(z[0]), pick(z[1]), pick(z[2])]
+                    })
+                    .collect();
+                let lin = self.sampled(&xf, Some(&e), p)?;
+                let f = unit * (sign / (2.0 * h));
+                for i in 0..s {
+                    for j in 0..d {
+                        let a = wc[i * d + j] * f;
+                        let mut dfo = 0.0;
+                        for k in 0..d {
+                            let o = i * d * d + j * d + k;
+                            let (kv, cv, mv) = (lin.k[o], lin.c[o], lin.m[o]);
+                            dfo += lin.cc[o] * lin.qt[i * d + k]
+                                + 2.0 * lin.om * lin.mm[o] * lin.qtt[i * d + k];
+                            if kv == 0.0 && cv == 0.0 && mv == 0.0 {
+                                continue;
+                            }
+                            for c in 0..l {
+                                let (f0, f1, f2) = whole.at(i, c);
+                                gf[k * l + c] += a * (kv * f0 + cv * f1 + mv * f2);
+                            }
+                        }
+                        gf[d * l] += a * dfo;
+                    }
+                }
+            }
+        }
+        for (k, g) in gf.iter().enumerate() {
+            grad[self.map(k)] += g;
+        }
+        let phi = |lin: &Sampled| -> C64 {
+            let mut t = C64::default();
+            for i in 0..s {
+                for j in 0..d {
+                    let mut r = C64::default();
+                    for k in 0..d {
+                        let o = i * d * d + j * d + k;
+                        let z = u[i * d + k];
+                        r += z[0] * lin.k[o] + z[1] * lin.c[o] + z[2] * lin.m[o];
+                    }
+                    t += wc[i * d + j] * r;
+                }
+            }
+            t
+        };
+        for k in 0..2 {
+            let hp = 1e-6 * (1.0 + p[k].abs());
+            let (mut pp, mut pm) = (p, p);
+            pp[k] += hp;
+            pm[k] -= hp;
+            let a = self.sampled(&xf, None, pp)?;
+            let b = self.sampled(&xf, None, pm)?;
+            grad[n + k] = (phi(&a) - phi(&b)) / (2.0 * hp);
+        }
+        // d/dnu of e^{-i nu tau} L e^{i nu tau} is i (omega C + 2 omega^2 M d/dtau).
+        let lin = self.sampled(&xf, None, p)?;
+        let iu = C64::new(0.0, 1.0);
+        let mut t = C64::default();
+        for i in 0..s {
+            for j in 0..d {
+                let mut r = C64::default();
+                for k in 0..d {
+                    let o = i * d * d + j * d + k;
+                    let z = u[i * d + k];
+                    r += z[0] * lin.c[o] + z[1] * (2.0 * lin.m[o]);
+                }
+                t += wc[i * d + j] * iu * r;
+            }
+        }
+        grad[n + 2] = t / (2.0 * PI);
+        Ok(grad)
+    }
+}
+
+/// [`PoSystem::hill_ns`] from the sampled linearisation: with the samples' discrete
+/// Fourier coefficients `K_m = sum_i K(tau_i) e^{-i m tau_i} / S` (likewise `omega C`,
+/// `omega^2 M`), entry `(r, c)` of block `(j, k)` is
+/// `K_{r-c} + i (c + nu) C_{r-c} - (c + nu)^2 M_{r-c}`, the sampled Galerkin sum exactly.
+fn hill_from(lin: &Sampled, n_harm: usize, theta: f64) -> DMatrix<C64> {
+    let (d, s) = (lin.d, lin.s);
+    let nh = n_harm as i64;
+    let l = 2 * n_harm + 1;
+    let nu = theta / (2.0 * PI);
+    let nf = 4 * n_harm + 1;
+    // hat[(m + 2N) * d * d + jk] for K, C, M.
+    let mut hat = [
+        vec![C64::default(); nf * d * d],
+        vec![C64::default(); nf * d * d],
+        vec![C64::default(); nf * d * d],
+    ];
+    for i in 0..s {
+        let tau = 2.0 * PI * i as f64 / s as f64;
+        let o = i * d * d;
+        for (mi, m) in (-2 * nh..=2 * nh).enumerate() {
+            let e = C64::from_polar(1.0 / s as f64, -(m as f64) * tau);
+            for (src, dst) in [&lin.k, &lin.c, &lin.m].into_iter().zip(hat.iter_mut()) {
+                for jk in 0..d * d {
+                    let v = src[o + jk];
+                    if v != 0.0 {
+                        dst[mi * d * d + jk] += e * v;
+                    }
+                }
+            }
+        }
+    }
+    let iu = C64::new(0.0, 1.0);
+    DMatrix::from_fn(d * l, d * l, |row, col| {
+        let (j, r) = (row / l, row % l);
+        let (k, c) = (col / l, col % l);
+        let mi = (r as i64 - c as i64 + 2 * nh) as usize;
+        let jk = mi * d * d + j * d + k;
+        let f = c as f64 - nh as f64 + nu;
+        hat[0][jk] + iu * f * hat[1][jk] - f * f * hat[2][jk]
+    })
+}
+
+/// Complex borders of the Neimark–Sacker test matrix.
+#[derive(Debug, Clone)]
+struct CBorder {
+    b: DVector<C64>,
+    c: DVector<C64>,
+}
+
+impl CBorder {
+    fn from_svd(h: &DMatrix<C64>) -> Result<Self> {
+        let svd = h.clone().svd(true, true);
+        let (u, vt) = match (svd.u, svd.v_t) {
+            (Some(u), Some(vt)) => (u, vt),
+            _ => return Err(Error::Eigen("SVD of the test matrix failed".into())),
+        };
+        let k = svd
+            .singular_values
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, _)| i)
+            .unwrap_or(0);
+        Ok(CBorder {
+            b: u.column(k).into_owned(),
+            c: vt.row(k).adjoint(),
+        })
+    }
+
+    /// `[[H, b], [c^H, 0]]`.
+    fn matrix(&self, h: &DMatrix<C64>) -> DMatrix<C64> {
+        let m = h.nrows();
+        DMatrix::from_fn(m + 1, m + 1, |i, j| match (i < m, j < m) {
+            (true, true) => h[(i, j)],
+            (true, false) => self.b[i],
+            (false, true) => self.c[j].conj(),
+            (false, false) => C64::default(),
+        })
+    }
+
+    /// `g` of `[[H, b], [c^H, 0]] [v; g] = e`; with `adjoint`, also `v` and `w` of
+    /// `[[H, b], [c^H, 0]]^H [w; h] = e` (then `dg = -w^H dH v`).
+    #[allow(clippy::type_complexity)]
+    fn solve(
+        &self,
+        h: &DMatrix<C64>,
+        adjoint: bool,
+    ) -> Option<(C64, Option<(Vec<C64>, Vec<C64>)>)> {
+        let m = h.nrows();
+        let bm = self.matrix(h);
+        let mut e = DVector::zeros(m + 1);
+        e[m] = C64::new(1.0, 0.0);
+        let s = bm.clone().lu().solve(&e)?;
+        let g = s[m];
+        if !(g.re.is_finite() && g.im.is_finite()) {
+            return None;
+        }
+        if !adjoint {
+            return Some((g, None));
+        }
+        let t = bm.adjoint().lu().solve(&e)?;
+        Some((
+            g,
+            Some((
+                s.rows(0, m).iter().copied().collect(),
+                t.rows(0, m).iter().copied().collect(),
+            )),
+        ))
+    }
+
+    fn update(&mut self, v: &[C64], w: &[C64]) {
+        let nv = v.iter().map(|x| x.norm_sqr()).sum::<f64>().sqrt();
+        let nw = w.iter().map(|x| x.norm_sqr()).sum::<f64>().sqrt();
+        if nv > 0.0 && nw > 0.0 && nv.is_finite() && nw.is_finite() {
+            self.c = DVector::from_iterator(v.len(), v.iter().map(|x| x / nv));
+            self.b = DVector::from_iterator(w.len(), w.iter().map(|x| x / nw));
+        }
+    }
+}
+
+/// The angle in `(0, pi)` where Hill's matrix of [`PoSystem::hill_ns`] is closest to
+/// singular (smallest least singular value): the start's critical pair.
+fn start_angle<D: Parametric>(sys: &mut PoSystem<'_, D>, xf: &[f64], p: [f64; 2]) -> Result<f64> {
+    let lin = sys.sampled(xf, None, p)?;
+    let nh = sys.n_harm;
+    let smin = |t: f64| {
+        hill_from(&lin, nh, t)
+            .singular_values()
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b))
+    };
+    // Away from the trivial multiplier at 0 and the conjugate's copy at pi.
+    let (lo, hi, n) = (0.02, PI - 0.02, 120);
+    let grid: Vec<(f64, f64)> = (0..=n)
+        .map(|i| {
+            let t = lo + (hi - lo) * i as f64 / n as f64;
+            (t, smin(t))
+        })
+        .collect();
+    let mut best = (f64::NAN, f64::INFINITY);
+    for i in 0..=n {
+        let left = if i > 0 { grid[i - 1].1 } else { f64::INFINITY };
+        let right = if i < n { grid[i + 1].1 } else { f64::INFINITY };
+        if grid[i].1 > left || grid[i].1 > right {
+            continue;
+        }
+        // Golden section on the bracket around the grid's local minimum.
+        let step = (hi - lo) / n as f64;
+        let (mut a, mut b) = ((grid[i].0 - step).max(lo), (grid[i].0 + step).min(hi));
+        let r = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut c, mut e) = (b - r * (b - a), a + r * (b - a));
+        let (mut fc, mut fe) = (smin(c), smin(e));
+        for _ in 0..60 {
+            if fc < fe {
+                b = e;
+                (e, fe) = (c, fc);
+                c = b - r * (b - a);
+                fc = smin(c);
+            } else {
+                a = c;
+                (c, fc) = (e, fe);
+                e = a + r * (b - a);
+                fe = smin(e);
+            }
+            if b - a < 1e-12 {
+                break;
+            }
+        }
+        let t = 0.5 * (a + b);
+        let f = smin(t);
+        if f < best.1 {
+            best = (t, f);
+        }
+    }
+    if best.0.is_nan() {
+        return Err(Error::param(
+            "event",
+            "no complex pair of multipliers on the unit circle at the start",
+        ));
+    }
+    Ok(best.0)
 }
 
 /// Borders of a minimally augmented system: `b` (a column), `c` (a row).
@@ -699,11 +1145,14 @@ impl Border {
     }
 }
 
-/// `[F; g] = 0` as a [`Problem`] in `(x, p1)` with parameter `p2`.
+/// `[F; g] = 0` as a [`Problem`] in `(x, p1)` with parameter `p2`; for `NS` the test
+/// function is complex, `[F; Re g; Im g] = 0` in `(x, p1, theta)`.
 pub struct Augmented<'a, D: Parametric> {
     pub sys: PoSystem<'a, D>,
     kind: PoCurveKind,
     border: Border,
+    /// The complex borders of an `NS` curve (`border` is then unused).
+    cborder: Option<CBorder>,
     /// `g` is divided by its gradient's norm at the start: `|g|` is then about the
     /// distance from the curve, and the corrector's tolerance means the same for it.
     scale: f64,
@@ -713,18 +1162,34 @@ pub struct Augmented<'a, D: Parametric> {
     grad: Option<GradCache>,
 }
 
+fn singular_at(p: [f64; 2]) -> Error {
+    Error::param(
+        "test_function",
+        format!(
+            "the bordered test matrix is singular at ({}, {})",
+            p[0], p[1]
+        ),
+    )
+}
+
 impl<'a, D: Parametric> Augmented<'a, D> {
-    fn g(&mut self, x: &[f64], p: [f64; 2]) -> Result<f64> {
-        let h = self.sys.test_matrix(self.kind, x, p)?;
+    /// Test functions at `y = (x, p1[, theta])` (one, or `Re g, Im g` for `NS`).
+    fn g(&mut self, y: &[f64], p2: f64) -> Result<Vec<f64>> {
+        let n = self.sys.n();
+        let p = [y[n], p2];
+        if let Some(cb) = &self.cborder {
+            let cb = cb.clone();
+            let xf = self.sys.full(&y[..n]);
+            let h = self.sys.hill_ns(&xf, p, y[n + 1])?;
+            return match cb.solve(&h, false) {
+                Some((g, _)) => Ok(vec![g.re * self.scale, g.im * self.scale]),
+                None => Err(singular_at(p)),
+            };
+        }
+        let h = self.sys.test_matrix(self.kind, &y[..n], p)?;
         match self.border.solve(&h, false) {
-            Some((g, _)) => Ok(g * self.scale),
-            None => Err(Error::param(
-                "test_function",
-                format!(
-                    "the bordered test matrix is singular at ({}, {})",
-                    p[0], p[1]
-                ),
-            )),
+            Some((g, _)) => Ok(vec![g * self.scale]),
+            None => Err(singular_at(p)),
         }
     }
 
@@ -733,17 +1198,38 @@ impl<'a, D: Parametric> Augmented<'a, D> {
     fn g_grad(&mut self, x: &[f64], p: [f64; 2]) -> Result<(f64, Vec<f64>, Vec<f64>, Vec<f64>)> {
         let h = self.sys.test_matrix(self.kind, x, p)?;
         let Some((g, Some((v, w)))) = self.border.solve(&h, true) else {
-            return Err(Error::param(
-                "test_function",
-                format!(
-                    "the bordered test matrix is singular at ({}, {})",
-                    p[0], p[1]
-                ),
-            ));
+            return Err(singular_at(p));
         };
         let grad = self.sys.contracted_gradient(self.kind, x, p, &w, &v)?;
         let grad = grad.iter().map(|d| -d * self.scale).collect();
         Ok((g * self.scale, grad, v, w))
+    }
+
+    /// The complex `g`, its gradient over `(x, p1, p2, theta)` (rows `Re`, `Im`) and the
+    /// null / adjoint vectors, for `NS`.
+    fn g_grad_ns(&mut self, y: &[f64], p2: f64) -> Result<GradCache> {
+        let n = self.sys.n();
+        let (p, theta) = ([y[n], p2], y[n + 1]);
+        let cb = self
+            .cborder
+            .clone()
+            .expect("complex borders of an NS curve");
+        let xf = self.sys.full(&y[..n]);
+        let h = self.sys.hill_ns(&xf, p, theta)?;
+        let Some((g, Some((v, w)))) = cb.solve(&h, true) else {
+            return Err(singular_at(p));
+        };
+        let grad = self.sys.ns_gradient(&y[..n], p, theta, &v, &w)?;
+        let s = self.scale;
+        Ok(GradCache {
+            key: vec![],
+            g: vec![g.re * s, g.im * s],
+            grad: vec![
+                grad.iter().map(|d| -d.re * s).collect(),
+                grad.iter().map(|d| -d.im * s).collect(),
+            ],
+            null: Null::Complex(v, w),
+        })
     }
 
     /// `g`, its gradient and the null / adjoint vectors at `(y, p2)`, kept for the
@@ -753,37 +1239,67 @@ impl<'a, D: Parametric> Augmented<'a, D> {
         key.push(p2.to_bits());
         if self.grad.as_ref().is_none_or(|c| c.key != key) {
             let n = self.sys.n();
-            let (g, grad, v, w) = self.g_grad(&y[..n], [y[n], p2])?;
-            self.grad = Some(GradCache { key, g, grad, v, w });
+            let mut c = if self.cborder.is_some() {
+                self.g_grad_ns(y, p2)?
+            } else {
+                let (g, grad, v, w) = self.g_grad(&y[..n], [y[n], p2])?;
+                GradCache {
+                    key: vec![],
+                    g: vec![g],
+                    grad: vec![grad],
+                    null: Null::Real(v, w),
+                }
+            };
+            c.key = key;
+            self.grad = Some(c);
         }
         Ok(self.grad.as_ref().unwrap())
     }
 
-    fn gradient(&mut self, y: &[f64], p2: f64) -> Result<Vec<f64>> {
-        Ok(self.at(y, p2)?.grad.clone())
+    /// The norm of the test functions' gradient over every unknown and `p2`.
+    fn gradient_norm(&mut self, y: &[f64], p2: f64) -> Result<f64> {
+        let c = self.at(y, p2)?;
+        Ok(c.grad.iter().flatten().map(|g| g * g).sum::<f64>().sqrt())
     }
 
     /// Borders from the null and adjoint vectors at a curve point.
     fn rebase(&mut self, y: &[f64], p2: f64) -> Result<()> {
-        let c = self.at(y, p2)?;
-        let (v, w) = (c.v.clone(), c.w.clone());
-        self.border.update(&v, &w);
-        self.grad = None;
+        self.at(y, p2)?;
+        let c = self.grad.take().unwrap();
+        match &c.null {
+            Null::Real(v, w) => self.border.update(v, w),
+            Null::Complex(v, w) => {
+                if let Some(cb) = self.cborder.as_mut() {
+                    cb.update(v, w);
+                }
+            }
+        }
         Ok(())
     }
+
+    /// Extra unknowns beyond `(x, p1)`: `theta` for `NS`.
+    fn extra(&self) -> usize {
+        usize::from(self.cborder.is_some())
+    }
+}
+
+enum Null {
+    Real(Vec<f64>, Vec<f64>),
+    Complex(Vec<C64>, Vec<C64>),
 }
 
 struct GradCache {
     key: Vec<u64>,
-    g: f64,
-    grad: Vec<f64>,
-    v: Vec<f64>,
-    w: Vec<f64>,
+    /// One test function, or `Re g, Im g`.
+    g: Vec<f64>,
+    /// Their gradients over `(x, p1, p2[, theta])`.
+    grad: Vec<Vec<f64>>,
+    null: Null,
 }
 
 impl<D: Parametric> Problem for Augmented<'_, D> {
     fn size(&self) -> usize {
-        self.sys.n() + 1
+        self.sys.n() + 1 + self.extra()
     }
     fn param(&self) -> f64 {
         self.p2
@@ -792,12 +1308,14 @@ impl<D: Parametric> Problem for Augmented<'_, D> {
         let n = self.sys.n();
         let p = [y[n], p2];
         self.sys.eval(&y[..n], p, &mut r[..n], None)?;
-        r[n] = self.g(&y[..n], p)?;
+        let g = self.g(y, p2)?;
+        r[n..n + g.len()].copy_from_slice(&g);
         Ok(())
     }
     fn jac_x(&mut self, y: &[f64], p2: f64, r: &mut [f64], jac: &mut [f64]) -> Result<()> {
         let n = self.sys.n();
-        let n1 = n + 1;
+        let e = self.extra();
+        let n1 = n + 1 + e;
         let p = [y[n], p2];
         let mut jx = vec![0.0; n * n];
         self.sys.eval(&y[..n], p, &mut r[..n], Some(&mut jx))?;
@@ -805,17 +1323,29 @@ impl<D: Parametric> Problem for Augmented<'_, D> {
         for i in 0..n {
             jac[i * n1..i * n1 + n].copy_from_slice(&jx[i * n..(i + 1) * n]);
             jac[i * n1 + n] = fp[i];
+            if e == 1 {
+                jac[i * n1 + n + 1] = 0.0;
+            }
         }
         let c = self.at(y, p2)?;
-        r[n] = c.g;
-        jac[n * n1..n * n1 + n1].copy_from_slice(&c.grad[..n1]);
+        for (k, (g, grad)) in c.g.iter().zip(&c.grad).enumerate() {
+            let row = (n + k) * n1;
+            r[n + k] = *g;
+            jac[row..row + n + 1].copy_from_slice(&grad[..n + 1]);
+            if e == 1 {
+                jac[row + n + 1] = grad[n + 2];
+            }
+        }
         Ok(())
     }
     fn jac_p(&mut self, y: &[f64], p2: f64, out: &mut [f64]) -> Result<()> {
         let n = self.sys.n();
         let fp = self.f_p(&y[..n], [y[n], p2], 1)?;
         out[..n].copy_from_slice(&fp);
-        out[n] = self.gradient(y, p2)?[n + 1];
+        let c = self.at(y, p2)?;
+        for (k, grad) in c.grad.iter().enumerate() {
+            out[n + k] = grad[n + 1];
+        }
         Ok(())
     }
 }
@@ -865,8 +1395,11 @@ pub struct PoCurvePoint {
     pub p: [f64; 2],
     /// The series, certified and judged as `periodic()` does.
     pub result: Periodic,
-    /// The curve's own test function (normalised), zero to the corrector's tolerance.
+    /// The curve's own test function (normalised; for `NS` the modulus of the complex
+    /// one), zero to the corrector's tolerance.
     pub g: f64,
+    /// `NS`: the critical pair's angle, multipliers `e^{+- i theta}` (`0 < theta < pi`).
+    pub theta: Option<f64>,
     /// The other kinds' determinants (their sign changes are codimension-two points).
     pub tests: Vec<(&'static str, f64)>,
 }
@@ -975,9 +1508,18 @@ pub fn periodic_curve<D: Parametric>(
         ));
     }
     let mut sys = PoSystem::new(base, names, &first.winding, n_harm, samples, together);
-    let x0 = sys.reduce(&first.unknowns());
-    let h0 = sys.test_matrix(kind, &x0, p0)?;
-    let border = Border::from_svd(&h0)?;
+    let mut x0 = sys.reduce(&first.unknowns());
+    let border = if kind == PoCurveKind::NeimarkSacker {
+        let xf = sys.full(&x0);
+        let theta = start_angle(&mut sys, &xf, p0)?;
+        let h0 = sys.hill_ns(&xf, p0, theta)?;
+        // theta rides after x and p1 in the augmented unknowns: `half` splits it off.
+        x0.push(theta);
+        Borders::Complex(CBorder::from_svd(&h0)?)
+    } else {
+        let h0 = sys.test_matrix(kind, &x0, p0)?;
+        Borders::Real(Border::from_svd(&h0)?)
+    };
     let mut o = opts.clone();
     o.arc.forward = false;
     let (back, sys) = half(sys, kind, &x0, p0, border.clone(), &o, &popts)?;
@@ -1000,28 +1542,51 @@ pub fn periodic_curve<D: Parametric>(
 
 type Half<'a, D> = (PoCurve, PoSystem<'a, D>);
 
+/// The start's borders: real, or complex for `NS`.
+#[derive(Debug, Clone)]
+enum Borders {
+    Real(Border),
+    Complex(CBorder),
+}
+
+/// On an `NS` curve closer than this to 0 or pi, the pair meets the real axis (strong
+/// resonance 1:1 or 1:2) and the curve ends.
+const THETA_END: f64 = 1e-3;
+
 fn half<'a, D: Parametric>(
     sys: PoSystem<'a, D>,
     kind: PoCurveKind,
     x0: &[f64],
     p0: [f64; 2],
-    border: Border,
+    border: Borders,
     opts: &PoCurveOptions,
     popts: &PeriodicOptions,
 ) -> Result<Half<'a, D>> {
     let n = sys.n();
+    let (border, cborder) = match border {
+        Borders::Real(b) => (b, None),
+        Borders::Complex(c) => (
+            Border {
+                b: DVector::zeros(0),
+                c: DVector::zeros(0),
+            },
+            Some(c),
+        ),
+    };
+    let ns = cborder.is_some();
     let mut ext = Augmented {
         sys,
         kind,
         border,
+        cborder,
         scale: 1.0,
         p2: p0[1],
         grad: None,
     };
-    let mut y0 = x0.to_vec();
+    let mut y0 = x0[..n].to_vec();
     y0.push(p0[0]);
-    let grad = ext.gradient(&y0, p0[1])?;
-    let norm = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
+    y0.extend_from_slice(&x0[n..]);
+    let norm = ext.gradient_norm(&y0, p0[1])?;
     if !(norm > 0.0 && norm.is_finite()) {
         return Err(Error::param(
             "event",
@@ -1053,7 +1618,18 @@ fn half<'a, D: Parametric>(
             arc.finish("omega_vanishes");
             break;
         }
-        let tt = arc.problem().sys.secondary(kind, &pt.x[..n], p)?;
+        let theta = ns.then(|| pt.x[n + 1]);
+        if let Some(t) = theta {
+            if t < THETA_END {
+                arc.finish("resonance_1:1");
+                break;
+            }
+            if t > PI - THETA_END {
+                arc.finish("resonance_1:2");
+                break;
+            }
+        }
+        let tt = arc.problem().sys.secondary(kind, &pt.x[..n], p, theta)?;
         let row = points.len();
         if let Some((a, ta)) = &prev {
             for (i, ((label, ga), (_, gb))) in ta.iter().zip(&tt).enumerate() {
@@ -1062,7 +1638,7 @@ fn half<'a, D: Parametric>(
                 }
                 let g = |e: &mut Augmented<'_, D>, pt: &ArcPoint| {
                     e.sys
-                        .secondary(kind, &pt.x[..n], [pt.x[n], pt.p])
+                        .secondary(kind, &pt.x[..n], [pt.x[n], pt.p], ns.then(|| pt.x[n + 1]))
                         .map(|v| v[i].1)
                 };
                 if let Some((e, _)) = locate(
@@ -1133,7 +1709,8 @@ fn half<'a, D: Parametric>(
         let sol = prob.sys.series(&pt.x[..n], pt.residual);
         let model = prob.sys.model(p)?.clone();
         let result = finish(&model, sol, popts);
-        let g = prob.g(&pt.x[..n], p)?;
+        let g = prob.g(&pt.x, pt.p)?;
+        let g = if ns { g[0].hypot(g[1]) } else { g[0] };
         // New borders for the next step (the curve is the same set: g = 0 iff H is
         // singular, whatever the borders).
         prob.rebase(&pt.x, pt.p)?;
@@ -1141,6 +1718,7 @@ fn half<'a, D: Parametric>(
             p,
             result,
             g,
+            theta,
             tests: tt.clone(),
         });
         prev = Some((pt, tt));
@@ -1318,6 +1896,144 @@ mod tests {
         }
     }
 
+    /// A balancer on Ocvirk's short bearing (L/D 1/2, rho = e/c) with an external damper
+    /// `zeta`, at Omega 2: the oil-whirl orbit (balls rocking, O-O) has a complex pair
+    /// that leaves the unit circle between zeta 0.100 and 0.136 at rho 0.5.
+    fn whirl_scene(zeta: f64, rho: f64) -> crate::Scene {
+        use crate::model::bearing::{Bearing, Cavitation, FilmModel};
+        use crate::model::components::{JournalSupport, SupportFilm};
+        let p = Planar::new(0.2, zeta, &[0.1], 50.0, 2.0, &[1.0, 1.0]).unwrap();
+        let film = SupportFilm::Reynolds(Bearing {
+            lambda: 0.5,
+            grooves: None,
+            cavitation: Cavitation::HalfSommerfeld,
+            model: FilmModel::Short,
+        });
+        crate::Scene::new(p, 0.0, None, 0.0, None, None)
+            .unwrap()
+            .with_bearing(Some(JournalSupport { film, rho }))
+            .unwrap()
+    }
+
+    /// The whirl branch in zeta from 0.3 down to `lo` at rho 0.5 (N harmonics).
+    fn whirl_branch(n: usize, lo: f64) -> (crate::Scene, crate::analysis::po_branch::PoBranch) {
+        let sc = whirl_scene(0.3, 0.5);
+        let mut o = branch_opts(n, lo, 0.3);
+        o.arc.forward = false;
+        // zeta 0.3: the whirl attracts strongly (pair 0.95), a short simulation finds it
+        o.periodic.guess.settle = 200.0;
+        o.periodic.guess.window = 100.0;
+        let start = periodic(&sc, &[false, false], None, &o.periodic);
+        assert_eq!(start.sol.status, Status::Converged);
+        let b = periodic_branch(&sc, "zeta", &start.sol, &o).unwrap();
+        (sc, b)
+    }
+
+    /// Along the NS curve in (zeta, rho), the monodromy of every point's series (the
+    /// variational equations integrated by RK45, not the Hill matrix the curve is defined
+    /// by) has a complex pair on the unit circle at the curve's angle.
+    #[test]
+    fn neimark_sacker_curve_points_have_a_monodromy_pair_on_the_unit_circle() {
+        let (sc, b) = whirl_branch(5, 0.12);
+        let e = b
+            .events
+            .iter()
+            .find(|e| e.kind == PoEventKind::NeimarkSacker)
+            .expect("an NS event");
+        let base = sc.with_param("zeta", e.p).unwrap();
+        let mut co = curve_opts(5, (0.05, 0.3), (0.48, 0.52), 3);
+        (co.arc.ds, co.arc.ds_max) = (0.01, 0.02);
+        let c = periodic_curve(
+            &base,
+            ["zeta", "rho"],
+            PoCurveKind::NeimarkSacker,
+            &e.point.result.sol,
+            &co,
+        )
+        .unwrap();
+        assert!(c.points.len() >= 4, "{:?}", c.stop);
+        for pt in &c.points {
+            let theta = pt.theta.expect("an NS curve's angle");
+            let m = &pt.result.floquet.as_ref().expect("multipliers").multipliers;
+            let z = m
+                .iter()
+                .filter(|z| z.1 > 1e-9)
+                .min_by(|a, b| {
+                    let d = |z: &&(f64, f64)| (z.0.hypot(z.1) - 1.0).abs();
+                    d(a).total_cmp(&d(b))
+                })
+                .expect("a complex pair");
+            assert!((z.0.hypot(z.1) - 1.0).abs() < 1e-6, "{z:?} at {:?}", pt.p);
+            assert!((z.1.atan2(z.0) - theta).abs() < 1e-5, "{z:?} {theta}");
+        }
+    }
+
+    /// Measurement: `cargo test --release -p ballbal-core explore_ns -- --ignored
+    /// --nocapture`.
+    #[test]
+    #[ignore]
+    fn explore_ns() {
+        let n: usize = std::env::var("N")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(6);
+        let t = std::time::Instant::now();
+        let (sc, b) = whirl_branch(n, 0.05);
+        println!(
+            "{} points {:?} stop {}",
+            b.points.len(),
+            t.elapsed(),
+            b.stop
+        );
+        for e in &b.events {
+            println!(
+                "EVENT {} p={:.9} w={}",
+                e.kind.as_str(),
+                e.p,
+                e.point.omega()
+            );
+        }
+        let e = b
+            .events
+            .iter()
+            .find(|e| e.kind == PoEventKind::NeimarkSacker)
+            .expect("an NS event");
+        let base = sc.with_param("zeta", e.p).unwrap();
+        let mut co = curve_opts(n, (0.0, 1.0), (0.3, 1.0), 40);
+        (co.arc.ds, co.arc.ds_max) = (0.01, 0.05);
+        let c = periodic_curve(
+            &base,
+            ["zeta", "rho"],
+            PoCurveKind::NeimarkSacker,
+            &e.point.result.sol,
+            &co,
+        )
+        .unwrap();
+        println!("curve {:?} {:?}", c.stop, t.elapsed());
+        for pt in &c.points {
+            let m = &pt.result.floquet.as_ref().expect("multipliers").multipliers;
+            let ns = m
+                .iter()
+                .filter(|z| z.1 > 1e-9)
+                .map(|z| format!("{:.6}@{:.4}", z.0.hypot(z.1), z.1.atan2(z.0)))
+                .collect::<Vec<_>>()
+                .join(" ");
+            println!(
+                "zeta={:.6} rho={:.6} theta={:.5} g={:.1e} w={:.5} {:?} | {}",
+                pt.p[0],
+                pt.p[1],
+                pt.theta.unwrap(),
+                pt.g,
+                pt.result.sol.omega,
+                pt.tests,
+                ns
+            );
+        }
+        for s in &c.special {
+            println!("SPECIAL {} {:?} row {}", s.kind, s.p, s.row);
+        }
+    }
+
     #[test]
     fn bad_inputs_name_the_parameter() {
         let (p, ev) = standard_events(1.0);
@@ -1353,6 +2069,10 @@ mod tests {
         let mut o3 = o.clone();
         o3.locate_tol = -1.0;
         assert_eq!(name(["Omega", "eta"], &sol, &o3), "locate_tol");
-        assert!(PoCurveKind::parse("NS").is_err());
+        assert!(PoCurveKind::parse("XX").is_err());
+        assert_eq!(
+            PoCurveKind::parse("NS").ok(),
+            Some(PoCurveKind::NeimarkSacker)
+        );
     }
 }
