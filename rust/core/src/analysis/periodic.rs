@@ -4,7 +4,9 @@
 //! simulation: settle, detect which balls rotate, measure the period, fit the series.
 
 use crate::error::check_range;
-use crate::floquet::{floquet, hill, judge, Floquet, FloquetOptions, Stability, HILL_MAX, HILL_TOL};
+use crate::floquet::{
+    floquet, hill, judge, Floquet, FloquetOptions, Stability, HILL_MAX, HILL_TOL,
+};
 use crate::hb::{defect_closure, solve, HbOptions, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
 use crate::numerics::problem::Parametric;

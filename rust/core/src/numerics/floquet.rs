@@ -870,9 +870,7 @@ fn real_eigenvalues(a: faer::MatRef<'_, f64>) -> Result<Vec<faer::c64>> {
         params.into(),
     )
     .map_err(|_| crate::Error::Eigen("eigenvalues of the Hill matrix did not converge".into()))?;
-    Ok((0..n)
-        .map(|i| faer::c64::new(re[i], im[i]))
-        .collect())
+    Ok((0..n).map(|i| faer::c64::new(re[i], im[i])).collect())
 }
 
 /// Merged balls: the coefficients in coordinates whose first two are the separation
@@ -1121,7 +1119,11 @@ mod tests {
                 assert_eq!(r.multipliers.len(), reference.len());
                 let err = multiplier_distance(&r.multipliers, &reference);
                 // 1e-11: the reference's own error.
-                assert!(err <= r.error + 1e-11, "{om} {pat:?} H {h}: {err:e} > {:e}", r.error);
+                assert!(
+                    err <= r.error + 1e-11,
+                    "{om} {pat:?} H {h}: {err:e} > {:e}",
+                    r.error
+                );
             }
             let r = hill(&p, &sol, HILL_TOL, HILL_MAX).unwrap();
             assert!(r.error <= HILL_TOL, "{r:?}");
