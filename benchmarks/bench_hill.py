@@ -3,7 +3,7 @@ it cross-checks (RK45 at the scan's rtol 1e-6, and Magnus), at the thesis' stand
 (Omega 1.2, eta 1.0, balls merged, R-R) and its hard case (Omega 1.0, eta 0.7, period
 ~106), N = 3 and 8, with the Hill multipliers' error against RK45 at rtol 1e-12.
 
-    python benchmarks/bench_hill.py            # wall clock, medians (~30 s)
+    python benchmarks/bench_hill.py            # wall clock, medians (a few seconds)
     python benchmarks/bench_hill.py --rust     # also the core's old-vs-new side by side
 
 The former Hill's method (complex Hill matrix, full eigen-decomposition, truncation
