@@ -4,7 +4,9 @@
 //! simulation: settle, detect which balls rotate, measure the period, fit the series.
 
 use crate::error::check_range;
-use crate::floquet::{floquet, hill_multipliers, judge, Floquet, FloquetOptions, Stability};
+use crate::floquet::{
+    floquet, hill, judge, Floquet, FloquetOptions, Stability, HILL_MAX, HILL_TOL,
+};
 use crate::hb::{defect_closure, solve, HbOptions, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
 use crate::numerics::problem::Parametric;
@@ -541,14 +543,12 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
             (None, Some(j)) => j,
             (None, None) => (defaults.margin, defaults.max_trivial),
         };
-        // The Hill matrix grows as (16 H)^2 and its eigenvectors as its cube: past 24
-        // harmonics the estimate costs seconds for no gain in the leading multipliers.
-        hill_multipliers(p, &sol, (sol.n_harm + 4).clamp(8, 24))
-            .ok()
-            .map(|m| {
-                let v = judge(&m, margin, max_trivial);
-                (m, v.stability)
-            })
+        // The truncation's error estimate widens the margin as the trivial multiplier's
+        // error does: a truncation that cannot resolve the exponents gives no verdict.
+        hill(p, &sol, HILL_TOL, HILL_MAX).ok().map(|h| {
+            let v = judge(&h.multipliers, margin.max(h.error), max_trivial);
+            (h.multipliers, v.stability)
+        })
     } else {
         None
     };

@@ -528,7 +528,10 @@ pub fn separation_error<D: Dynamics + ?Sized>(
     Some((det - exact).abs() / big.max(1.0))
 }
 
-/// Floquet multipliers by Hill's method: an estimate independent of the RK45 monodromy.
+/// Hill's method as it was before the real, eigenvalues-only form ([`hill`]): the complex
+/// Hill matrix's full eigen-decomposition, the copies picked by their eigenvectors'
+/// harmonic centroid. Kept as the reference the tests and `benchmarks/bench_hill.py`
+/// compare against; nothing else calls it.
 ///
 /// With `xi = e^{s t} sum_k p_k e^{i k omega t}` the linearisation `xi' = A(t) xi`
 /// becomes the eigenproblem `sum_l A_{k-l} p_l - i k omega p_k = s p_k` (`A_k` the
@@ -537,7 +540,7 @@ pub fn separation_error<D: Dynamics + ?Sized>(
 /// the zeroth harmonic is the best resolved, so the `2d` eigenvalues whose eigenvectors
 /// have the smallest harmonic centroid are taken and mapped to multipliers `e^{s T}`.
 /// Returns them largest modulus first.
-pub fn hill_multipliers<D: Dynamics + ?Sized>(
+pub fn hill_multipliers_dense<D: Dynamics + ?Sized>(
     model: &D,
     sol: &HbSolution,
     n_hill: usize,
@@ -648,6 +651,408 @@ pub fn hill_multipliers<D: Dynamics + ?Sized>(
     Ok(mults)
 }
 
+/// Hill's multipliers with the truncation's own error estimate.
+#[derive(Debug, Clone)]
+pub struct Hill {
+    /// The `2d` multipliers, largest modulus first (fewer only when the truncation does
+    /// not resolve `2d` distinct exponents; `error` is then infinite).
+    pub multipliers: Vec<(f64, f64)>,
+    /// Estimated error of the multipliers relative to the larger of 1 and their modulus:
+    /// the largest disagreement between an exponent and its copies shifted by one
+    /// harmonic (see [`hill_at`]).
+    pub error: f64,
+    /// Truncation used: harmonics `-n_hill..=n_hill`.
+    pub n_hill: usize,
+    /// Factor by which the estimate falls per harmonic of truncation (the worst
+    /// exponent's spread to copies one harmonic away over that to copies two away).
+    pub decay: f64,
+}
+
+/// Error estimate [`hill`] enlarges the truncation for (relative to the larger of 1 and
+/// the modulus): a tenth of the verdict's default margin (1e-6), so that the estimate
+/// does not widen it. The estimate is conservative (the error one harmonic further
+/// out): measured errors were 3 to 50 times smaller (`hill_study`).
+pub const HILL_TOL: f64 = 1e-7;
+
+/// Largest truncation [`hill`] tries: the matrix has `2d (2H + 1)` rows, and past 24 the
+/// eigenvalues cost tens of milliseconds.
+pub const HILL_MAX: usize = 24;
+
+/// Hill's multipliers, the truncation enlarged until the error estimate is below `tol`
+/// or the truncation reaches `n_max`; returns the attempt with the smallest estimate.
+/// The first truncation is [`hill_start`]; a failed attempt predicts the next from how
+/// fast its estimate decays with the harmonic (the spread between copies one and two
+/// harmonics apart), with one harmonic to spare.
+pub fn hill<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    tol: f64,
+    n_max: usize,
+) -> Result<Hill> {
+    let n_max = n_max.max(1);
+    let mut h = hill_start(sol).min(n_max);
+    let mut best: Option<Hill> = None;
+    loop {
+        let r = hill_at(model, sol, h)?;
+        let done = r.error <= tol || h >= n_max;
+        let decay = r.decay;
+        let error = r.error;
+        if best.as_ref().is_none_or(|b| r.error < b.error) {
+            best = Some(r);
+        }
+        if done {
+            return Ok(best.expect("set above"));
+        }
+        if crate::cancel::cancelled() {
+            return Err(crate::Error::Cancelled);
+        }
+        let more = if error.is_finite() && decay > 0.0 && decay < 0.9 {
+            ((tol / error).ln() / decay.ln()).ceil() as usize + 1
+        } else {
+            h.div_ceil(2)
+        };
+        h = (h + more.clamp(1, h)).min(n_max);
+    }
+}
+
+/// First truncation [`hill`] tries: `3 / sqrt(omega)` harmonics (at least 3).
+/// Measured on the thesis' R-R, O-O and R-O orbits (periods 21 to 107, N = 3 and 8;
+/// the ignored test `hill_study`): the truncation error depends on the orbit's
+/// frequency, not on N (the exponents' copies centred on the zeroth harmonic sit at the
+/// natural frequencies, about 1, so their eigenvectors reach ~ 1 / omega harmonics, and
+/// the error falls by 5 to 50 per harmonic); `3 / sqrt(omega)` harmonics reached an
+/// estimate of [`HILL_TOL`] on the first attempt in all but one case (the period-106
+/// R-R orbit at N = 8, one retry).
+pub fn hill_start(sol: &HbSolution) -> usize {
+    let h = 3.0 / sol.omega.abs().sqrt();
+    if h.is_finite() {
+        (h.ceil() as usize).clamp(3, HILL_MAX)
+    } else {
+        HILL_MAX
+    }
+}
+
+/// Fourier coefficients `A_k`, `k = 0..=k_max`, of the state matrix along the series
+/// (row-major `2d x 2d` blocks; `A_{-k}` is the conjugate, `A` being real), by the
+/// trapezoidal rule on `samples` points.
+fn state_matrix_harmonics<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    k_max: usize,
+    samples: usize,
+) -> Vec<faer::c64> {
+    use faer::c64;
+    let d = model.ndof();
+    let n2 = 2 * d;
+    let nn = n2 * n2;
+    let om = sol.omega;
+    let (mut q, mut v, mut a) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    let mut cols = vec![0.0; 2 * d * d];
+    let mut amat = vec![0.0; nn];
+    let mut coef = vec![c64::new(0.0, 0.0); (k_max + 1) * nn];
+    let scale = 1.0 / samples as f64;
+    let turn: Vec<(f64, f64)> = (0..samples)
+        .map(|i| (2.0 * std::f64::consts::PI * i as f64 / samples as f64).sin_cos())
+        .collect();
+    for j in 0..samples {
+        let tau = 2.0 * std::f64::consts::PI * j as f64 / samples as f64;
+        sol.eval_rates(tau, &mut q, &mut v, &mut a);
+        let t = tau / om;
+        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        crate::linalg::state_matrix(model, t, &q, &k, &c, &mut cols, &mut amat);
+        for (kk, block) in coef.chunks_exact_mut(nn).enumerate() {
+            let (sn, cs) = turn[(kk * j) % samples];
+            let (er, ei) = (cs * scale, -sn * scale);
+            for (b, &x) in block.iter_mut().zip(&amat) {
+                b.re += er * x;
+                b.im += ei * x;
+            }
+        }
+    }
+    coef
+}
+
+/// Eigenvalues of the real Hill matrix at truncation `h` of the state coordinates
+/// `idx` (a block of `coef`'s `n2 x n2` coefficients that no other coordinate feeds).
+///
+/// The Hill operator `p -> A p - p'` on periodic `p` maps real functions to real ones, so
+/// on the span of `1, cos k omega t, sin k omega t` (`k <= H`) -- the span of the
+/// complex truncation `|k| <= H`, hence the same eigenvalues -- its matrix is real, and
+/// faer's real Schur form gives the eigenvalues without eigenvectors.
+fn hill_block_eigenvalues(
+    coef: &[faer::c64],
+    n2: usize,
+    idx: &[usize],
+    h: usize,
+    om: f64,
+) -> Result<Vec<faer::c64>> {
+    use faer::c64;
+    let nn = n2 * n2;
+    let nb = idx.len();
+    let at = |k: i64, i: usize, j: usize| -> c64 {
+        let z = coef[k.unsigned_abs() as usize * nn + idx[i] * n2 + idx[j]];
+        if k >= 0 {
+            z
+        } else {
+            z.conj()
+        }
+    };
+    // Rows/columns: block 0 the constant part, then cos k and sin k for k = 1..=H.
+    let size = nb * (2 * h + 1);
+    let cos_at = |k: usize| if k == 0 { 0 } else { nb * (2 * k - 1) };
+    let sin_at = |k: usize| nb * 2 * k;
+    let mut hm = faer::Mat::<f64>::zeros(size, size);
+    for kr in 0..=h {
+        // The constant row carries the mean, the others twice the real/imaginary parts.
+        let half = if kr == 0 { 0.5 } else { 1.0 };
+        for kc in 0..=h {
+            let (dm, dp) = (kr as i64 - kc as i64, (kr + kc) as i64);
+            for i in 0..nb {
+                for j in 0..nb {
+                    let (lo, hi) = (at(dm, i, j), at(dp, i, j));
+                    hm[(cos_at(kr) + i, cos_at(kc) + j)] = half * (lo.re + hi.re);
+                    if kc > 0 {
+                        hm[(cos_at(kr) + i, sin_at(kc) + j)] = half * (lo.im - hi.im);
+                    }
+                    if kr > 0 {
+                        hm[(sin_at(kr) + i, cos_at(kc) + j)] = -(lo.im + hi.im);
+                        if kc > 0 {
+                            hm[(sin_at(kr) + i, sin_at(kc) + j)] = lo.re - hi.re;
+                        }
+                    }
+                }
+            }
+        }
+        if kr > 0 {
+            // -p' : cos k -> k omega sin k, sin k -> -k omega cos k.
+            let w = kr as f64 * om;
+            for i in 0..nb {
+                hm[(sin_at(kr) + i, cos_at(kr) + i)] += w;
+                hm[(cos_at(kr) + i, sin_at(kr) + i)] -= w;
+            }
+        }
+    }
+    let ev = real_eigenvalues(hm.as_ref())?;
+    if ev.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+        return Err(crate::Error::Integration(
+            "the Hill matrix has non-finite eigenvalues".into(),
+        ));
+    }
+    Ok(ev)
+}
+
+/// Eigenvalues of a real square matrix (no vectors), by faer's Hessenberg reduction and
+/// real Schur iteration.
+fn real_eigenvalues(a: faer::MatRef<'_, f64>) -> Result<Vec<faer::c64>> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::evd::{evd_real, evd_scratch, ComputeEigenvectors, EvdParams};
+    let n = a.nrows();
+    let params: EvdParams = faer::Auto::<f64>::auto();
+    let par = faer::Par::Seq;
+    let mut re = faer::diag::Diag::<f64>::zeros(n);
+    let mut im = faer::diag::Diag::<f64>::zeros(n);
+    let mut buf = MemBuffer::new(evd_scratch::<f64>(
+        n,
+        ComputeEigenvectors::No,
+        ComputeEigenvectors::No,
+        par,
+        params.into(),
+    ));
+    evd_real(
+        a,
+        re.as_mut(),
+        im.as_mut(),
+        None,
+        None,
+        par,
+        MemStack::new(&mut buf),
+        params.into(),
+    )
+    .map_err(|_| crate::Error::Eigen("eigenvalues of the Hill matrix did not converge".into()))?;
+    Ok((0..n).map(|i| faer::c64::new(re[i], im[i])).collect())
+}
+
+/// Merged balls: the coefficients in coordinates whose first two are the separation
+/// mode `(e, e')` of the pair (see [`separation_error`]), and the index sets of the two
+/// diagonal blocks, if no coefficient leaks out of the separation subspace (to 1e-13 of
+/// the largest); otherwise `None`.
+#[allow(clippy::type_complexity)]
+fn split_merged(
+    coef: &[faer::c64],
+    n2: usize,
+    pair: (usize, usize),
+) -> Option<(Vec<faer::c64>, Vec<usize>, Vec<usize>)> {
+    use faer::c64;
+    let d = n2 / 2;
+    let nn = n2 * n2;
+    let (i, j) = pair;
+    let r = std::f64::consts::FRAC_1_SQRT_2;
+    // Orthogonal Q: columns 0, 1 the separation (position, velocity), the pair's other
+    // two the sums, then the remaining coordinates in order.
+    let mut q = vec![0.0; nn];
+    let mut col = 0;
+    for (a, b) in [(i, j), (d + i, d + j)] {
+        q[a * n2 + col] = r;
+        q[b * n2 + col] = -r;
+        col += 1;
+    }
+    for (a, b) in [(i, j), (d + i, d + j)] {
+        q[a * n2 + col] = r;
+        q[b * n2 + col] = r;
+        col += 1;
+    }
+    for row in (0..n2).filter(|&x| ![i, j, d + i, d + j].contains(&x)) {
+        q[row * n2 + col] = 1.0;
+        col += 1;
+    }
+    let scale = coef.iter().fold(0.0f64, |m, z| m.max(z.norm()));
+    let mut out = vec![c64::new(0.0, 0.0); coef.len()];
+    let mut tmp = vec![c64::new(0.0, 0.0); nn];
+    for (blk, res) in coef.chunks_exact(nn).zip(out.chunks_exact_mut(nn)) {
+        // Q^T A_k Q.
+        for a in 0..n2 {
+            for c in 0..n2 {
+                tmp[a * n2 + c] = (0..n2).map(|k| blk[a * n2 + k] * q[k * n2 + c]).sum();
+            }
+        }
+        for a in 0..n2 {
+            for c in 0..n2 {
+                res[a * n2 + c] = (0..n2).map(|k| tmp[k * n2 + c] * q[k * n2 + a]).sum();
+            }
+        }
+        // The separation subspace is invariant (A maps it into itself: rows 2.. of
+        // columns 0..2 vanish), so A is block upper triangular in these coordinates.
+        let leak = (2..n2)
+            .flat_map(|a| (0..2).map(move |c| (a, c)))
+            .map(|(a, c)| res[a * n2 + c].norm())
+            .fold(0.0f64, f64::max);
+        if !(leak <= 1e-13 * scale.max(1e-300)) {
+            return None;
+        }
+    }
+    Some((out, vec![0, 1], (2..n2).collect()))
+}
+
+/// Hill's method at one truncation `H`, by eigenvalues only.
+///
+/// Every true exponent `s` appears as copies `s + i k omega`; the copy whose
+/// eigenvector is centred on harmonic `c` sees the truncation window shifted by `c`, so
+/// copies whose eigenvectors sit near the window's centre agree with their neighbours
+/// and those near its edge drift. Each eigenvalue's disagreement with the eigenvalues
+/// nearest to it plus and minus `i omega` (the change from moving the window by one
+/// harmonic: at least the truncation error of the copy one harmonic further out) is
+/// its error estimate; the eigenvalues are taken in order of that estimate, each a new
+/// exponent unless it is a copy of one already taken (same value modulo `i omega`
+/// within the estimates: spurious eigenvalues from the window's edge have no consistent
+/// copies and come last), with the multiplicity of its cluster, until `2d` are found.
+/// An exponent on the strip's edge (a negative real multiplier) has conjugate copies
+/// `a +- i omega / 2` and is taken once. Merged balls' separation block (see
+/// [`separation_error`]) decouples and is solved on its own.
+pub fn hill_at<D: Dynamics + ?Sized>(model: &D, sol: &HbSolution, n_hill: usize) -> Result<Hill> {
+    let n2 = 2 * model.ndof();
+    let h = n_hill.max(1);
+    let om = sol.omega;
+    // Enough samples to resolve A's harmonics up to 2H without aliasing.
+    let samples = (8 * h + 8).max(64);
+    let coef = state_matrix_harmonics(model, sol, 2 * h, samples);
+    let split = merged_pair(sol, model.first_ball()).and_then(|p| split_merged(&coef, n2, p));
+    let ev = match split {
+        Some((c, sep, rest)) => {
+            let mut ev = hill_block_eigenvalues(&c, n2, &rest, h, om)?;
+            ev.extend(hill_block_eigenvalues(&c, n2, &sep, h, om)?);
+            ev
+        }
+        None => hill_block_eigenvalues(&coef, n2, &(0..n2).collect::<Vec<_>>(), h, om)?,
+    };
+    Ok(select_exponents(&ev, om, n2, h, sol.period()))
+}
+
+/// The `n2` exponents among the Hill matrix's eigenvalues `ev` (see [`hill_at`]) as
+/// multipliers with the error estimate.
+fn select_exponents(ev: &[faer::c64], om: f64, n2: usize, h: usize, period: f64) -> Hill {
+    use faer::c64;
+    // Nearest eigenvalue to a point: a scan outwards from its imaginary part in `by_im`.
+    let mut by_im: Vec<c64> = ev.to_vec();
+    by_im.sort_by(|a, b| a.im.total_cmp(&b.im));
+    let nearest = |target: c64| -> c64 {
+        let start = by_im.partition_point(|z| z.im < target.im);
+        let mut best = (f64::INFINITY, c64::new(f64::INFINITY, 0.0));
+        for z in by_im[start..].iter() {
+            if (z.im - target.im).powi(2) > best.0 {
+                break;
+            }
+            let d = (*z - target).norm_sqr();
+            if d < best.0 {
+                best = (d, *z);
+            }
+        }
+        for z in by_im[..start].iter().rev() {
+            if (z.im - target.im).powi(2) > best.0 {
+                break;
+            }
+            let d = (*z - target).norm_sqr();
+            if d < best.0 {
+                best = (d, *z);
+            }
+        }
+        best.1
+    };
+    // Disagreement with the copies `k` harmonics away.
+    let spread = |z: c64, k: f64| -> f64 {
+        let up = c64::new(z.re, z.im + k * om);
+        let down = c64::new(z.re, z.im - k * om);
+        (nearest(up) - up).norm().max((nearest(down) - down).norm())
+    };
+    let mut fams: Vec<(c64, f64)> = ev.iter().map(|&z| (z, spread(z, 1.0))).collect();
+    fams.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let reduce = |z: c64| c64::new(z.re, z.im - (z.im / om).round() * om);
+    let tol = |z: c64, e: f64| 4.0 * e + 1e-8 * (om + z.norm());
+    // (eigenvalue, estimate, multiplicity)
+    let mut chosen: Vec<(c64, f64, usize)> = Vec::with_capacity(n2);
+    let mut count = 0;
+    for (z, e) in fams {
+        let copy = chosen.iter().any(|&(c, ec, _)| {
+            let dz = reduce(z) - reduce(c);
+            let k = (dz.im / om).round();
+            let t = tol(z, e).max(tol(c, ec));
+            dz.re.abs() <= t && (dz.im - k * om).abs() <= t
+        });
+        if !copy {
+            let t = tol(z, e);
+            let mult = ev.iter().filter(|w| (**w - z).norm() <= t).count().max(1);
+            let mult = mult.min(n2 - count);
+            chosen.push((z, e, mult));
+            count += mult;
+        }
+        if count == n2 {
+            break;
+        }
+    }
+    let mut error = if count == n2 { 0.0f64 } else { f64::INFINITY };
+    let mut decay = 0.0f64;
+    let mut mults: Vec<(f64, f64)> = Vec::with_capacity(n2);
+    for &(z, e, mult) in &chosen {
+        let r = (z.re * period).exp();
+        let (sn, cs) = (z.im * period).sin_cos();
+        // d(mu) = mu T ds.
+        let err = e * period * r / r.max(1.0);
+        if err >= error {
+            // How fast the worst exponent's estimate falls per harmonic.
+            decay = e / spread(z, 2.0);
+        }
+        error = error.max(err);
+        mults.extend(std::iter::repeat_n((r * cs, r * sn), mult));
+    }
+    mults.sort_by(|a, b| b.0.hypot(b.1).total_cmp(&a.0.hypot(a.1)));
+    Hill {
+        multipliers: mults,
+        error,
+        decay,
+        n_hill: h,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -675,7 +1080,7 @@ mod tests {
         let r = periodic(&p, &[true, true], None, &opts);
         let f = r.floquet.unwrap();
         let sol = solve(&p, &r.sol, &opts.hb);
-        let hill = hill_multipliers(&p, &sol, 12).unwrap();
+        let hill = hill_multipliers_dense(&p, &sol, 12).unwrap();
         let mods = |v: &[(f64, f64)]| -> Vec<f64> { v.iter().map(|z| z.0.hypot(z.1)).collect() };
         let (a, b) = (mods(&f.multipliers), mods(&hill));
         for (x, y) in a.iter().zip(&b) {
@@ -683,6 +1088,58 @@ mod tests {
         }
         // The spec's shooting value of the leading non-trivial modulus.
         assert!((b[1] - 0.8637).abs() < 2e-4, "{b:?}");
+    }
+
+    /// The eigenvalues-only Hill's method against a tight RK45 monodromy of the same
+    /// linearisation: its error estimate bounds the error at every truncation from the
+    /// coarse to the converged, on the standard merged R-R orbit (separation block split
+    /// off, two negative real multipliers at N = 3), an R-O orbit (no split) and three
+    /// merged balls (a double separation multiplier); and the adaptive truncation meets
+    /// its tolerance.
+    #[test]
+    fn hill_estimate_bounds_its_error() {
+        let cases: [(f64, f64, &[bool]); 3] = [
+            (1.2, 1.0, &[true, true]),
+            (1.3, 0.7, &[true, false]),
+            (1.2, 1.0, &[true, true, true]),
+        ];
+        for (om, eta, pat) in cases {
+            let p = Planar::new(0.2, 0.05, &[0.05], 50.0, om, &vec![eta; pat.len()]).unwrap();
+            let sol = periodic(&p, pat, None, &PeriodicOptions::default()).sol;
+            assert_eq!(sol.status, crate::hb::Status::Converged);
+            let tight = FloquetOptions {
+                rtol: 1e-12,
+                atol: 1e-14,
+                max_steps: 10_000_000,
+                ..Default::default()
+            };
+            let reference = floquet(&p, &sol, &tight).unwrap().multipliers;
+            for h in 3..=8 {
+                let r = hill_at(&p, &sol, h).unwrap();
+                assert_eq!(r.multipliers.len(), reference.len());
+                let err = multiplier_distance(&r.multipliers, &reference);
+                // 1e-11: the reference's own error.
+                assert!(
+                    err <= r.error + 1e-11,
+                    "{om} {pat:?} H {h}: {err:e} > {:e}",
+                    r.error
+                );
+            }
+            let r = hill(&p, &sol, HILL_TOL, HILL_MAX).unwrap();
+            assert!(r.error <= HILL_TOL, "{r:?}");
+            assert!(multiplier_distance(&r.multipliers, &reference) <= HILL_TOL);
+        }
+    }
+
+    /// Real eigenvalues-only Hill matrix and the former complex one have the same
+    /// spectrum at the same truncation, so both give the same multipliers once converged.
+    #[test]
+    fn hill_matches_the_dense_form() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let sol = periodic(&p, &[true, true], None, &PeriodicOptions::default()).sol;
+        let dense = hill_multipliers_dense(&p, &sol, 12).unwrap();
+        let fast = hill_at(&p, &sol, 12).unwrap();
+        assert!(multiplier_distance(&fast.multipliers, &dense) < 1e-10);
     }
 
     /// Cost and error of RK45 and Magnus monodromies at thesis points (run with
@@ -792,6 +1249,70 @@ mod tests {
         }
     }
 
+    /// Hill's error estimate against the truncation error measured against a tight RK45
+    /// monodromy, truncation by truncation (run with `--ignored --nocapture`): the
+    /// calibration behind [`hill_start`].
+    #[test]
+    #[ignore]
+    fn hill_study() {
+        let cases: [(&str, f64, f64, [bool; 2]); 5] = [
+            ("std R-R", 1.2, 1.0, [true, true]),
+            ("hard R-R", 1.0, 0.7, [true, true]),
+            ("O-O", 1.1, 0.4, [false, false]),
+            ("R-O stable", 1.3, 0.7, [true, false]),
+            ("R-O unstable", 1.1, 0.6, [true, false]),
+        ];
+        for n_harm in [3, 8] {
+            for (name, om, eta, pat) in cases {
+                let p = Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap();
+                let opts = PeriodicOptions {
+                    hb: HbOptions {
+                        n_harm,
+                        ..Default::default()
+                    },
+                    ..Default::default()
+                };
+                let r = periodic(&p, &pat, None, &opts);
+                if r.sol.status != crate::hb::Status::Converged {
+                    println!("{name} N={n_harm}: {:?}", r.sol.status);
+                    continue;
+                }
+                let sol = r.sol;
+                let tight = FloquetOptions {
+                    rtol: 1e-12,
+                    atol: 1e-14,
+                    max_steps: 10_000_000,
+                    ..Default::default()
+                };
+                let reference = floquet(&p, &sol, &tight).unwrap();
+                let old = hill_multipliers_dense(&p, &sol, (n_harm + 4).clamp(8, 24)).unwrap();
+                println!(
+                    "{name} N={n_harm} T={:.1} omega {:.3} old err {:.1e} mods {:?}",
+                    sol.period(),
+                    sol.omega,
+                    multiplier_distance(&old, &reference.multipliers),
+                    reference
+                        .multipliers
+                        .iter()
+                        .map(|z| z.0.hypot(z.1))
+                        .collect::<Vec<_>>()
+                );
+                for h in 2..=16 {
+                    let hl = hill_at(&p, &sol, h).unwrap();
+                    let e = multiplier_distance(&hl.multipliers, &reference.multipliers);
+                    println!("  H {h:2}: est {:9.1e} err {e:9.1e}", hl.error);
+                }
+                let a = hill(&p, &sol, HILL_TOL, HILL_MAX).unwrap();
+                println!(
+                    "  adaptive: H {} est {:.1e} err {:.1e}",
+                    a.n_hill,
+                    a.error,
+                    multiplier_distance(&a.multipliers, &reference.multipliers)
+                );
+            }
+        }
+    }
+
     /// Instruction counts under callgrind: `valgrind --tool=callgrind <test binary>
     /// --ignored --exact numerics::floquet::tests::magnus_profile`.
     #[test]
@@ -826,7 +1347,97 @@ mod tests {
 
     #[inline(never)]
     fn profile_hill(p: &Planar, sol: &HbSolution) -> f64 {
-        hill_multipliers(p, sol, 8).unwrap()[0].0
+        hill(p, sol, HILL_TOL, HILL_MAX).unwrap().multipliers[0].0
+    }
+
+    /// Hill's method alone at the standard case, N = 3 and 8, two and three balls, today's
+    /// ([`hill`]) and the former dense one ([`hill_multipliers_dense`] at the truncation
+    /// `periodic` used, `clamp(N + 4, 8, 24)`), under callgrind: `valgrind
+    /// --tool=callgrind <test binary> --ignored --exact
+    /// numerics::floquet::tests::hill_profile` (one function per case, so the inclusive
+    /// counts split by case).
+    #[test]
+    #[ignore]
+    fn hill_profile() {
+        let mut acc = 0.0;
+        for (n_harm, balls) in [(3, 2), (8, 2), (3, 3), (8, 3)] {
+            let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &vec![1.0; balls]).unwrap();
+            let opts = PeriodicOptions {
+                hb: HbOptions {
+                    n_harm,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            let sol = periodic(&p, &vec![true; balls], None, &opts).sol;
+            assert_eq!(sol.status, crate::hb::Status::Converged, "{sol:?}");
+            let t = std::time::Instant::now();
+            let fast = match (n_harm, balls) {
+                (3, 2) => hill_n3_b2(&p, &sol),
+                (8, 2) => hill_n8_b2(&p, &sol),
+                (3, _) => hill_n3_b3(&p, &sol),
+                _ => hill_n8_b3(&p, &sol),
+            };
+            let t_fast = t.elapsed().as_secs_f64() * 1e3;
+            let t = std::time::Instant::now();
+            let h = (n_harm + 4).clamp(8, 24);
+            let dense = match (n_harm, balls) {
+                (3, 2) => dense_n3_b2(&p, &sol, h),
+                (8, 2) => dense_n8_b2(&p, &sol, h),
+                (3, _) => dense_n3_b3(&p, &sol, h),
+                _ => dense_n8_b3(&p, &sol, h),
+            };
+            let t_dense = t.elapsed().as_secs_f64() * 1e3;
+            println!(
+                "N={n_harm} balls={balls}: hill H={} est {:.1e} {t_fast:.2} ms; dense H={h} \
+                 {t_dense:.2} ms; distance {:.1e}",
+                fast.n_hill,
+                fast.error,
+                multiplier_distance(&fast.multipliers, &dense)
+            );
+            acc += fast.multipliers[0].0 + dense[0].0;
+        }
+        println!("{acc}");
+    }
+
+    #[inline(never)]
+    fn hill_n3_b2(p: &Planar, sol: &HbSolution) -> Hill {
+        hill(p, sol, HILL_TOL, HILL_MAX).unwrap()
+    }
+
+    #[inline(never)]
+    fn hill_n8_b2(p: &Planar, sol: &HbSolution) -> Hill {
+        hill(p, sol, HILL_TOL, HILL_MAX).unwrap()
+    }
+
+    #[inline(never)]
+    fn hill_n3_b3(p: &Planar, sol: &HbSolution) -> Hill {
+        hill(p, sol, HILL_TOL, HILL_MAX).unwrap()
+    }
+
+    #[inline(never)]
+    fn hill_n8_b3(p: &Planar, sol: &HbSolution) -> Hill {
+        hill(p, sol, HILL_TOL, HILL_MAX).unwrap()
+    }
+
+    #[inline(never)]
+    fn dense_n3_b2(p: &Planar, sol: &HbSolution, h: usize) -> Vec<(f64, f64)> {
+        hill_multipliers_dense(p, sol, h).unwrap()
+    }
+
+    #[inline(never)]
+    fn dense_n8_b2(p: &Planar, sol: &HbSolution, h: usize) -> Vec<(f64, f64)> {
+        hill_multipliers_dense(p, sol, h).unwrap()
+    }
+
+    #[inline(never)]
+    fn dense_n3_b3(p: &Planar, sol: &HbSolution, h: usize) -> Vec<(f64, f64)> {
+        hill_multipliers_dense(p, sol, h).unwrap()
+    }
+
+    #[inline(never)]
+    fn dense_n8_b3(p: &Planar, sol: &HbSolution, h: usize) -> Vec<(f64, f64)> {
+        hill_multipliers_dense(p, sol, h).unwrap()
     }
 
     #[inline(never)]

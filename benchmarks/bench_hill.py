@@ -1,0 +1,99 @@
+"""Cost of Hill's-method cross-check (``periodic(..., hill=True)``) against the monodromy
+it cross-checks (RK45 at the scan's rtol 1e-6, and Magnus), at the thesis' standard case
+(Omega 1.2, eta 1.0, balls merged, R-R) and its hard case (Omega 1.0, eta 0.7, period
+~106), N = 3 and 8, with the Hill multipliers' error against RK45 at rtol 1e-12.
+
+    python benchmarks/bench_hill.py            # wall clock, medians (a few seconds)
+    python benchmarks/bench_hill.py --rust     # also the core's old-vs-new side by side
+
+The former Hill's method (complex Hill matrix, full eigen-decomposition, truncation
+clamp(N + 4, 8, 24)) is reachable only in the core (``hill_multipliers_dense``); its cost
+is printed beside today's from the callgrind counts below, and ``--rust`` runs the
+core's ``hill_profile`` test, which times both on the same series:
+
+    cargo test --release -p ballbal-core --lib --no-run
+    valgrind --tool=callgrind target/release/deps/ballbal_core-* --ignored --exact \\
+        numerics::floquet::tests::hill_profile
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import ballbal
+
+# Instructions per Hill's-method call, standard case, measured with callgrind on
+# 2026-11-23 (hill_profile): (N, balls) -> (former dense, today's).
+CALLGRIND = {(3, 2): (147.3e6, 16.8e6), (8, 2): (348.2e6, 16.8e6),
+             (3, 3): (234.9e6, 26.7e6), (8, 3): (610.8e6, 27.3e6)}
+
+
+def median_time(f, repeats: int = 15) -> tuple[float, object]:
+    ts = []
+    out = None
+    for _ in range(repeats):
+        t = time.perf_counter()
+        out = f()
+        ts.append(time.perf_counter() - t)
+    return float(np.median(ts)), out
+
+
+def match_error(a, ref) -> float:
+    left = list(a)
+    worst = 0.0
+    for r in sorted(ref, key=lambda z: -abs(z)):
+        k = int(np.argmin([abs(z - r) for z in left]))
+        worst = max(worst, abs(left.pop(k) - r) / max(1.0, abs(r)))
+    return worst
+
+
+def case(name: str, b: ballbal.Balancer, seed: ballbal.PeriodicSolution, N: int) -> None:
+    sol = ballbal.periodic(b, "R-R", N=N, guess=seed, hill=False)
+    ref = ballbal.periodic(b, "R-R", N=N, guess=sol, rtol=1e-12, atol=1e-14,
+                           max_steps=10_000_000, hill=False)
+
+    def run(**kw):
+        return ballbal.periodic(b, "R-R", N=N, guess=sol, **kw)
+
+    t_hb, _ = median_time(lambda: run(floquet=False, hill=False))
+    t_rk, _ = median_time(lambda: run(rtol=1e-6, atol=1e-9, hill=False))
+    t_mg, _ = median_time(lambda: run(rtol=1e-6, hill=False, floquet_method="magnus"))
+    t_hill, h = median_time(lambda: run(floquet=False, hill=True))
+    rk, mg, hl = t_rk - t_hb, t_mg - t_hb, t_hill - t_hb
+    err = match_error(h.hill_multipliers, ref.multipliers)
+    print(f"{name:>9} N = {N}: Hill {hl * 1e3:6.2f} ms (error {err:.1e}, "
+          f"{h.hill_stability}); RK45 {rk * 1e3:5.2f} ms; Magnus {mg * 1e3:5.2f} ms; "
+          f"Hill / RK45 {hl / rk:4.1f}, Hill / Magnus {hl / mg:4.1f}")
+
+
+def main() -> None:
+    base = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, eta=(1.0, 1.0))
+    b = ballbal.Balancer(**base, Omega=1.2)
+    seed = ballbal.periodic(b, "R-R", N=8, hill=False)
+    hard = ballbal.Balancer(**{**base, "eta": (0.7, 0.7)}, Omega=1.0)
+    hard_seed = ballbal.periodic(hard.replace(Omega=0.99), "R-R", N=8, hill=False)
+    print("Hill's method beside the monodromy it cross-checks (wall clock, medians):")
+    for N in (3, 8):
+        case("standard", b, seed, N)
+        case("hard", hard, hard_seed, N)
+    print("\ncallgrind instructions per Hill call, standard case (former dense -> today):")
+    for (N, balls), (old, new) in CALLGRIND.items():
+        print(f"  N = {N}, {balls} balls: {old / 1e6:6.1f} M -> {new / 1e6:5.1f} M "
+              f"({old / new:4.1f} x)")
+    if "--rust" in sys.argv:
+        root = Path(__file__).resolve().parent.parent
+        out = subprocess.run(
+            ["cargo", "test", "--release", "-q", "-p", "ballbal-core", "--lib",
+             "hill_profile", "--", "--ignored", "--nocapture"],
+            cwd=root, capture_output=True, text=True, check=True).stdout
+        print("\ncore, same series, one call each (today's hill vs hill_multipliers_dense):")
+        print("\n".join("  " + ln for ln in out.splitlines() if ln.startswith("N=")))
+
+
+if __name__ == "__main__":
+    main()
