@@ -356,19 +356,19 @@ def basins(
     done: set[int] = set()
     todo: list[int] = []
     interrupted = False
-    try:
+    from .scan import _as_completed, _interrupted
+
+    def keep(c: int, cols: dict[str, Any]) -> None:
+        df = frame(c, cols)
+        if store is not None:
+            store.write(c, df)
+        parts[c] = df
+
+    def work() -> None:
+        nonlocal done, todo
         done = store.done(sizes) if store is not None else set()
-
-        def keep(c: int, cols: dict[str, Any]) -> None:
-            df = frame(c, cols)
-            if store is not None:
-                store.write(c, df)
-            parts[c] = df
-
         todo = [c for c in range(n_chunks) if c not in done]
         if todo and execution.executor is not None:
-            from .scan import _as_completed
-
             per_task = 1 if execution.threads is None else threads
             futures = {execution.executor.submit(
                 _run_chunk, model, starts[c * chunk:c * chunk + sizes[c]], options,
@@ -385,24 +385,27 @@ def basins(
         for c in done:
             assert store is not None
             parts[c] = store.read(c)
-    except KeyboardInterrupt:
-        interrupted = True
-        if store is not None:
-            # Ctrl-C can land between a chunk's atomic rename and `parts[c] = ...`: a
-            # file that exists is whole, so it belongs to the table returned now.
-            for c in todo:
-                if c not in parts and store.store.file(c).exists():
-                    parts[c] = store.read(c)
-            for c in done:
-                parts.setdefault(c, store.read(c))
-        warnings.warn(
-            ScanInterrupted(
-                f"basins interrupted: {len(parts)} of {n_chunks} chunks finished"
-                + (f" and kept in {execution.out}; run the same call again to resume"
-                   if store is not None else "; pass execution.out to keep chunks on disk")
-            ),
-            stacklevel=2,
-        )
+
+    try:
+        interrupted = _interrupted(work)
+        if interrupted:
+            if store is not None:
+                # Ctrl-C can land between a chunk's atomic rename and `parts[c] = ...`:
+                # a file that exists is whole, so it belongs to the table returned now.
+                for c in todo:
+                    if c not in parts and store.store.file(c).exists():
+                        parts[c] = store.read(c)
+                for c in done:
+                    parts.setdefault(c, store.read(c))
+            warnings.warn(
+                ScanInterrupted(
+                    f"basins interrupted: {len(parts)} of {n_chunks} chunks finished"
+                    + (f" and kept in {execution.out}; run the same call again to resume"
+                       if store is not None
+                       else "; pass execution.out to keep chunks on disk")
+                ),
+                stacklevel=2,
+            )
     finally:
         if store is not None:
             store.close()

@@ -463,6 +463,26 @@ class _Progress:
             self.bar.close()
 
 
+def _interrupted(work: Callable[[], None]) -> bool:
+    """Runs ``work()``; True if Ctrl-C stopped it. One Ctrl-C can arrive twice: when it
+    lands while polars writes a chunk, polars raises a KeyboardInterrupt of its own and
+    Python's handler, still pending, raises another at the next opportunity (entering
+    the handler below, or the call in it). Both are this one interrupt."""
+    try:
+        try:
+            work()
+        except KeyboardInterrupt:
+            _pending()
+            return True
+    except KeyboardInterrupt:
+        return True
+    return False
+
+
+def _pending() -> None:
+    """Nothing: calling it is where a pending Ctrl-C is raised."""
+
+
 def _as_completed(futures: list[Any]) -> Iterable[Any]:
     if futures and type(futures[0]).__module__.startswith("distributed"):
         from distributed import as_completed
@@ -648,7 +668,7 @@ def _run(job: _Job, store: _Store | None, executor: Any, threads: int | None,
         finished.add(c)
         bar.update(job.points(c))
 
-    try:
+    def work() -> None:
         if todo and executor is not None:
             per_task = 1 if threads is None else local_threads
             futures = [executor.submit(run_chunk, job, c, per_task) for c in todo]
@@ -662,19 +682,21 @@ def _run(job: _Job, store: _Store | None, executor: Any, threads: int | None,
                 raise
         elif todo:
             job.native(todo, local_threads, lambda c, d: keep(c, _frame(job.names, d)))
-    except KeyboardInterrupt:
-        if store is not None:
-            # Ctrl-C can land between a chunk's atomic rename and `finished.add`: a
-            # file that exists is whole, so it belongs to the table returned now.
-            finished |= {c for c in todo if store.file(c).exists()}
-        warnings.warn(
-            ScanInterrupted(
-                f"scan interrupted: {len(finished)} of {n} chunks finished"
-                + (f" and kept in {store.dir}; run the same scan again to resume"
-                   if store is not None else "; pass out= to keep chunks on disk")
-            ),
-            stacklevel=3,
-        )
+
+    try:
+        if _interrupted(work):
+            if store is not None:
+                # Ctrl-C can land between a chunk's atomic rename and `finished.add`: a
+                # file that exists is whole, so it belongs to the table returned now.
+                finished |= {c for c in todo if store.file(c).exists()}
+            warnings.warn(
+                ScanInterrupted(
+                    f"scan interrupted: {len(finished)} of {n} chunks finished"
+                    + (f" and kept in {store.dir}; run the same scan again to resume"
+                       if store is not None else "; pass out= to keep chunks on disk")
+                ),
+                stacklevel=3,
+            )
     finally:
         bar.close()
     if store is not None:
