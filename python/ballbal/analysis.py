@@ -421,7 +421,8 @@ def periodic(
     step halved on failure). ``True`` tries ``Omega`` 0.1 and 0.2 below and above the
     model's, then ``eta = 1``; a dict ``{"Omega": 1.2}`` or pairs ``[("Omega", 1.2)]``
     give the starts to try, in order. Only used without ``guess`` and only when
-    simulation here finds nothing. ``info["guess_source"]`` says how every result was
+    simulation here finds nothing. By default (``None``) the ``True`` starts are tried
+    last, after the constructed starts; ``False`` never tries them. ``info["guess_source"]`` says how every result was
     found: ``"simulation"``, ``"guess"`` or ``"homotopy from Omega=1.2"``.
 
     ``N="auto"`` starts at 3 and raises the harmonics (solving from the last) until the
@@ -482,8 +483,10 @@ def periodic(
                                      f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
     starts = None if homotopy is None or homotopy is False else _homotopy(model, homotopy)
+    # By default the homotopy starts come last, after the constructed ones.
+    last = _homotopy(model, True) if homotopy is None else None
     d = _native.periodic(model, pattern, options,
-                         None if go is None or gc is None else (go, gc), wind, starts)
+                         None if go is None or gc is None else (go, gc), wind, starts, last)
     out = _solution(model, d)
     out.info["guess_source"] = d["guess_source"]
     return out

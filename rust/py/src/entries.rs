@@ -244,9 +244,10 @@ pub(crate) fn start(m: &Model, ball_winding: &[f64], w: f64, c: &[f64]) -> PyRes
 /// balls' turns per period (`None`: -1 for each `R`, 0 for each `O`).
 /// `homotopy`: `(parameter, value)` starts to follow from when simulation finds no
 /// orbit here (`analysis::homotopy`), before the constructed starts
-/// (`analysis::constructed`); the dict's `guess_source` says how it was found.
+/// (`analysis::constructed`); `last_resort`: such starts tried after the constructed
+/// ones; the dict's `guess_source` says how it was found.
 #[pyfunction]
-#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None))]
+#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None, last_resort=None))]
 pub fn periodic<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -255,6 +256,7 @@ pub fn periodic<'py>(
     guess: Option<(f64, PyReadonlyArray1<'py, f64>)>,
     windings: Option<Vec<i64>>,
     homotopy: Option<Vec<(String, f64)>>,
+    last_resort: Option<Vec<(String, f64)>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = autonomous(&model, false, "periodic")?;
     let ball_winding = parse_windings(pattern, windings.as_deref(), m.n_balls()).py()?;
@@ -267,7 +269,13 @@ pub fn periodic<'py>(
         dispatch!(&m, d => {
             stiff_guess(d, guess.is_none(), &opts)?;
             Ok(match &guess {
-                None => periodic_discover(d, &ball_winding, homotopy.as_deref(), &opts),
+                None => periodic_discover(
+                    d,
+                    &ball_winding,
+                    homotopy.as_deref(),
+                    last_resort.as_deref(),
+                    &opts
+                ),
                 Some(g) => (periodic_searched(d, &ball_winding, Some(g), &opts), source_of(true)),
             })
         })

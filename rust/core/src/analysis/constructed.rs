@@ -18,13 +18,14 @@ use crate::Dynamics;
 
 /// `periodic()` without a guess: the simulated starts ([`periodic_searched`]); if they reach no orbit of the
 /// pattern, the `homotopy` starts (`(parameter, value)`, as [`homotopy_walks`] takes
-/// them); then, for one-turn patterns, the constructed starts. Returns the result and
-/// how it was found (the `guess_source` results report); when nothing converges, the
-/// simulated search's own result.
+/// them); then, for one-turn patterns, the constructed starts; then the `last_resort`
+/// homotopy starts. Returns the result and how it was found (the `guess_source`
+/// results report); when nothing converges, the simulated search's own result.
 pub fn periodic_discover<D: Parametric>(
     p: &D,
     ball_winding: &[f64],
     homotopy: Option<&[(String, f64)]>,
+    last_resort: Option<&[(String, f64)]>,
     opts: &PeriodicOptions,
 ) -> (Periodic, String) {
     let first = periodic_searched(p, ball_winding, None, opts);
@@ -39,6 +40,9 @@ pub fn periodic_discover<D: Parametric>(
         if let Some(found) = constructed_search(p, &rotating, opts) {
             return found;
         }
+    }
+    if let Some(found) = last_resort.and_then(|h| homotopy_walks(p, ball_winding, h, opts)) {
+        return found;
     }
     (first, source_of(false))
 }
