@@ -74,8 +74,7 @@ def periodic(
     model: Balancer | Scene, pattern: str, options: PeriodicOptions,
     guess: tuple[float, npt.NDArray[np.float64]] | None = None,
     windings: list[int] | None = None,
-    homotopy: list[tuple[str, float]] | None = None,
-    last_resort: list[tuple[str, float]] | None = None,
+    homotopy: tuple[list[tuple[str, float]], bool] | None = None,
 ) -> dict[str, Any]: ...
 def orbit_closure(
     model: Balancer | Scene, omega: float, coeffs: npt.NDArray[np.float64],

@@ -482,11 +482,11 @@ def periodic(
             raise ParameterTypeError("guess", "must be a PeriodicSolution or (omega, coeffs), "
                                      f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
-    starts = None if homotopy is None or homotopy is False else _homotopy(model, homotopy)
-    # By default the homotopy starts come last, after the constructed ones.
-    last = _homotopy(model, True) if homotopy is None else None
+    # (starts, before the constructed starts): by default the nearby points come last.
+    starts = (None if homotopy is False else (_homotopy(model, True), False)
+              if homotopy is None else (_homotopy(model, homotopy), True))
     d = _native.periodic(model, pattern, options,
-                         None if go is None or gc is None else (go, gc), wind, starts, last)
+                         None if go is None or gc is None else (go, gc), wind, starts)
     out = _solution(model, d)
     out.info["guess_source"] = d["guess_source"]
     return out

@@ -243,11 +243,11 @@ pub(crate) fn start(m: &Model, ball_winding: &[f64], w: f64, c: &[f64]) -> PyRes
 /// `guess` is `(omega, coefficients)` or `None` (a simulated start); `windings` the
 /// balls' turns per period (`None`: -1 for each `R`, 0 for each `O`).
 /// `homotopy`: `(parameter, value)` starts to follow from when simulation finds no
-/// orbit here (`analysis::homotopy`), before the constructed starts
-/// (`analysis::constructed`); `last_resort`: such starts tried after the constructed
-/// ones; the dict's `guess_source` says how it was found.
+/// orbit here (`analysis::homotopy`), and whether to try them before the constructed
+/// starts (`analysis::constructed`) or after; the dict's `guess_source` says how it
+/// was found.
 #[pyfunction]
-#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None, last_resort=None))]
+#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None))]
 pub fn periodic<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -255,8 +255,7 @@ pub fn periodic<'py>(
     options: PeriodicArgs,
     guess: Option<(f64, PyReadonlyArray1<'py, f64>)>,
     windings: Option<Vec<i64>>,
-    homotopy: Option<Vec<(String, f64)>>,
-    last_resort: Option<Vec<(String, f64)>>,
+    homotopy: Option<(Vec<(String, f64)>, bool)>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = autonomous(&model, false, "periodic")?;
     let ball_winding = parse_windings(pattern, windings.as_deref(), m.n_balls()).py()?;
@@ -265,17 +264,16 @@ pub fn periodic<'py>(
         Some((w, c)) => Some(start(&m, &ball_winding, *w, slice(c, "guess")?)?),
         None => None,
     };
+    let (first, last) = match &homotopy {
+        Some((starts, true)) => (Some(starts.as_slice()), None),
+        Some((starts, false)) => (None, Some(starts.as_slice())),
+        None => (None, None),
+    };
     let (r, source) = guarded(py, || {
         dispatch!(&m, d => {
             stiff_guess(d, guess.is_none(), &opts)?;
             Ok(match &guess {
-                None => periodic_discover(
-                    d,
-                    &ball_winding,
-                    homotopy.as_deref(),
-                    last_resort.as_deref(),
-                    &opts
-                ),
+                None => periodic_discover(d, &ball_winding, first, last, &opts),
                 Some(g) => (periodic_searched(d, &ball_winding, Some(g), &opts), source_of(true)),
             })
         })
