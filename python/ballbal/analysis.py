@@ -422,8 +422,9 @@ def periodic(
     model's, then ``eta = 1``; a dict ``{"Omega": 1.2}`` or pairs ``[("Omega", 1.2)]``
     give the starts to try, in order. Only used without ``guess`` and only when
     simulation here finds nothing. By default (``None``) the ``True`` starts are tried
-    last, after the constructed starts; ``False`` never tries them. ``info["guess_source"]`` says how every result was
-    found: ``"simulation"``, ``"guess"`` or ``"homotopy from Omega=1.2"``.
+    last, after the constructed starts; ``False`` never tries them.
+    ``info["guess_source"]`` says how every result was found: ``"simulation"``,
+    ``"guess"``, ``"constructed (...)"`` or ``"homotopy from Omega=1.2"``.
 
     ``N="auto"`` starts at 3 and raises the harmonics (solving from the last) until the
     highest harmonic relative to the motion (``tail``) and the trivial multiplier's
