@@ -52,7 +52,7 @@ use crate::error::{Error, Result};
 use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
 use crate::numerics::problem::{Parametric, Problem};
 use crate::periodic::{finish, Periodic, PeriodicOptions};
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{Complex, ComplexField, DMatrix, DVector};
 use std::f64::consts::PI;
 
 /// The bifurcation a curve continues.
@@ -925,84 +925,6 @@ fn hill_from(lin: &Sampled, n_harm: usize, theta: f64) -> DMatrix<C64> {
     })
 }
 
-/// Complex borders of the Neimark–Sacker test matrix.
-#[derive(Debug, Clone)]
-struct CBorder {
-    b: DVector<C64>,
-    c: DVector<C64>,
-}
-
-impl CBorder {
-    fn from_svd(h: &DMatrix<C64>) -> Result<Self> {
-        let svd = h.clone().svd(true, true);
-        let (u, vt) = match (svd.u, svd.v_t) {
-            (Some(u), Some(vt)) => (u, vt),
-            _ => return Err(Error::Eigen("SVD of the test matrix failed".into())),
-        };
-        let k = svd
-            .singular_values
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
-        Ok(CBorder {
-            b: u.column(k).into_owned(),
-            c: vt.row(k).adjoint(),
-        })
-    }
-
-    /// `[[H, b], [c^H, 0]]`.
-    fn matrix(&self, h: &DMatrix<C64>) -> DMatrix<C64> {
-        let m = h.nrows();
-        DMatrix::from_fn(m + 1, m + 1, |i, j| match (i < m, j < m) {
-            (true, true) => h[(i, j)],
-            (true, false) => self.b[i],
-            (false, true) => self.c[j].conj(),
-            (false, false) => C64::default(),
-        })
-    }
-
-    /// `g` of `[[H, b], [c^H, 0]] [v; g] = e`; with `adjoint`, also `v` and `w` of
-    /// `[[H, b], [c^H, 0]]^H [w; h] = e` (then `dg = -w^H dH v`).
-    #[allow(clippy::type_complexity)]
-    fn solve(
-        &self,
-        h: &DMatrix<C64>,
-        adjoint: bool,
-    ) -> Option<(C64, Option<(Vec<C64>, Vec<C64>)>)> {
-        let m = h.nrows();
-        let bm = self.matrix(h);
-        let mut e = DVector::zeros(m + 1);
-        e[m] = C64::new(1.0, 0.0);
-        let s = bm.clone().lu().solve(&e)?;
-        let g = s[m];
-        if !(g.re.is_finite() && g.im.is_finite()) {
-            return None;
-        }
-        if !adjoint {
-            return Some((g, None));
-        }
-        let t = bm.adjoint().lu().solve(&e)?;
-        Some((
-            g,
-            Some((
-                s.rows(0, m).iter().copied().collect(),
-                t.rows(0, m).iter().copied().collect(),
-            )),
-        ))
-    }
-
-    fn update(&mut self, v: &[C64], w: &[C64]) {
-        let nv = v.iter().map(|x| x.norm_sqr()).sum::<f64>().sqrt();
-        let nw = w.iter().map(|x| x.norm_sqr()).sum::<f64>().sqrt();
-        if nv > 0.0 && nw > 0.0 && nv.is_finite() && nw.is_finite() {
-            self.c = DVector::from_iterator(v.len(), v.iter().map(|x| x / nv));
-            self.b = DVector::from_iterator(w.len(), w.iter().map(|x| x / nw));
-        }
-    }
-}
-
 /// The angle in `(0, pi)` where Hill's matrix of [`PoSystem::hill_ns`] is closest to
 /// singular (smallest least singular value): the start's critical pair.
 fn start_angle<D: Parametric>(sys: &mut PoSystem<'_, D>, xf: &[f64], p: [f64; 2]) -> Result<f64> {
@@ -1066,16 +988,19 @@ fn start_angle<D: Parametric>(sys: &mut PoSystem<'_, D>, xf: &[f64], p: [f64; 2]
     Ok(best.0)
 }
 
-/// Borders of a minimally augmented system: `b` (a column), `c` (a row).
+/// Borders of a minimally augmented system: `b` (a column), `c` (a row, kept as its
+/// adjoint): real, or complex for the Neimark–Sacker test matrix.
 #[derive(Debug, Clone)]
-struct Border {
-    b: DVector<f64>,
-    c: DVector<f64>,
+struct Border<T: ComplexField> {
+    b: DVector<T>,
+    c: DVector<T>,
 }
 
-impl Border {
+type CBorder = Border<C64>;
+
+impl<T: ComplexField<RealField = f64>> Border<T> {
     /// The smallest singular value's left and right vectors.
-    fn from_svd(h: &DMatrix<f64>) -> Result<Self> {
+    fn from_svd(h: &DMatrix<T>) -> Result<Self> {
         let svd = h.clone().svd(true, true);
         let (u, vt) = match (svd.u, svd.v_t) {
             (Some(u), Some(vt)) => (u, vt),
@@ -1090,57 +1015,59 @@ impl Border {
             .unwrap_or(0);
         Ok(Border {
             b: u.column(k).into_owned(),
-            c: vt.row(k).transpose(),
+            c: vt.row(k).adjoint(),
         })
     }
 
-    fn matrix(&self, h: &DMatrix<f64>) -> DMatrix<f64> {
+    /// `[[H, b], [c^H, 0]]`.
+    fn matrix(&self, h: &DMatrix<T>) -> DMatrix<T> {
         let m = h.nrows();
         DMatrix::from_fn(m + 1, m + 1, |i, j| match (i < m, j < m) {
-            (true, true) => h[(i, j)],
-            (true, false) => self.b[i],
-            (false, true) => self.c[j],
-            (false, false) => 0.0,
+            (true, true) => h[(i, j)].clone(),
+            (true, false) => self.b[i].clone(),
+            (false, true) => self.c[j].clone().conjugate(),
+            (false, false) => T::zero(),
         })
     }
 
-    /// `g` of `[[H, b], [c^T, 0]] [v; g] = e`; with `adjoint`, also `v` and the adjoint
-    /// `w` (`[[H, b], [c^T, 0]]^T [w; g] = e`).
+    /// `g` of `[[H, b], [c^H, 0]] [v; g] = e`; with `adjoint`, also `v` and the adjoint
+    /// `w` of `[[H, b], [c^H, 0]]^H [w; h] = e` (then `dg = -w^H dH v`).
     #[allow(clippy::type_complexity)]
-    fn solve(
-        &self,
-        h: &DMatrix<f64>,
-        adjoint: bool,
-    ) -> Option<(f64, Option<(Vec<f64>, Vec<f64>)>)> {
+    fn solve(&self, h: &DMatrix<T>, adjoint: bool) -> Option<(T, Option<(Vec<T>, Vec<T>)>)> {
         let m = h.nrows();
         let bm = self.matrix(h);
         let mut e = DVector::zeros(m + 1);
-        e[m] = 1.0;
+        e[m] = T::one();
         let s = bm.clone().lu().solve(&e)?;
-        let g = s[m];
+        let g = s[m].clone();
         if !g.is_finite() {
             return None;
         }
         if !adjoint {
             return Some((g, None));
         }
-        let t = bm.transpose().lu().solve(&e)?;
+        let t = bm.adjoint().lu().solve(&e)?;
         Some((
             g,
             Some((
-                s.rows(0, m).iter().copied().collect(),
-                t.rows(0, m).iter().copied().collect(),
+                s.rows(0, m).iter().cloned().collect(),
+                t.rows(0, m).iter().cloned().collect(),
             )),
         ))
     }
 
     /// New borders from a point's null and adjoint vectors (unit length).
-    fn update(&mut self, v: &[f64], w: &[f64]) {
-        let nv = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let nw = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+    fn update(&mut self, v: &[T], w: &[T]) {
+        let norm = |x: &[T]| {
+            x.iter()
+                .map(|a| a.clone().modulus_squared())
+                .sum::<f64>()
+                .sqrt()
+        };
+        let (nv, nw) = (norm(v), norm(w));
         if nv > 0.0 && nw > 0.0 && nv.is_finite() && nw.is_finite() {
-            self.c = DVector::from_iterator(v.len(), v.iter().map(|x| x / nv));
-            self.b = DVector::from_iterator(w.len(), w.iter().map(|x| x / nw));
+            self.c = DVector::from_iterator(v.len(), v.iter().map(|x| x.clone().unscale(nv)));
+            self.b = DVector::from_iterator(w.len(), w.iter().map(|x| x.clone().unscale(nw)));
         }
     }
 }
@@ -1150,7 +1077,7 @@ impl Border {
 pub struct Augmented<'a, D: Parametric> {
     pub sys: PoSystem<'a, D>,
     kind: PoCurveKind,
-    border: Border,
+    border: Border<f64>,
     /// The complex borders of an `NS` curve (`border` is then unused).
     cborder: Option<CBorder>,
     /// `g` is divided by its gradient's norm at the start: `|g|` is then about the
@@ -1545,7 +1472,7 @@ type Half<'a, D> = (PoCurve, PoSystem<'a, D>);
 /// The start's borders: real, or complex for `NS`.
 #[derive(Debug, Clone)]
 enum Borders {
-    Real(Border),
+    Real(Border<f64>),
     Complex(CBorder),
 }
 
