@@ -484,8 +484,11 @@ def periodic(
                                      f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
     # (starts, before the constructed starts): by default the nearby points come last.
-    starts = (None if homotopy is False else (_homotopy(model, True), False)
-              if homotopy is None else (_homotopy(model, homotopy), True))
+    starts: tuple[list[tuple[str, float]], bool] | None = None
+    if homotopy is None:
+        starts = (_homotopy(model, True), False)
+    elif homotopy is not False:
+        starts = (_homotopy(model, homotopy), True)
     d = _native.periodic(model, pattern, options,
                          None if go is None or gc is None else (go, gc), wind, starts)
     out = _solution(model, d)

@@ -475,12 +475,13 @@ fn classify_with<D: Dynamics + ?Sized>(
     // harmonic balance to another of the coexisting O-O orbits on the thesis maps. The
     // settling run's steps up to its last one are those steps, so it continues from
     // there rather than integrating them again.
-    let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
-    let traj = match &settled {
-        Some(cp) if !early => solve_at_from(rhs, cp, &all_t, &opts),
+    let traj = if early {
         // the observation's own start: it integrated from there with a fresh solver
-        _ if early => solve_at(rhs, g.settle, &ys, &all_t, &opts),
-        _ => solve_at(rhs, 0.0, y0, &all_t, &opts),
+        solve_at(rhs, g.settle, &ys, &all_t, &opts)
+    } else if let Some(cp) = &settled {
+        solve_at_from(rhs, cp, &all_t, &opts)
+    } else {
+        solve_at(rhs, 0.0, y0, &all_t, &opts)
     };
     let Ok((traj, _)) = traj else {
         return Failed;
