@@ -25,6 +25,14 @@ __all__ = ["periodic_curve"]
 _KINDS = ("LP", "BP", "PD", "NS")
 
 
+def _flag_label(kind: str, status: str) -> str:
+    """A codimension-two label as the ``flag`` column shows it: only a confirmed point
+    carries the bare label of a bifurcation."""
+    if status == "confirmed":
+        return kind
+    return f"{kind}?" if status == "undetermined" else f"not {kind}"
+
+
 def periodic_curve(
     branch: Branch,
     event_index: int,
@@ -55,13 +63,24 @@ def periodic_curve(
     stability and multipliers with ``periodic_options``, ``test`` (the curve's own test
     function, ~0), ``test_*`` (the other kinds' determinants, whose sign changes are the
     codimension-two points), ``flag`` (the codimension-two points located since the
-    previous row)); an ``NS`` curve also has ``theta``, the critical pair's angle in
-    ``(0, pi)``. ``points``: the codimension-two points (``CP`` cusp of an LP curve,
+    previous row: the bare label when its multipliers confirm it, ``"LPPD?"`` when they
+    cannot decide, ``"not LPPD"`` when they reject it)); an ``NS`` curve also has
+    ``theta``, the critical pair's angle in ``(0, pi)``. ``points``: the sign changes of
+    the test functions located on the curve (``CP`` cusp of an LP curve,
     ``BP`` / ``LP`` / ``PD`` where the curve meets that curve, ``LPPD`` fold–flip; on an
     ``NS`` curve ``LPNS`` fold–Neimark–Sacker, ``PDNS`` flip–Neimark–Sacker, ``BPNS`` and
     the strong resonances ``R4`` (``theta = pi/2``) and ``R3`` (``theta = 2 pi/3``)). An
     ``NS`` curve ends with ``"resonance_1:1"`` / ``"resonance_1:2"`` where ``theta``
-    reaches 0 or pi (the pair meets the real axis).
+    reaches 0 or pi (the pair meets the real axis). Each point carries its multiplier
+    certificate: ``status`` (``"confirmed"``, ``"rejected"``, ``"undetermined"``; only a
+    confirmed point is a codimension-two bifurcation, a truncated Galerkin determinant can
+    change sign with no multiplier crossing), ``gap`` (distance of the nearest multiplier
+    to the value the label adds: -1 for ``LPPD`` on an LP curve, ``PD``, ``PDNS``; the
+    separation multiplier's +1 for ``BP``, ``BPNS``; a second +1 for ``LP``, ``LPNS``,
+    ``LPPD`` on a PD curve; for ``CP``, ``R3``, ``R4`` the curve's own), ``residual`` /
+    ``own_residual`` (the smallest perturbation of the monodromy that puts a multiplier at
+    the added / the curve's own value) and ``error`` (the monodromy's estimated error);
+    see docs/guide.md, "Certificates of codimension-two points".
     ``meta["solutions"]``: the :class:`~ballbal.PeriodicSolution` of every row.
     """
     if not isinstance(branch, Branch) or branch.kind != "periodic":
@@ -105,7 +124,8 @@ def periodic_curve(
     flags: list[str | None] = [None] * len(pts)
     for s in d["special"]:
         r = min(int(s["row"]), len(pts) - 1)
-        flags[r] = s["type"] if flags[r] is None else f"{flags[r]},{s['type']}"
+        label = _flag_label(s["type"], s["status"])
+        flags[r] = label if flags[r] is None else f"{flags[r]},{label}"
     tests = sorted({k for p in pts for k in p if k.startswith("test_")})
     ns = kind == "NS"
     rows = []
@@ -132,8 +152,11 @@ def periodic_curve(
     points = pl.DataFrame({
         "type": [s["type"] for s in sp], p1: [s["p1"] for s in sp],
         p2: [s["p2"] for s in sp], "omega": [s["omega"] for s in sp],
-        "row": [s["row"] for s in sp],
-    }, schema={"type": pl.Utf8, p1: f, p2: f, "omega": f, "row": pl.Int64})
+        "row": [s["row"] for s in sp], "status": [s["status"] for s in sp],
+        "gap": [s["gap"] for s in sp], "residual": [s["residual"] for s in sp],
+        "own_residual": [s["own_residual"] for s in sp], "error": [s["error"] for s in sp],
+    }, schema={"type": pl.Utf8, p1: f, p2: f, "omega": f, "row": pl.Int64,
+               "status": pl.Utf8, "gap": f, "residual": f, "own_residual": f, "error": f})
     solutions = tuple(_solution(model_at(model_at(model, p1, p["p1"]), p2, p["p2"]), p)
                       for p in pts)
     return Curve(kind=d["kind"], parameters=(p1, p2), table=table, points=points,

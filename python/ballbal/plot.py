@@ -26,7 +26,9 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
     stable and unstable markers, and the perfect balance's stable region shaded (for a
     scene with springs, its balanced state's: name it with ``shade``). ``curves``:
     :class:`~ballbal.continuation` curves (``Curve`` objects whose tables have the columns
-    ``x`` and ``y``) drawn over the map, with their codimension-two points."""
+    ``x`` and ``y``) drawn over the map, with their codimension-two points (black stars
+    for the confirmed ones; points whose multipliers reject or cannot decide the label,
+    ``status`` other than ``"confirmed"``, as hollow grey circles)."""
     plt = _pyplot()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))
@@ -53,8 +55,17 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
             if col not in t.columns:
                 raise ValueError(f"curves: a {cv.kind} curve has no column {col!r}")
         ax.plot(t[x], t[y], "-" if cv.kind != "hopf" else "--", lw=1.5, label=cv.kind)
-        if cv.points.height:
-            ax.plot(cv.points[x], cv.points[y], "k*", ms=9)
+        pts = cv.points
+        if pts.height and "status" in pts.columns:
+            # only confirmed points are bifurcations: the others hollow, grey
+            ok = pts.filter(pl.col("status") == "confirmed")
+            other = pts.filter(pl.col("status") != "confirmed")
+            if ok.height:
+                ax.plot(ok[x], ok[y], "k*", ms=9)
+            if other.height:
+                ax.plot(other[x], other[y], "o", ms=6, mfc="none", color="tab:gray")
+        elif pts.height:
+            ax.plot(pts[x], pts[y], "k*", ms=9)
     ax.set_xlabel(x)
     ax.set_ylabel(y)
     ax.set_title(title or f"{type} solutions")

@@ -20,7 +20,9 @@ use pyo3::types::PyDict;
 /// `start = (omega, coeffs, winding)` of `model` (at the event's parameter values) in
 /// `(parameter, parameter2)`; `range` bounds `parameter2`, `range1` `parameter`. Returns
 /// `{"kind", "together", "points": [dict], "special": [dict], "stop": str}`; an `NS`
-/// curve's points carry `"theta"`, the critical pair's angle.
+/// curve's points carry `"theta"`, the critical pair's angle; each special point its
+/// multiplier certificate (`"status"`, `"gap"`, `"residual"`, `"own_residual"`,
+/// `"error"`).
 #[pyfunction]
 #[pyo3(signature = (model, kind, parameter, parameter2, start, range, range1, continuation, options, locate_tol))]
 #[allow(clippy::too_many_arguments)]
@@ -101,6 +103,12 @@ pub fn periodic_curve<'py>(
         d.set_item("p2", s.p[1])?;
         d.set_item("omega", s.omega)?;
         d.set_item("row", s.row)?;
+        let c = s.certificate;
+        d.set_item("status", c.status.as_str())?;
+        d.set_item("gap", c.gap)?;
+        d.set_item("residual", c.residual)?;
+        d.set_item("own_residual", c.own_residual)?;
+        d.set_item("error", c.error)?;
         special.push(d);
     }
     out.set_item("kind", c.kind.as_str())?;
