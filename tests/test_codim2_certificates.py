@@ -14,14 +14,15 @@ from functools import cache
 
 import numpy as np
 import polars as pl
+from scipy.integrate import solve_ivp
+from test_codim2 import fold_curve
+from test_ns_curves import _flow, _monodromy
+from test_po_curves import MONODROMY, NO_FLOQUET, thesis
 
 import ballbal
 from ballbal.continuation import Continuation, Curve, periodic_branch, periodic_curve
 
 from reference import rhs
-from test_codim2 import fold_curve
-from test_ns_curves import _flow, _monodromy
-from test_po_curves import MONODROMY, NO_FLOQUET, thesis
 
 
 def shoot(b: ballbal.Balancer, y: np.ndarray, T: float, winding: np.ndarray
@@ -125,7 +126,7 @@ def test_near_homoclinic_flags_are_not_presented_as_bifurcations() -> None:
     r = int(lppd["row"][0])
     s = c.meta["solutions"][r]
     y0 = s.state(0.0)
-    from scipy.integrate import solve_ivp
+
     end = solve_ivp(lambda t, x: rhs(s.balancer, t, x), (0, s.period), y0, rtol=1e-10,
                     atol=1e-12, method="DOP853").y[:, -1]
     shift = np.zeros(8)
