@@ -25,18 +25,20 @@ from ballbal.continuation import Continuation, Curve, periodic_branch, periodic_
 from reference import rhs
 
 
-def shoot(b: ballbal.Balancer, y: np.ndarray, T: float, winding: np.ndarray
-          ) -> tuple[float, np.ndarray]:
+def shoot(b: ballbal.Balancer, y: np.ndarray, T: float, winding: np.ndarray,
+          h: float = 1e-6) -> tuple[float, np.ndarray]:
     """Newton on ``phi_T(y0) - y0 - 2 pi winding = 0`` (unknowns: the state but the
     first ball's angle, which fixes the phase, and ``T``; the Jacobian from the
     monodromy and the flow's velocity), from a close start: the period and the
-    monodromy's eigenvalues at the closed orbit."""
+    monodromy's eigenvalues at the closed orbit. ``h``: the differences' step (small:
+    on the snake a perturbation grows ~900-fold over a period, and its square's term
+    would move the trivial multiplier by 1e-2 at h = 1e-4)."""
     shift = np.zeros(8)
     shift[:4] = 2 * np.pi * np.asarray(winding)
     free = [i for i in range(8) if i != 2]
     y = y.copy()
     for _ in range(6):
-        M = _monodromy(b, y, T)  # type: ignore[arg-type]
+        M = _monodromy(b, y, T, h)  # type: ignore[arg-type]
         end = _flow(b, y, T)  # type: ignore[arg-type]
         r = end - y - shift
         if np.max(np.abs(r)) < 1e-9:
@@ -150,3 +152,50 @@ def test_plot_marks_only_confirmed_points() -> None:
     assert sum(len(ln.get_xdata()) for ln in stars) == n_conf
     hollow = [ln for ln in ax.lines if ln.get_marker() == "o"]
     assert sum(len(ln.get_xdata()) for ln in hollow) == c.points.height - n_conf
+
+
+@cache
+def snake() -> ballbal.continuation.Branch:
+    """The merged R-R at mu 0.2, zeta 0.05, zeta_b 0.1, delta 50, eta 1 continued up in
+    Omega from 1.2: its BP and LP at ~1.40, then back down onto the unstable snake, whose
+    first fold (~1.2177) has a PD right past it (multipliers of modulus ~900)."""
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, delta=50.0, zeta_b=0.1, Omega=1.2,
+                         eta=(1.0, 1.0))
+    start = ballbal.periodic(b, "R-R", options=MONODROMY)
+    return periodic_branch(start, "Omega", range=(0.95, 1.9), periodic_options=MONODROMY,
+                           options=Continuation(ds=0.05, ds_max=0.2, max_points=50))
+
+
+def test_snake_period_doubling_against_shooting() -> None:
+    """The snake's first PD, shot at the event's Omega from the event's orbit: a
+    multiplier at -1 and the same period. The tolerance: the event is located to
+    ``event_tol`` = 1e-7 in Omega, where the multiplier moves at |dlambda/dOmega| ~4e3
+    (between the two rows after it, both shot here): 4e-4; the N = 8 series' truncation and
+    the differenced monodromy add ~1e-6 (the largest multiplier, ~809, agrees with the
+    branch's to 2e-8). Measured: 2.2e-6."""
+    br = snake()
+    ev = br.events
+    types = ev["type"].to_list()
+    assert "PD" in types, ev
+    i = types.index("PD")
+    k = int(ev["index"][i])
+    assert 1.2 < float(ev["Omega"][i]) < 1.25
+    assert float(br.table["max_modulus"][k]) > 100  # the snake's: strongly unstable
+    s = br.event_solutions[i]
+    T, m = shoot(s.balancer, s.state(0.0), s.period, np.asarray(s.winding))
+    # measured 1e-13: the N = 8 series' period
+    assert abs(T / s.period - 1) < 1e-8, (T, s.period)
+    lam = []
+    for r in (k, k + 1):
+        sr = br.solutions[r]
+        _, mr = shoot(sr.balancer, sr.state(0.0), sr.period, np.asarray(sr.winding))
+        real = mr[np.abs(mr.imag) < 1e-8].real
+        lam.append(real[real < -1].max())  # the multiplier that went through -1
+    om = br.table["Omega"].to_numpy()[[k, k + 1]]
+    slope = abs((lam[1] - lam[0]) / (om[1] - om[0]))
+    assert 1e3 < slope < 1e5, slope
+    tol = float(br.meta["event_tol"]) * slope + 1e-5
+    gap = float(np.min(np.abs(m + 1)))
+    assert gap < tol, (gap, tol, m)
+    # the trivial multiplier: the differenced monodromy's own error (measured 1.3e-6)
+    assert float(np.min(np.abs(m - 1))) < 1e-5, m
