@@ -130,6 +130,8 @@ def periodic_branch(
     continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
 ) -> dict[str, Any]: ...
 # {"kind", "together", "points": [solution dict + p1, p2, test, test_*], "special", "stop"}
+# special: [{"type", "p1", "p2", "omega", "row", "status" ("confirmed" | "rejected" |
+#   "undetermined"), "gap", "residual", "own_residual", "error"}]
 def periodic_curve(
     model: Balancer | Scene, kind: str, parameter: str, parameter2: str,
     start: tuple[float, npt.NDArray[np.float64], list[float]], range: tuple[float, float],
