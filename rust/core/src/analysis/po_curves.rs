@@ -1438,8 +1438,8 @@ fn added_need(kind: PoCurveKind, label: &str) -> Option<Need> {
 }
 
 /// The verdict on one needed multiplier: `residual` the backward error at the value,
-/// `resolution` the smaller of those at the value moved by [`CODIM2_RESOLUTION`] either
-/// way, `error` the monodromy's, `trusted` whether the monodromy passes the crate's own
+/// `resolution` the larger of those at the value moved by [`CODIM2_RESOLUTION`] either
+/// way (another genuine multiplier may sit on one side), `error` the monodromy's, `trusted` whether the monodromy passes the crate's own
 /// certificate (trivial multiplier within `MAX_TRIVIAL` of 1) at all.
 pub fn condition_status(residual: f64, resolution: f64, error: f64, trusted: bool) -> Codim2Status {
     let tol = CODIM2_SAFETY * error;
