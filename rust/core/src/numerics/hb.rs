@@ -336,6 +336,108 @@ impl HbSolution {
     }
 }
 
+/// Harmonic counts up to which the Galerkin Jacobian is projected sample by sample
+/// ([`HbSystem`]'s direct path, the arithmetic every N = 3 scan was saved with); above
+/// it, from the Fourier coefficients of the Jacobian entries (product-to-sum).
+///
+/// At N = 3 the two cost the same (`S (2N+1)^2 = 1568` multiply-adds per coordinate
+/// pair against `3 S (4N+2) = 1248` plus the `(2N+1)^2` sums), so the direct path costs
+/// nothing there and keeps the scans' Newton paths to the bit: the two differ at
+/// round-off, and a scan's discovery (which coexisting O-O orbit a Newton run from a
+/// simulated seed reaches on the zeta 0.02 maps) changed on such round-off in an
+/// earlier attempt. From N = 4 on the product-to-sum path is the cheaper one (at N = 8,
+/// 2.9 times fewer operations, and a matrix product instead of a scalar loop).
+pub const DIRECT_PROJECTION_MAX_HARM: usize = 3;
+
+/// Stages of a harmonic-balance solve whose time [`stage_seconds`] reports, when
+/// [`stage_profile`] has switched the timers on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Sampling the series, the model's residual at the samples and its projection
+    /// (the alternating frequency–time residual).
+    Residual = 0,
+    /// The model's `K, C, M` at the samples.
+    ModelJacobians = 1,
+    /// The Galerkin projection of `K, C, M` into the Jacobian (and its omega column).
+    Projection = 2,
+    /// The LU factorisation and solve of the Newton step.
+    Lu = 3,
+}
+
+const STAGES: usize = 4;
+static PROFILE_ON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+static STAGE_NANOS: [std::sync::atomic::AtomicU64; STAGES] =
+    [const { std::sync::atomic::AtomicU64::new(0) }; STAGES];
+/// Solves, Newton iterations (LU solves) and residual evaluations.
+static COUNTS: [std::sync::atomic::AtomicU64; 3] =
+    [const { std::sync::atomic::AtomicU64::new(0) }; 3];
+
+/// Switches the per-stage timers of [`stage_seconds`] on or off (off by default: a
+/// benchmark's measure; the timers cost two clock reads per stage and change nothing
+/// else) and resets them.
+pub fn stage_profile(on: bool) {
+    use std::sync::atomic::Ordering::Relaxed;
+    PROFILE_ON.store(on, Relaxed);
+    STAGE_NANOS.iter().chain(&COUNTS).for_each(|a| a.store(0, Relaxed));
+}
+
+/// Seconds per [`Stage`] (in its order) since [`stage_profile`] switched the timers on,
+/// then the number of solves, Newton iterations and residual evaluations.
+pub fn stage_seconds() -> [f64; STAGES + 3] {
+    use std::sync::atomic::Ordering::Relaxed;
+    let mut out = [0.0; STAGES + 3];
+    for (o, a) in out.iter_mut().zip(&STAGE_NANOS) {
+        *o = a.load(Relaxed) as f64 * 1e-9;
+    }
+    for (o, a) in out[STAGES..].iter_mut().zip(&COUNTS) {
+        *o = a.load(Relaxed) as f64;
+    }
+    out
+}
+
+#[inline(always)]
+fn profiling() -> bool {
+    PROFILE_ON.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Runs `f`, adding its time to `stage` when the timers are on.
+#[inline(always)]
+fn timed<T>(stage: Stage, f: impl FnOnce() -> T) -> T {
+    if !profiling() {
+        return f();
+    }
+    let t = std::time::Instant::now();
+    let out = f();
+    STAGE_NANOS[stage as usize].fetch_add(
+        t.elapsed().as_nanos() as u64,
+        std::sync::atomic::Ordering::Relaxed,
+    );
+    out
+}
+
+fn count(what: usize) {
+    if profiling() {
+        COUNTS[what].fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+/// `cos k tau_i` and `sin k tau_i` for `k = 0..=2N` (row-major `S x 2(2N+1)`, the
+/// cosines first): the discrete Fourier transform that gives the Jacobian entries'
+/// coefficients. The angle is reduced to `2 pi (k i mod S) / S` before the
+/// trigonometric call, so every entry is as accurate as the basis tables.
+fn dft_table(n_harm: usize, samples: usize) -> Vec<f64> {
+    let w = 2 * n_harm + 1;
+    let mut t = vec![0.0; samples * 2 * w];
+    for i in 0..samples {
+        for k in 0..w {
+            let (sn, cs) = (2.0 * PI * ((k * i) % samples) as f64 / samples as f64).sin_cos();
+            t[i * 2 * w + k] = cs;
+            t[i * 2 * w + w + k] = sn;
+        }
+    }
+    t
+}
+
 /// Workspace and fixed data of one harmonic-balance problem.
 pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     model: &'a D,
@@ -350,10 +452,13 @@ pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     qt: Vec<f64>,
     qtt: Vec<f64>,
     f: Vec<f64>,
-    k: Vec<f64>,
-    c: Vec<f64>,
-    m: Vec<f64>,
+    /// Row-major `S x 3d^2`: per sample `K`, then `C`, then `M` (each row-major `d x d`).
+    kcm: Vec<f64>,
     g: Vec<f64>,
+    /// Product-to-sum path (`n_harm > DIRECT_PROJECTION_MAX_HARM`): the DFT table and
+    /// the `3d^2 x 2(2N+1)` Fourier coefficients of the entries of `K, C, M`.
+    dft: Vec<f64>,
+    coef: Vec<f64>,
 }
 
 impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
@@ -374,10 +479,11 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             qt: vec![0.0; s * d],
             qtt: vec![0.0; s * d],
             f: vec![0.0; s * d],
-            k: vec![0.0; s * d * d],
-            c: vec![0.0; s * d * d],
-            m: vec![0.0; s * d * d],
+            kcm: vec![0.0; s * 3 * d * d],
             g: vec![0.0; s * (2 * n_harm + 1)],
+            // Built on first use: the direct path never needs them.
+            dft: vec![],
+            coef: vec![],
         }
     }
 
@@ -429,12 +535,21 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         r: &mut [f64],
         jac: Option<&mut [f64]>,
     ) {
+        timed(Stage::Residual, || self.residual_with(model, x, r));
+        if let Some(jac) = jac {
+            self.jacobian_at_samples(model, x, jac);
+        }
+    }
+
+    /// The residual alone: samples `x`, evaluates the model there and projects.
+    #[inline(never)]
+    fn residual_with<M: Dynamics + ?Sized>(&mut self, model: &M, x: &[f64], r: &mut [f64]) {
+        count(2);
         let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         let om = x[d * l];
         self.sample(x);
         let mut v = vec![0.0; d];
         let mut a = vec![0.0; d];
-        let want_jac = jac.is_some();
         for i in 0..s {
             for j in 0..d {
                 v[j] = om * self.qt[i * d + j];
@@ -443,14 +558,6 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             let t = self.basis.tau[i] / om;
             let q = &self.q[i * d..(i + 1) * d];
             model.residual(t, q, &v, &a, &mut self.f[i * d..(i + 1) * d]);
-            if want_jac {
-                let (kk, cc, mm) = (
-                    &mut self.k[i * d * d..(i + 1) * d * d],
-                    &mut self.c[i * d * d..(i + 1) * d * d],
-                    &mut self.m[i * d * d..(i + 1) * d * d],
-                );
-                model.jacobians(t, q, &v, &a, kk, cc, mm);
-            }
         }
         // Galerkin projection.
         r.fill(0.0);
@@ -474,30 +581,90 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         } else {
             x[pc * l + 2]
         };
-        let Some(jac) = jac else { return };
+    }
+
+    /// The Jacobian at `x`, the point the last residual evaluation sampled (its
+    /// `q, q', q''` are reused): what Newton needs after a line search accepted the
+    /// point whose residual it has just evaluated.
+    pub fn jacobian_after_residual(&mut self, x: &[f64], jac: &mut [f64]) {
+        let model = self.model;
+        self.jacobian_at_samples(model, x, jac);
+    }
+
+    /// `K, C, M` at the sampled points and their Galerkin projection.
+    fn jacobian_at_samples<M: Dynamics + ?Sized>(&mut self, model: &M, x: &[f64], jac: &mut [f64]) {
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
+        let om = x[d * l];
+        let dd = d * d;
+        timed(Stage::ModelJacobians, || {
+            let mut v = vec![0.0; d];
+            let mut a = vec![0.0; d];
+            for i in 0..s {
+                for j in 0..d {
+                    v[j] = om * self.qt[i * d + j];
+                    a[j] = om * om * self.qtt[i * d + j];
+                }
+                let t = self.basis.tau[i] / om;
+                let q = &self.q[i * d..(i + 1) * d];
+                let (kk, rest) = self.kcm[i * 3 * dd..(i + 1) * 3 * dd].split_at_mut(dd);
+                let (cc, mm) = rest.split_at_mut(dd);
+                model.jacobians(t, q, &v, &a, kk, cc, mm);
+            }
+        });
+        timed(Stage::Projection, || {
+            jac.fill(0.0);
+            let done = if self.basis.n_harm <= DIRECT_PROJECTION_MAX_HARM {
+                self.project_direct(om, jac)
+            } else {
+                self.project_product_to_sum(om, jac)
+            };
+            if done {
+                self.omega_column(om, jac);
+            }
+        });
+    }
+
+    /// Whether no sample couples coordinate `j` to `k` (a zero block).
+    fn zero_block(&self, j: usize, k: usize) -> bool {
+        let dd = self.d * self.d;
+        let idx = j * self.d + k;
+        !(0..self.basis.samples).any(|i| {
+            let o = i * 3 * dd + idx;
+            self.kcm[o] != 0.0 || self.kcm[o + dd] != 0.0 || self.kcm[o + 2 * dd] != 0.0
+        })
+    }
+
+    /// The Galerkin projection sample by sample, `J_jk = W^T (K Phi + omega C Phi' +
+    /// omega^2 M Phi'')`. Every entry sums its samples in order from zero, exactly as
+    /// the scans at N <= [`DIRECT_PROJECTION_MAX_HARM`] were computed (weights that are
+    /// exactly zero, `sin m tau_0`, are skipped as they always were). Returns `false`
+    /// if cancelled.
+    #[inline(never)]
+    fn project_direct(&mut self, om: f64, jac: &mut [f64]) -> bool {
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         let n = self.size();
-        jac.fill(0.0);
-        let (om2, g) = (om * om, &mut self.g);
+        let dd = d * d;
+        let om2 = om * om;
         for j in 0..d {
             for k in 0..d {
                 // A block takes a fraction of a second at hundreds of harmonics; a
                 // cancelled solve stops at the next Newton iteration (see `cancel`).
                 if crate::cancel::cancelled() {
-                    return;
+                    return false;
                 }
-                // Skip blocks where the coordinates do not interact at all.
-                let idx = j * d + k;
-                let any = (0..s).any(|i| {
-                    let o = i * d * d + idx;
-                    self.k[o] != 0.0 || self.c[o] != 0.0 || self.m[o] != 0.0
-                });
-                if !any {
+                if self.zero_block(j, k) {
                     continue;
                 }
+                let idx = j * d + k;
+                let g = &mut self.g;
                 // G = K Phi + omega C Phi' + omega^2 M Phi''  (S x L)
                 for i in 0..s {
-                    let o = i * d * d + idx;
-                    let (kv, cv, mv) = (self.k[o], om * self.c[o], om2 * self.m[o]);
+                    let o = i * 3 * dd + idx;
+                    let (kv, cv, mv) = (
+                        self.kcm[o],
+                        om * self.kcm[o + dd],
+                        om2 * self.kcm[o + 2 * dd],
+                    );
                     let b = i * l;
                     for p in 0..l {
                         g[b + p] = kv * self.basis.phi[b + p]
@@ -523,21 +690,115 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                 }
             }
         }
-        // d/d omega: C q_tau + 2 omega M q_tautau
+        true
+    }
+
+    /// The Galerkin projection from the Fourier coefficients of each entry of `K, C, M`
+    /// (`X_c[k] = sum_i X_i cos k tau_i`, `X_s[k]` likewise, `k <= 2N`, one matrix
+    /// product for all entries): the products of two basis functions in the projection
+    /// are sums of harmonics `|m - n|` and `m + n` (product-to-sum), so each block is a
+    /// Toeplitz-plus-Hankel combination of these coefficients. Equal to
+    /// [`Self::project_direct`] in exact arithmetic at any sample count (the identities
+    /// hold sample by sample), `O(S N d^2 + N^2 d^2)` instead of `O(S N^2 d^2)`.
+    /// Returns `false` if cancelled.
+    #[inline(never)]
+    fn project_product_to_sum(&mut self, om: f64, jac: &mut [f64]) -> bool {
+        use faer::{linalg::matmul::matmul, Accum, MatMut, MatRef, Par};
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
+        let nh = self.basis.n_harm;
+        let n = self.size();
+        let dd = d * d;
+        let w = 2 * nh + 1;
+        if self.dft.is_empty() {
+            self.dft = dft_table(nh, s);
+            self.coef = vec![0.0; 3 * dd * 2 * w];
+        }
+        // coef (3d^2 x 2w) = KCM^T (3d^2 x S) * table (S x 2w)
+        matmul(
+            MatMut::from_row_major_slice_mut(&mut self.coef, 3 * dd, 2 * w),
+            Accum::Replace,
+            MatRef::from_row_major_slice(&self.kcm, s, 3 * dd).transpose(),
+            MatRef::from_row_major_slice(&self.dft, s, 2 * w),
+            1.0,
+            Par::Seq,
+        );
+        let inv = 1.0 / s as f64;
+        for j in 0..d {
+            for k in 0..d {
+                if crate::cancel::cancelled() {
+                    return false;
+                }
+                if self.zero_block(j, k) {
+                    continue;
+                }
+                let idx = j * d + k;
+                let row = |x: usize| &self.coef[(x * dd + idx) * 2 * w..(x * dd + idx + 1) * 2 * w];
+                let (kx, cx, mx) = (row(0), row(1), row(2));
+                // Cosine and signed sine coefficients: sin(-k tau) = -sin(k tau).
+                let xc = |c: &[f64], h: isize| c[h.unsigned_abs()];
+                let xs = |c: &[f64], h: isize| h.signum() as f64 * c[w + h.unsigned_abs()];
+                let at = |rr: usize, p: usize| (j * l + rr) * n + k * l + p;
+                // Column n of a block: K phi + omega C phi' + omega^2 M phi'' with
+                // phi = cos n tau gives (K - omega^2 n^2 M) cos n tau - omega n C sin n tau,
+                // with phi = sin n tau, (K - omega^2 n^2 M) sin n tau + omega n C cos n tau.
+                // Rows: weight 1/S (mean), 2/S cos m tau, 2/S sin m tau.
+                jac[at(0, 0)] = inv * kx[0];
+                for m in 1..=nh {
+                    jac[at(2 * m - 1, 0)] = 2.0 * inv * kx[m];
+                    jac[at(2 * m, 0)] = 2.0 * inv * kx[w + m];
+                }
+                for nn in 1..=nh {
+                    let nf = nn as f64;
+                    let (a2, cn) = (om * om * nf * nf, om * nf);
+                    // A = K - omega^2 n^2 M, coefficient by coefficient
+                    let ac = |h: isize| xc(kx, h) - a2 * xc(mx, h);
+                    let as_ = |h: isize| xs(kx, h) - a2 * xs(mx, h);
+                    let (ni, pc, ps) = (nn as isize, 2 * nn - 1, 2 * nn);
+                    jac[at(0, pc)] = inv * (ac(ni) - cn * xs(cx, ni));
+                    jac[at(0, ps)] = inv * (as_(ni) + cn * xc(cx, ni));
+                    for m in 1..=nh {
+                        let mi = m as isize;
+                        let (dm, sm) = (mi - ni, mi + ni);
+                        let (rc, rs) = (2 * m - 1, 2 * m);
+                        // cos m cos n = (cos(m-n) + cos(m+n))/2, cos m sin n =
+                        // (sin(m+n) - sin(m-n))/2, sin m cos n = (sin(m+n) + sin(m-n))/2,
+                        // sin m sin n = (cos(m-n) - cos(m+n))/2.
+                        jac[at(rc, pc)] =
+                            inv * (ac(dm) + ac(sm) - cn * (xs(cx, sm) - xs(cx, dm)));
+                        jac[at(rc, ps)] =
+                            inv * (as_(sm) - as_(dm) + cn * (xc(cx, dm) + xc(cx, sm)));
+                        jac[at(rs, pc)] =
+                            inv * (as_(sm) + as_(dm) - cn * (xc(cx, dm) - xc(cx, sm)));
+                        jac[at(rs, ps)] =
+                            inv * (ac(dm) - ac(sm) + cn * (xs(cx, sm) + xs(cx, dm)));
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// The omega column, `d/d omega = W^T (C q_tau + 2 omega M q_tautau)`, and the
+    /// phase condition's row.
+    fn omega_column(&self, om: f64, jac: &mut [f64]) {
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
+        let n = self.size();
+        let dd = d * d;
         for i in 0..s {
             let w = &self.basis.wgt[i * l..(i + 1) * l];
             for j in 0..d {
                 let mut dfo = 0.0;
                 for k in 0..d {
-                    let o = i * d * d + j * d + k;
-                    dfo +=
-                        self.c[o] * self.qt[i * d + k] + 2.0 * om * self.m[o] * self.qtt[i * d + k];
+                    let o = i * 3 * dd + j * d + k;
+                    dfo += self.kcm[o + dd] * self.qt[i * d + k]
+                        + 2.0 * om * self.kcm[o + 2 * dd] * self.qtt[i * d + k];
                 }
                 for rr in 0..l {
                     jac[(j * l + rr) * n + d * l] += w[rr] * dfo;
                 }
             }
         }
+        let pc = self.phase_coord;
         let prow = d * l * n;
         if self.phase_rotating {
             jac[prow + pc * l] = 1.0;
@@ -641,10 +902,9 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         guess.resized(opts.n_harm)
     };
     let samples = opts.samples.unwrap_or_else(|| default_samples(opts.n_harm));
-    let mut prob = HbProblem::new(ModelAt::fixed(model), &g.winding, opts.n_harm, samples);
-    // The model as given: the problem's own parameter value, where it never fails.
-    let p = prob.param();
-    let n = prob.size();
+    count(0);
+    let mut sys = HbSystem::new(model, &g.winding, opts.n_harm, samples);
+    let n = sys.size();
     let mut x = g.unknowns();
     let mut r = vec![0.0; n];
     let mut rt = vec![0.0; n];
@@ -681,7 +941,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         );
         return out;
     }
-    let _ = prob.jac_x(&x, p, &mut r, &mut jac);
+    sys.assemble(&x, &mut r, Some(&mut jac));
     let mut rn = max_abs(&r);
     let scale0 = max_abs(&x).max(1.0);
     for it in 1..=opts.max_iter {
@@ -702,7 +962,8 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
             return out;
         }
         let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-        let Some(sol) = lu_solve(&jac, n, &neg) else {
+        count(1);
+        let Some(sol) = timed(Stage::Lu, || lu_solve(&jac, n, &neg)) else {
             finish(&x, &mut out, Status::Singular, rn, f64::INFINITY, it - 1);
             return out;
         };
@@ -720,7 +981,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
                 xt[i] = x[i] + lam * dx[i];
             }
             if xt[n - 1] > 0.0 {
-                let _ = prob.residual(&xt, p, &mut rt);
+                sys.assemble(&xt, &mut rt, None);
                 rtn = max_abs(&rt);
                 let mt = l2(&rt);
                 if mt.is_finite() && mt < (1.0 - 1e-4 * lam) * merit.max(1e-300) {
@@ -750,7 +1011,10 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
             finish(&x, &mut out, Status::Converged, rn, step, it);
             return out;
         }
-        let _ = prob.jac_x(&x, p, &mut r, &mut jac);
+        // The accepted point is the last one the line search evaluated: its residual
+        // is `rt` and its samples are still in `sys`, so only the Jacobian is new.
+        r.copy_from_slice(&rt);
+        sys.jacobian_after_residual(&x, &mut jac);
         rn = max_abs(&r);
         if it == opts.max_iter {
             finish(&x, &mut out, Status::MaxIterations, rn, step, it);
@@ -1071,6 +1335,131 @@ mod tests {
         assert!(gaps[1] < gaps[0] / 30.0, "not converging as h^2: {gaps:?}");
     }
 
+    /// The Galerkin Jacobian written out sample by sample, independently of
+    /// `HbSystem`: `J[(j, r), (k, p)] = sum_i w_r(tau_i) (K phi_p + omega C phi_p' +
+    /// omega^2 M phi_p'')_jk` with the basis from `cos`/`sin` of `m tau_i`, and the omega
+    /// column `sum_i w_r (C q_tau + 2 omega M q_tautau)_j`.
+    fn direct_jacobian<D: Dynamics>(model: &D, sol: &HbSolution, s: usize) -> Vec<f64> {
+        let (d, nh) = (sol.ndof(), sol.n_harm);
+        let l = 2 * nh + 1;
+        let n = d * l + 1;
+        let om = sol.omega;
+        let mut jac = vec![0.0; n * n];
+        // basis p at tau: (phi, phi', phi'')
+        let basis = |p: usize, t: f64| -> (f64, f64, f64) {
+            if p == 0 {
+                return (1.0, 0.0, 0.0);
+            }
+            let m = p.div_ceil(2) as f64;
+            let (sn, cs) = ((m * t).sin(), (m * t).cos());
+            if p % 2 == 1 {
+                (cs, -m * sn, -m * m * cs)
+            } else {
+                (sn, m * cs, -m * m * sn)
+            }
+        };
+        let (mut q, mut v, mut a) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+        let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        for i in 0..s {
+            let t = 2.0 * PI * i as f64 / s as f64;
+            sol.eval_rates(t, &mut q, &mut v, &mut a);
+            model.jacobians(t / om, &q, &v, &a, &mut k, &mut c, &mut m);
+            let (mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d]);
+            sol.eval(t, &mut q, &mut qt, &mut qtt);
+            for r in 0..l {
+                let wr = basis(r, t).0 * if r == 0 { 1.0 } else { 2.0 } / s as f64;
+                for j in 0..d {
+                    for kk in 0..d {
+                        let o = j * d + kk;
+                        for p in 0..l {
+                            let (f, f1, f2) = basis(p, t);
+                            jac[(j * l + r) * n + kk * l + p] +=
+                                wr * (k[o] * f + om * c[o] * f1 + om * om * m[o] * f2);
+                        }
+                        jac[(j * l + r) * n + d * l] +=
+                            wr * (c[o] * qt[kk] + 2.0 * om * m[o] * qtt[kk]);
+                    }
+                }
+            }
+        }
+        jac
+    }
+
+    #[test]
+    fn product_to_sum_jacobian_equals_the_direct_projection() {
+        use crate::model::Planar;
+        use crate::periodic::{periodic, PeriodicOptions};
+        let opts = |n_harm| PeriodicOptions {
+            hb: HbOptions {
+                n_harm,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        // Two merged balls on a converged R-R orbit (standard case), and motions of two
+        // and three balls with one rotating and one oscillating ball: a series with
+        // slowly decaying harmonics in every coordinate.
+        let two = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let three = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.3, &[1.0, 0.8, 0.6]).unwrap();
+        let rr = periodic(&two, &[true, true], None, &opts(3)).sol;
+        assert_eq!(rr.status, Status::Converged);
+        let synthetic = |winding: Vec<f64>, nh: usize| {
+            let l = 2 * nh + 1;
+            let coeffs = (0..winding.len() * l)
+                .map(|i| {
+                    let h = (i % l).div_ceil(2) as f64;
+                    0.3 * ((i * 37 % 17) as f64 / 8.0 - 1.0) / (1.0 + h * h)
+                })
+                .collect();
+            HbSolution::start(0.83, coeffs, winding, nh, Status::Converged)
+        };
+        let mut worst = 0.0f64;
+        for nh in [3, 8, 12] {
+            let rr_n = periodic(&two, &[true, true], Some(&rr), &opts(nh)).sol;
+            assert_eq!(rr_n.status, Status::Converged);
+            let cases: [(&Planar, HbSolution); 3] = [
+                (&two, rr_n),
+                (&two, synthetic(vec![0.0, 0.0, -1.0, 0.0], nh)),
+                (&three, synthetic(vec![0.0, 0.0, 0.0, -1.0, -1.0], nh)),
+            ];
+            for (model, sol) in &cases {
+                let s = default_samples(nh);
+                let expect = direct_jacobian(*model, sol, s);
+                let scale = expect.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                let mut sys = HbSystem::new(*model, &sol.winding, nh, s);
+                let n = sys.size();
+                let x = sol.unknowns();
+                let (mut r, mut jac) = (vec![0.0; n], vec![0.0; n * n]);
+                sys.assemble(&x, &mut r, Some(&mut jac));
+                // Both paths, whichever `assemble` takes at this N.
+                let (mut direct, mut pts) = (vec![0.0; n * n], vec![0.0; n * n]);
+                assert!(sys.project_direct(sol.omega, &mut direct));
+                sys.omega_column(sol.omega, &mut direct);
+                assert!(sys.project_product_to_sum(sol.omega, &mut pts));
+                sys.omega_column(sol.omega, &mut pts);
+                for row in 0..n - 1 {
+                    for col in 0..n {
+                        let e = expect[row * n + col];
+                        for (name, got) in [("assembled", &jac), ("direct", &direct), ("pts", &pts)] {
+                            let gap = (got[row * n + col] - e).abs();
+                            worst = worst.max(gap / scale);
+                            assert!(
+                                gap <= 1e-13 * scale,
+                                "N {nh} d {} {name} ({row},{col}): {} vs {e}",
+                                sol.ndof(),
+                                got[row * n + col]
+                            );
+                        }
+                    }
+                }
+                // The rotating and oscillating balls' blocks are not empty.
+                let nonzero = pts.iter().filter(|v| v.abs() > 1e-8 * scale).count();
+                assert!(nonzero > n * n / 4, "N {nh}: {nonzero} of {}", n * n);
+            }
+        }
+        println!("largest gap relative to the largest entry: {worst:.1e}");
+    }
+
     #[test]
     fn series_evaluation_and_fit_round_trip() {
         let c = [0.3, 1.0, -0.5, 0.2, 0.1];
@@ -1085,7 +1474,10 @@ mod tests {
     }
 
     /// Warm-started solves at N = 3, 6, 8, 12 for callgrind (`--ignored --exact
-    /// numerics::hb::tests::hb_profile`): per N, a `warm_solve::<N>` frame.
+    /// numerics::hb::tests::hb_profile`): 20 solves per N, all four N, or only the N in
+    /// `BALLBAL_HB_N`. Per solve: `warm_solve`'s inclusive count / 20 with
+    /// `BALLBAL_HB_N` set (the per-N copies of `warm_solve` compile to one function, so
+    /// callgrind cannot tell the N apart in a run of all four).
     #[test]
     #[ignore]
     fn hb_profile() {
@@ -1101,19 +1493,22 @@ mod tests {
             ..Default::default()
         };
         let seed12 = periodic(&near, &[true, true], Some(&seed), &opts(12)).sol;
+        let only: Option<usize> = std::env::var("BALLBAL_HB_N")
+            .ok()
+            .map(|v| v.parse().expect("BALLBAL_HB_N: a harmonic count"));
+        let ns: Vec<usize> = only.map_or(vec![3, 6, 8, 12], |n| vec![n]);
         let mut acc = 0.0;
         for _ in 0..20 {
-            acc += warm_solve::<3>(&p, &seed12, &opts(3));
-            acc += warm_solve::<6>(&p, &seed12, &opts(6));
-            acc += warm_solve::<8>(&p, &seed12, &opts(8));
-            acc += warm_solve::<12>(&p, &seed12, &opts(12));
+            for &n in &ns {
+                acc += warm_solve(&p, &seed12, &opts(n));
+            }
         }
         println!("{acc}");
     }
 
-    /// One solve; monomorphised per `N` so that callgrind reports each N apart.
+    /// One warm solve (certificates included): the frame callgrind reports.
     #[inline(never)]
-    fn warm_solve<const N: usize>(
+    fn warm_solve(
         p: &crate::Planar,
         g: &HbSolution,
         o: &crate::periodic::PeriodicOptions,
