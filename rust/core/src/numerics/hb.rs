@@ -459,6 +459,9 @@ pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     /// the `3d^2 x 2(2N+1)` Fourier coefficients of the entries of `K, C, M`.
     dft: Vec<f64>,
     coef: Vec<f64>,
+    /// The entries that vary along the orbit (`S x nv`) and their coefficients.
+    packed: Vec<f64>,
+    packed_coef: Vec<f64>,
 }
 
 impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
@@ -480,10 +483,12 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             qtt: vec![0.0; s * d],
             f: vec![0.0; s * d],
             kcm: vec![0.0; s * 3 * d * d],
-            g: vec![0.0; s * (2 * n_harm + 1)],
+            g: vec![0.0; s * (2 * n_harm + 1).div_ceil(8) * 8],
             // Built on first use: the direct path never needs them.
             dft: vec![],
             coef: vec![],
+            packed: vec![],
+            packed_coef: vec![],
         }
     }
 
@@ -645,6 +650,8 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let n = self.size();
         let dd = d * d;
         let om2 = om * om;
+        // G's rows padded to whole groups of 8 columns (the padding stays zero).
+        let lp = l.div_ceil(8) * 8;
         for j in 0..d {
             for k in 0..d {
                 // A block takes a fraction of a second at hundreds of harmonics; a
@@ -667,25 +674,29 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                     );
                     let b = i * l;
                     for p in 0..l {
-                        g[b + p] = kv * self.basis.phi[b + p]
+                        g[i * lp + p] = kv * self.basis.phi[b + p]
                             + cv * self.basis.dphi[b + p]
                             + mv * self.basis.ddphi[b + p];
                     }
                 }
-                // J block = W^T G
-                for i in 0..s {
-                    let w = &self.basis.wgt[i * l..(i + 1) * l];
-                    let gi = &g[i * l..(i + 1) * l];
-                    for rr in 0..l {
-                        let wr = w[rr];
-                        if wr == 0.0 {
-                            continue;
+                // J block = W^T G, eight columns at a time in registers; each entry
+                // sums its samples in order from zero as before.
+                for rr in 0..l {
+                    let row = &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
+                    for p0 in (0..l).step_by(8) {
+                        let mut acc = [0.0f64; 8];
+                        for i in 0..s {
+                            let wr = self.basis.wgt[i * l + rr];
+                            if wr == 0.0 {
+                                continue;
+                            }
+                            let gi = &g[i * lp + p0..i * lp + p0 + 8];
+                            for t in 0..8 {
+                                acc[t] += wr * gi[t];
+                            }
                         }
-                        let row =
-                            &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
-                        for p in 0..l {
-                            row[p] += wr * gi[p];
-                        }
+                        let m = (l - p0).min(8);
+                        row[p0..p0 + m].copy_from_slice(&acc[..m]);
                     }
                 }
             }
@@ -713,16 +724,52 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             self.dft = dft_table(nh, s);
             self.coef = vec![0.0; 3 * dd * 2 * w];
         }
-        // coef (3d^2 x 2w) = KCM^T (3d^2 x S) * table (S x 2w)
+        // coef (3d^2 x 2w) = KCM^T (3d^2 x S) * table (S x 2w), for the entries that
+        // vary along the orbit; an entry that is the same at every sample (the planar
+        // model's mass and damping constants, or zero) has the coefficients `S x` of
+        // its constant at k = 0 and none above (sum_i cos k tau_i = 0 for 0 < k < S).
+        let e3 = 3 * dd;
+        let (mut varying, mut constant) = (vec![], vec![]);
+        for e in 0..e3 {
+            let first = self.kcm[e];
+            if (1..s).all(|i| self.kcm[i * e3 + e] == first) {
+                constant.push((e, first));
+            } else {
+                varying.push(e);
+            }
+        }
+        let nv = varying.len();
+        self.packed.resize(s * nv, 0.0);
+        for i in 0..s {
+            for (t, &e) in varying.iter().enumerate() {
+                self.packed[i * nv + t] = self.kcm[i * e3 + e];
+            }
+        }
+        self.packed_coef.resize(nv * 2 * w, 0.0);
         matmul(
-            MatMut::from_row_major_slice_mut(&mut self.coef, 3 * dd, 2 * w),
+            MatMut::from_row_major_slice_mut(&mut self.packed_coef, nv, 2 * w),
             Accum::Replace,
-            MatRef::from_row_major_slice(&self.kcm, s, 3 * dd).transpose(),
+            MatRef::from_row_major_slice(&self.packed, s, nv).transpose(),
             MatRef::from_row_major_slice(&self.dft, s, 2 * w),
             1.0,
             Par::Seq,
         );
+        for (t, &e) in varying.iter().enumerate() {
+            self.coef[e * 2 * w..(e + 1) * 2 * w]
+                .copy_from_slice(&self.packed_coef[t * 2 * w..(t + 1) * 2 * w]);
+        }
+        for (e, c) in constant {
+            let row = &mut self.coef[e * 2 * w..(e + 1) * 2 * w];
+            row.fill(0.0);
+            row[0] = s as f64 * c;
+        }
         let inv = 1.0 / s as f64;
+        // Per block, the coefficients on the signed harmonics h = -2N..2N (index
+        // h + 2N): cosines even in h, sines odd (sin(-h tau) = -sin(h tau)).
+        let e = 4 * nh + 1;
+        let z = 2 * nh;
+        let mut ext = vec![0.0; 6 * e];
+        let (mut ac, mut as_) = (vec![0.0; e], vec![0.0; e]);
         for j in 0..d {
             for k in 0..d {
                 if crate::cancel::cancelled() {
@@ -732,45 +779,51 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                     continue;
                 }
                 let idx = j * d + k;
-                let row = |x: usize| &self.coef[(x * dd + idx) * 2 * w..(x * dd + idx + 1) * 2 * w];
-                let (kx, cx, mx) = (row(0), row(1), row(2));
-                // Cosine and signed sine coefficients: sin(-k tau) = -sin(k tau).
-                let xc = |c: &[f64], h: isize| c[h.unsigned_abs()];
-                let xs = |c: &[f64], h: isize| h.signum() as f64 * c[w + h.unsigned_abs()];
-                let at = |rr: usize, p: usize| (j * l + rr) * n + k * l + p;
+                for x in 0..3 {
+                    let c = &self.coef[(x * dd + idx) * 2 * w..(x * dd + idx + 1) * 2 * w];
+                    let (ce, se) = ext[2 * x * e..(2 * x + 2) * e].split_at_mut(e);
+                    for h in 0..w {
+                        ce[z + h] = c[h];
+                        ce[z - h] = c[h];
+                        se[z + h] = c[w + h];
+                        se[z - h] = -c[w + h];
+                    }
+                }
+                let (kc, ks) = (&ext[0..e], &ext[e..2 * e]);
+                let (cc, cs) = (&ext[2 * e..3 * e], &ext[3 * e..4 * e]);
+                let (mc, ms) = (&ext[4 * e..5 * e], &ext[5 * e..6 * e]);
+                let base = j * l * n + k * l;
                 // Column n of a block: K phi + omega C phi' + omega^2 M phi'' with
                 // phi = cos n tau gives (K - omega^2 n^2 M) cos n tau - omega n C sin n tau,
                 // with phi = sin n tau, (K - omega^2 n^2 M) sin n tau + omega n C cos n tau.
                 // Rows: weight 1/S (mean), 2/S cos m tau, 2/S sin m tau.
-                jac[at(0, 0)] = inv * kx[0];
+                jac[base] = inv * kc[z];
                 for m in 1..=nh {
-                    jac[at(2 * m - 1, 0)] = 2.0 * inv * kx[m];
-                    jac[at(2 * m, 0)] = 2.0 * inv * kx[w + m];
+                    jac[base + (2 * m - 1) * n] = 2.0 * inv * kc[z + m];
+                    jac[base + 2 * m * n] = 2.0 * inv * ks[z + m];
                 }
                 for nn in 1..=nh {
                     let nf = nn as f64;
                     let (a2, cn) = (om * om * nf * nf, om * nf);
-                    // A = K - omega^2 n^2 M, coefficient by coefficient
-                    let ac = |h: isize| xc(kx, h) - a2 * xc(mx, h);
-                    let as_ = |h: isize| xs(kx, h) - a2 * xs(mx, h);
-                    let (ni, pc, ps) = (nn as isize, 2 * nn - 1, 2 * nn);
-                    jac[at(0, pc)] = inv * (ac(ni) - cn * xs(cx, ni));
-                    jac[at(0, ps)] = inv * (as_(ni) + cn * xc(cx, ni));
+                    // A = K - omega^2 n^2 M, coefficient by coefficient.
+                    for h in 0..e {
+                        ac[h] = kc[h] - a2 * mc[h];
+                        as_[h] = ks[h] - a2 * ms[h];
+                    }
+                    let (pc, ps) = (base + 2 * nn - 1, base + 2 * nn);
+                    jac[pc] = inv * (ac[z + nn] - cn * cs[z + nn]);
+                    jac[ps] = inv * (as_[z + nn] + cn * cc[z + nn]);
                     for m in 1..=nh {
-                        let mi = m as isize;
-                        let (dm, sm) = (mi - ni, mi + ni);
-                        let (rc, rs) = (2 * m - 1, 2 * m);
+                        // m - n and m + n as indices
+                        let (dm, sm) = (z + m - nn, z + m + nn);
+                        let (rc, rs) = ((2 * m - 1) * n, 2 * m * n);
                         // cos m cos n = (cos(m-n) + cos(m+n))/2, cos m sin n =
                         // (sin(m+n) - sin(m-n))/2, sin m cos n = (sin(m+n) + sin(m-n))/2,
                         // sin m sin n = (cos(m-n) - cos(m+n))/2.
-                        jac[at(rc, pc)] =
-                            inv * (ac(dm) + ac(sm) - cn * (xs(cx, sm) - xs(cx, dm)));
-                        jac[at(rc, ps)] =
-                            inv * (as_(sm) - as_(dm) + cn * (xc(cx, dm) + xc(cx, sm)));
-                        jac[at(rs, pc)] =
-                            inv * (as_(sm) + as_(dm) - cn * (xc(cx, dm) - xc(cx, sm)));
-                        jac[at(rs, ps)] =
-                            inv * (ac(dm) - ac(sm) + cn * (xs(cx, sm) + xs(cx, dm)));
+                        jac[rc + pc] = inv * (ac[dm] + ac[sm] - cn * (cs[sm] - cs[dm]));
+                        jac[rc + ps] = inv * (as_[sm] - as_[dm] + cn * (cc[dm] + cc[sm]));
+                        jac[rs + pc] = inv * (as_[sm] + as_[dm] - cn * (cc[dm] - cc[sm]));
+                        jac[rs + ps] = inv * (ac[dm] - ac[sm] + cn * (cs[sm] + cs[dm]));
                     }
                 }
             }
@@ -784,19 +837,26 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         let n = self.size();
         let dd = d * d;
+        // Summed in a contiguous column (sample by sample from zero, as the strided
+        // column of `jac` was: the same sums).
+        let mut col = vec![0.0; d * l];
         for i in 0..s {
             let w = &self.basis.wgt[i * l..(i + 1) * l];
+            let kcm = &self.kcm[i * 3 * dd..(i + 1) * 3 * dd];
+            let (qt, qtt) = (&self.qt[i * d..(i + 1) * d], &self.qtt[i * d..(i + 1) * d]);
             for j in 0..d {
                 let mut dfo = 0.0;
                 for k in 0..d {
-                    let o = i * 3 * dd + j * d + k;
-                    dfo += self.kcm[o + dd] * self.qt[i * d + k]
-                        + 2.0 * om * self.kcm[o + 2 * dd] * self.qtt[i * d + k];
+                    let o = j * d + k;
+                    dfo += kcm[o + dd] * qt[k] + 2.0 * om * kcm[o + 2 * dd] * qtt[k];
                 }
-                for rr in 0..l {
-                    jac[(j * l + rr) * n + d * l] += w[rr] * dfo;
+                for (c, wr) in col[j * l..(j + 1) * l].iter_mut().zip(w) {
+                    *c += wr * dfo;
                 }
             }
+        }
+        for (row, c) in col.iter().enumerate() {
+            jac[row * n + d * l] = *c;
         }
         let pc = self.phase_coord;
         let prow = d * l * n;
