@@ -427,15 +427,26 @@ fn count(what: usize) {
 /// trigonometric call, so every entry is as accurate as the basis tables.
 fn dft_table(n_harm: usize, samples: usize) -> Vec<f64> {
     let w = 2 * n_harm + 1;
+    // S points on the unit circle serve every product k i.
+    let circle: Vec<(f64, f64)> = (0..samples)
+        .map(|j| (2.0 * PI * j as f64 / samples as f64).sin_cos())
+        .collect();
     let mut t = vec![0.0; samples * 2 * w];
     for i in 0..samples {
         for k in 0..w {
-            let (sn, cs) = (2.0 * PI * ((k * i) % samples) as f64 / samples as f64).sin_cos();
+            let (sn, cs) = circle[(k * i) % samples];
             t[i * 2 * w + k] = cs;
             t[i * 2 * w + w + k] = sn;
         }
     }
     t
+}
+
+/// Zeroes the `(j, k)` block of coefficient rows and columns (`L x L`) of `jac`.
+fn zero_block_of(jac: &mut [f64], n: usize, l: usize, j: usize, k: usize) {
+    for rr in 0..l {
+        jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l].fill(0.0);
+    }
 }
 
 /// Workspace and fixed data of one harmonic-balance problem.
@@ -617,7 +628,9 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             }
         });
         timed(Stage::Projection, || {
-            jac.fill(0.0);
+            // Every entry of a coupled block, the omega column and the phase row are
+            // written below; the blocks of coordinates that do not interact are zeroed
+            // where they are skipped.
             let done = if self.basis.n_harm <= DIRECT_PROJECTION_MAX_HARM {
                 self.project_direct(om, jac)
             } else {
@@ -660,6 +673,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                     return false;
                 }
                 if self.zero_block(j, k) {
+                    zero_block_of(jac, n, l, j, k);
                     continue;
                 }
                 let idx = j * d + k;
@@ -776,6 +790,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                     return false;
                 }
                 if self.zero_block(j, k) {
+                    zero_block_of(jac, n, l, j, k);
                     continue;
                 }
                 let idx = j * d + k;
@@ -860,6 +875,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         }
         let pc = self.phase_coord;
         let prow = d * l * n;
+        jac[prow..prow + n].fill(0.0);
         if self.phase_rotating {
             jac[prow + pc * l] = 1.0;
             for m in 1..=self.basis.n_harm {
