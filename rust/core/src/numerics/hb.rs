@@ -340,13 +340,16 @@ impl HbSolution {
 /// ([`HbSystem`]'s direct path, the arithmetic every N = 3 scan was saved with); above
 /// it, from the Fourier coefficients of the Jacobian entries (product-to-sum).
 ///
-/// At N = 3 the two cost the same (`S (2N+1)^2 = 1568` multiply-adds per coordinate
-/// pair against `3 S (4N+2) = 1248` plus the `(2N+1)^2` sums), so the direct path costs
-/// nothing there and keeps the scans' Newton paths to the bit: the two differ at
-/// round-off, and a scan's discovery (which coexisting O-O orbit a Newton run from a
-/// simulated seed reaches on the zeta 0.02 maps) changed on such round-off in an
-/// earlier attempt. From N = 4 on the product-to-sum path is the cheaper one (at N = 8,
-/// 2.9 times fewer operations, and a matrix product instead of a scalar loop).
+/// At N = 3 the two take about the same arithmetic (`S (2N+1)^2 = 1568` multiply-adds
+/// per coordinate pair against `3 S (4N+2) = 1344` for the coefficients plus the
+/// `(2N+1)^2` sums), so the direct path costs little there and keeps the scans' Newton
+/// paths to the bit: the two differ at round-off, and a scan's discovery (which
+/// coexisting O-O orbit a Newton run from a simulated seed reaches on the zeta 0.02
+/// maps) changed on such round-off in an earlier attempt. This is a deliberate switch on
+/// N, not a hidden one: N <= 3 gives the results saved before it, N >= 4 moves at
+/// round-off (omega 2e-16, multipliers 4e-13 relative on the thesis N = 8 scans).
+/// From N = 4 on the product-to-sum path is the cheaper one: at N = 8 the projection
+/// and its omega column fell from about 8 M to 1.2 M instructions per warm solve.
 pub const DIRECT_PROJECTION_MAX_HARM: usize = 3;
 
 /// Stages of a harmonic-balance solve whose time [`stage_seconds`] reports, when
@@ -378,7 +381,10 @@ static COUNTS: [std::sync::atomic::AtomicU64; 3] =
 pub fn stage_profile(on: bool) {
     use std::sync::atomic::Ordering::Relaxed;
     PROFILE_ON.store(on, Relaxed);
-    STAGE_NANOS.iter().chain(&COUNTS).for_each(|a| a.store(0, Relaxed));
+    STAGE_NANOS
+        .iter()
+        .chain(&COUNTS)
+        .for_each(|a| a.store(0, Relaxed));
 }
 
 /// Seconds per [`Stage`] (in its order) since [`stage_profile`] switched the timers on,
@@ -1516,7 +1522,8 @@ mod tests {
                 for row in 0..n - 1 {
                     for col in 0..n {
                         let e = expect[row * n + col];
-                        for (name, got) in [("assembled", &jac), ("direct", &direct), ("pts", &pts)] {
+                        for (name, got) in [("assembled", &jac), ("direct", &direct), ("pts", &pts)]
+                        {
                             let gap = (got[row * n + col] - e).abs();
                             worst = worst.max(gap / scale);
                             assert!(
@@ -1584,11 +1591,7 @@ mod tests {
 
     /// One warm solve (certificates included): the frame callgrind reports.
     #[inline(never)]
-    fn warm_solve(
-        p: &crate::Planar,
-        g: &HbSolution,
-        o: &crate::periodic::PeriodicOptions,
-    ) -> f64 {
+    fn warm_solve(p: &crate::Planar, g: &HbSolution, o: &crate::periodic::PeriodicOptions) -> f64 {
         crate::periodic::periodic(p, &[true, true], Some(g), o)
             .sol
             .omega
