@@ -12,8 +12,14 @@ instruction counts under callgrind are steadier:
     cargo test --release -p ballbal-core --lib --no-run
     valgrind --tool=callgrind target/release/deps/ballbal_core-* --ignored --exact \\
         numerics::floquet::tests::magnus_profile        # RK45, Magnus, Hill
-    BALLBAL_HB_N=8 valgrind --tool=callgrind target/release/deps/ballbal_core-* \\
-        --ignored --exact numerics::hb::tests::hb_profile  # 20 warm HB solves at N
+    BALLBAL_HB_N=8 valgrind --tool=callgrind --toggle-collect='*warm_solve*' \\
+        target/release/deps/ballbal_core-* --ignored --exact \\
+        numerics::hb::tests::hb_profile  # 20 warm HB solves at N (total / 20 per solve)
+
+Instructions per warm solve (certificates included), 2026-11-23, before -> after the
+product-to-sum Jacobian (N > 3) and the reuse of the accepted trial's residual:
+N = 3: 2.41 M -> 1.87 M, N = 6: 6.71 M -> 3.01 M, N = 8: 11.46 M -> 4.47 M,
+N = 12: 26.7 M -> 8.36 M; N = 8 / N = 3: 4.75 -> 2.39.
 """
 
 from __future__ import annotations
@@ -48,15 +54,52 @@ def match_error(a, ref) -> float:
     return worst
 
 
+STAGES = ("residual (AFT)", "model K,C,M", "Jacobian projection", "LU")
+
+
 def harmonic_balance(b, seed) -> None:
+    """Warm solves against N, then the same solves' time per stage (the core's stage
+    timers, ``_native.hb_stage_profile``): the residual (sampling, the model at the
+    samples, the Galerkin projection), the model's K, C, M at the samples, their
+    projection into the Jacobian (sample by sample at N <= 3, product-to-sum above),
+    the LU solve; the certificates (integrated ODE defect, tail) are the rest of a
+    solve's time."""
+    from ballbal import _native
+
     print("\nharmonic balance, warm start from the fine-grid neighbour (no Floquet):")
-    print(f"{'N':>3} {'HB solve [us]':>14} {'iters':>6} {'ratio to N=3':>13}")
+    print(f"{'N':>3} {'S':>4} {'unknowns':>8} {'HB solve [us]':>14} {'iters':>6} "
+          f"{'residuals':>9} {'ratio to N=3':>13}")
     base = None
+    rows = []
     for N in (3, 6, 8, 12):
-        t_hb, sol = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed,
-                                                         floquet=False, hill=False), 50)
+        def solve(N=N):
+            return ballbal.periodic(b, "R-R", N=N, guess=seed, floquet=False, hill=False)
+        t_hb, sol = median_time(solve, 50)
+        _native.hb_stage_profile(True)
+        c0 = _native.certificate_seconds()
+        reps = 50
+        t0 = time.perf_counter()
+        for _ in range(reps):
+            solve()
+        t_all = (time.perf_counter() - t0) / reps
+        cert = (_native.certificate_seconds() - c0) / reps
+        st = _native.hb_stage_seconds()
+        _native.hb_stage_profile(False)
+        stages = [v / reps for v in st[:4]]
+        solves, iters, residuals = st[4] / reps, st[5] / reps, st[6] / reps
         base = base or t_hb
-        print(f"{N:3d} {t_hb * 1e6:14.0f} {sol.iterations:6d} {t_hb / base:13.2f}")
+        samples = 8 * (N + 1)
+        print(f"{N:3d} {samples:4d} {4 * (2 * N + 1) + 1:8d} {t_hb * 1e6:14.0f} "
+              f"{iters / solves:6.2f} {residuals / solves:9.2f} {t_hb / base:13.2f}")
+        rows.append((N, stages, cert, t_all))
+    print("per stage [us per solve] (timed run; rest: tail check, the Python facade and its "
+          "conversions)")
+    print(f"{'N':>3} " + " ".join(f"{s:>20}" for s in STAGES)
+          + f" {'certificates':>13} {'rest':>6} {'total':>7}")
+    for N, stages, cert, t_all in rows:
+        rest = t_all - sum(stages) - cert
+        print(f"{N:3d} " + " ".join(f"{v * 1e6:20.1f}" for v in stages)
+              + f" {cert * 1e6:13.1f} {rest * 1e6:6.1f} {t_all * 1e6:7.1f}")
 
 
 def floquet_methods(name, b, seed, N) -> None:

@@ -155,3 +155,26 @@ def test_ro_solution_by_continuation_cross_checked():
     # or (if it is stable with a small basin) agree with the shooting multipliers.
     nontrivial = np.delete(mult, np.argmin(np.abs(mult - 1)))
     assert sol.stability == ("unstable" if np.max(np.abs(nontrivial)) > 1 else "stable")
+
+
+def test_hb_stage_counters_count_what_a_warm_solve_does(standard):
+    """The stage timers behind bench_periodic's per-stage printout: one solve, its own
+    Newton iterations (one LU each), one residual per iteration plus the first, and
+    nothing counted while they are off."""
+    from ballbal import _native
+
+    standard, _ = standard
+    seed = ballbal.periodic(standard.replace(Omega=1.19), "R-R", N=8)
+    _native.hb_stage_profile(True)
+    try:
+        sol = ballbal.periodic(standard, "R-R", N=8, guess=seed, floquet=False, hill=False)
+        st = _native.hb_stage_seconds()
+    finally:
+        _native.hb_stage_profile(False)
+    assert sol.status == "converged"
+    assert st[4] == 1 and st[5] == sol.iterations
+    # the first residual, then one per line-search trial (a full step each here)
+    assert st[6] == sol.iterations + 1
+    assert all(v > 0 for v in st[:4])
+    ballbal.periodic(standard, "R-R", N=8, guess=seed, floquet=False, hill=False)
+    assert _native.hb_stage_seconds() == [0.0] * 7

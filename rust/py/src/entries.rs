@@ -445,6 +445,22 @@ pub fn certificate_seconds() -> f64 {
     ballbal_core::hb::certificate_seconds()
 }
 
+/// Switches the harmonic-balance solve's per-stage timers on or off and resets them
+/// (off by default; a benchmark's measure, see `hb_stage_seconds`).
+#[pyfunction]
+pub fn hb_stage_profile(on: bool) {
+    ballbal_core::hb::stage_profile(on)
+}
+
+/// Seconds spent since `hb_stage_profile(True)` in the harmonic-balance residual
+/// (sampling, model, projection), the model's Jacobians at the samples, the Galerkin
+/// projection of the Jacobian and the LU solve, then the counts of solves, Newton
+/// iterations and residual evaluations.
+#[pyfunction]
+pub fn hb_stage_seconds() -> Vec<f64> {
+    ballbal_core::hb::stage_seconds().to_vec()
+}
+
 /// Default block (and chunk) length, in values of the last parameter, for grid lengths
 /// `lens`: about 1024 points.
 #[pyfunction]

@@ -336,6 +336,125 @@ impl HbSolution {
     }
 }
 
+/// Harmonic counts up to which the Galerkin Jacobian is projected sample by sample
+/// ([`HbSystem`]'s direct path, the arithmetic every N = 3 scan was saved with); above
+/// it, from the Fourier coefficients of the Jacobian entries (product-to-sum).
+///
+/// At N = 3 the two take about the same arithmetic (`S (2N+1)^2 = 1568` multiply-adds
+/// per coordinate pair against `3 S (4N+2) = 1344` for the coefficients plus the
+/// `(2N+1)^2` sums), so the direct path costs little there and keeps the scans' Newton
+/// paths to the bit: the two differ at round-off, and a scan's discovery (which
+/// coexisting O-O orbit a Newton run from a simulated seed reaches on the zeta 0.02
+/// maps) changed on such round-off in an earlier attempt. This is a deliberate switch on
+/// N, not a hidden one: N <= 3 gives the results saved before it, N >= 4 moves at
+/// round-off (omega 2e-16, multipliers 4e-13 relative on the thesis N = 8 scans).
+/// From N = 4 on the product-to-sum path is the cheaper one: at N = 8 the projection
+/// and its omega column fell from about 8 M to 1.2 M instructions per warm solve.
+pub const DIRECT_PROJECTION_MAX_HARM: usize = 3;
+
+/// Stages of a harmonic-balance solve whose time [`stage_seconds`] reports, when
+/// [`stage_profile`] has switched the timers on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Sampling the series, the model's residual at the samples and its projection
+    /// (the alternating frequency–time residual).
+    Residual = 0,
+    /// The model's `K, C, M` at the samples.
+    ModelJacobians = 1,
+    /// The Galerkin projection of `K, C, M` into the Jacobian (and its omega column).
+    Projection = 2,
+    /// The LU factorisation and solve of the Newton step.
+    Lu = 3,
+}
+
+const STAGES: usize = 4;
+static PROFILE_ON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+static STAGE_NANOS: [std::sync::atomic::AtomicU64; STAGES] =
+    [const { std::sync::atomic::AtomicU64::new(0) }; STAGES];
+/// Solves, Newton iterations (LU solves) and residual evaluations.
+static COUNTS: [std::sync::atomic::AtomicU64; 3] =
+    [const { std::sync::atomic::AtomicU64::new(0) }; 3];
+
+/// Switches the per-stage timers of [`stage_seconds`] on or off (off by default: a
+/// benchmark's measure; the timers cost two clock reads per stage and change nothing
+/// else) and resets them.
+pub fn stage_profile(on: bool) {
+    use std::sync::atomic::Ordering::Relaxed;
+    PROFILE_ON.store(on, Relaxed);
+    STAGE_NANOS
+        .iter()
+        .chain(&COUNTS)
+        .for_each(|a| a.store(0, Relaxed));
+}
+
+/// Seconds per [`Stage`] (in its order) since [`stage_profile`] switched the timers on,
+/// then the number of solves, Newton iterations and residual evaluations.
+pub fn stage_seconds() -> [f64; STAGES + 3] {
+    use std::sync::atomic::Ordering::Relaxed;
+    let mut out = [0.0; STAGES + 3];
+    for (o, a) in out.iter_mut().zip(&STAGE_NANOS) {
+        *o = a.load(Relaxed) as f64 * 1e-9;
+    }
+    for (o, a) in out[STAGES..].iter_mut().zip(&COUNTS) {
+        *o = a.load(Relaxed) as f64;
+    }
+    out
+}
+
+#[inline(always)]
+fn profiling() -> bool {
+    PROFILE_ON.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Runs `f`, adding its time to `stage` when the timers are on.
+#[inline(always)]
+fn timed<T>(stage: Stage, f: impl FnOnce() -> T) -> T {
+    if !profiling() {
+        return f();
+    }
+    let t = std::time::Instant::now();
+    let out = f();
+    STAGE_NANOS[stage as usize].fetch_add(
+        t.elapsed().as_nanos() as u64,
+        std::sync::atomic::Ordering::Relaxed,
+    );
+    out
+}
+
+fn count(what: usize) {
+    if profiling() {
+        COUNTS[what].fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
+/// `cos k tau_i` and `sin k tau_i` for `k = 0..=2N` (row-major `S x 2(2N+1)`, the
+/// cosines first): the discrete Fourier transform that gives the Jacobian entries'
+/// coefficients. The angle is reduced to `2 pi (k i mod S) / S` before the
+/// trigonometric call, so every entry is as accurate as the basis tables.
+fn dft_table(n_harm: usize, samples: usize) -> Vec<f64> {
+    let w = 2 * n_harm + 1;
+    // S points on the unit circle serve every product k i.
+    let circle: Vec<(f64, f64)> = (0..samples)
+        .map(|j| (2.0 * PI * j as f64 / samples as f64).sin_cos())
+        .collect();
+    let mut t = vec![0.0; samples * 2 * w];
+    for i in 0..samples {
+        for k in 0..w {
+            let (sn, cs) = circle[(k * i) % samples];
+            t[i * 2 * w + k] = cs;
+            t[i * 2 * w + w + k] = sn;
+        }
+    }
+    t
+}
+
+/// Zeroes the `(j, k)` block of coefficient rows and columns (`L x L`) of `jac`.
+fn zero_block_of(jac: &mut [f64], n: usize, l: usize, j: usize, k: usize) {
+    for rr in 0..l {
+        jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l].fill(0.0);
+    }
+}
+
 /// Workspace and fixed data of one harmonic-balance problem.
 pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     model: &'a D,
@@ -350,10 +469,16 @@ pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     qt: Vec<f64>,
     qtt: Vec<f64>,
     f: Vec<f64>,
-    k: Vec<f64>,
-    c: Vec<f64>,
-    m: Vec<f64>,
+    /// Row-major `S x 3d^2`: per sample `K`, then `C`, then `M` (each row-major `d x d`).
+    kcm: Vec<f64>,
     g: Vec<f64>,
+    /// Product-to-sum path (`n_harm > DIRECT_PROJECTION_MAX_HARM`): the DFT table and
+    /// the `3d^2 x 2(2N+1)` Fourier coefficients of the entries of `K, C, M`.
+    dft: Vec<f64>,
+    coef: Vec<f64>,
+    /// The entries that vary along the orbit (`S x nv`) and their coefficients.
+    packed: Vec<f64>,
+    packed_coef: Vec<f64>,
 }
 
 impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
@@ -374,10 +499,13 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             qt: vec![0.0; s * d],
             qtt: vec![0.0; s * d],
             f: vec![0.0; s * d],
-            k: vec![0.0; s * d * d],
-            c: vec![0.0; s * d * d],
-            m: vec![0.0; s * d * d],
-            g: vec![0.0; s * (2 * n_harm + 1)],
+            kcm: vec![0.0; s * 3 * d * d],
+            g: vec![0.0; s * (2 * n_harm + 1).div_ceil(8) * 8],
+            // Built on first use: the direct path never needs them.
+            dft: vec![],
+            coef: vec![],
+            packed: vec![],
+            packed_coef: vec![],
         }
     }
 
@@ -429,12 +557,21 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         r: &mut [f64],
         jac: Option<&mut [f64]>,
     ) {
+        timed(Stage::Residual, || self.residual_with(model, x, r));
+        if let Some(jac) = jac {
+            self.jacobian_at_samples(model, x, jac);
+        }
+    }
+
+    /// The residual alone: samples `x`, evaluates the model there and projects.
+    #[inline(never)]
+    fn residual_with<M: Dynamics + ?Sized>(&mut self, model: &M, x: &[f64], r: &mut [f64]) {
+        count(2);
         let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         let om = x[d * l];
         self.sample(x);
         let mut v = vec![0.0; d];
         let mut a = vec![0.0; d];
-        let want_jac = jac.is_some();
         for i in 0..s {
             for j in 0..d {
                 v[j] = om * self.qt[i * d + j];
@@ -443,14 +580,6 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             let t = self.basis.tau[i] / om;
             let q = &self.q[i * d..(i + 1) * d];
             model.residual(t, q, &v, &a, &mut self.f[i * d..(i + 1) * d]);
-            if want_jac {
-                let (kk, cc, mm) = (
-                    &mut self.k[i * d * d..(i + 1) * d * d],
-                    &mut self.c[i * d * d..(i + 1) * d * d],
-                    &mut self.m[i * d * d..(i + 1) * d * d],
-                );
-                model.jacobians(t, q, &v, &a, kk, cc, mm);
-            }
         }
         // Galerkin projection.
         r.fill(0.0);
@@ -474,71 +603,285 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         } else {
             x[pc * l + 2]
         };
-        let Some(jac) = jac else { return };
+    }
+
+    /// The Jacobian at `x`, the point the last residual evaluation sampled (its
+    /// `q, q', q''` are reused): what Newton needs after a line search accepted the
+    /// point whose residual it has just evaluated.
+    pub fn jacobian_after_residual(&mut self, x: &[f64], jac: &mut [f64]) {
+        let model = self.model;
+        self.jacobian_at_samples(model, x, jac);
+    }
+
+    /// `K, C, M` at the sampled points and their Galerkin projection.
+    fn jacobian_at_samples<M: Dynamics + ?Sized>(&mut self, model: &M, x: &[f64], jac: &mut [f64]) {
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
+        let om = x[d * l];
+        let dd = d * d;
+        timed(Stage::ModelJacobians, || {
+            let mut v = vec![0.0; d];
+            let mut a = vec![0.0; d];
+            for i in 0..s {
+                for j in 0..d {
+                    v[j] = om * self.qt[i * d + j];
+                    a[j] = om * om * self.qtt[i * d + j];
+                }
+                let t = self.basis.tau[i] / om;
+                let q = &self.q[i * d..(i + 1) * d];
+                let (kk, rest) = self.kcm[i * 3 * dd..(i + 1) * 3 * dd].split_at_mut(dd);
+                let (cc, mm) = rest.split_at_mut(dd);
+                model.jacobians(t, q, &v, &a, kk, cc, mm);
+            }
+        });
+        timed(Stage::Projection, || {
+            // Every entry of a coupled block, the omega column and the phase row are
+            // written below; the blocks of coordinates that do not interact are zeroed
+            // where they are skipped.
+            let done = if self.basis.n_harm <= DIRECT_PROJECTION_MAX_HARM {
+                self.project_direct(om, jac)
+            } else {
+                self.project_product_to_sum(om, jac)
+            };
+            if done {
+                self.omega_column(om, jac);
+            }
+        });
+    }
+
+    /// Whether no sample couples coordinate `j` to `k` (a zero block).
+    fn zero_block(&self, j: usize, k: usize) -> bool {
+        let dd = self.d * self.d;
+        let idx = j * self.d + k;
+        !(0..self.basis.samples).any(|i| {
+            let o = i * 3 * dd + idx;
+            self.kcm[o] != 0.0 || self.kcm[o + dd] != 0.0 || self.kcm[o + 2 * dd] != 0.0
+        })
+    }
+
+    /// The Galerkin projection sample by sample, `J_jk = W^T (K Phi + omega C Phi' +
+    /// omega^2 M Phi'')`. Every entry sums its samples in order from zero, exactly as
+    /// the scans at N <= [`DIRECT_PROJECTION_MAX_HARM`] were computed (weights that are
+    /// exactly zero, `sin m tau_0`, are skipped as they always were). Returns `false`
+    /// if cancelled.
+    #[inline(never)]
+    fn project_direct(&mut self, om: f64, jac: &mut [f64]) -> bool {
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
         let n = self.size();
-        jac.fill(0.0);
-        let (om2, g) = (om * om, &mut self.g);
+        let dd = d * d;
+        let om2 = om * om;
+        // G's rows padded to whole groups of 8 columns (the padding stays zero).
+        let lp = l.div_ceil(8) * 8;
         for j in 0..d {
             for k in 0..d {
                 // A block takes a fraction of a second at hundreds of harmonics; a
                 // cancelled solve stops at the next Newton iteration (see `cancel`).
                 if crate::cancel::cancelled() {
-                    return;
+                    return false;
                 }
-                // Skip blocks where the coordinates do not interact at all.
-                let idx = j * d + k;
-                let any = (0..s).any(|i| {
-                    let o = i * d * d + idx;
-                    self.k[o] != 0.0 || self.c[o] != 0.0 || self.m[o] != 0.0
-                });
-                if !any {
+                if self.zero_block(j, k) {
+                    zero_block_of(jac, n, l, j, k);
                     continue;
                 }
+                let idx = j * d + k;
+                let g = &mut self.g;
                 // G = K Phi + omega C Phi' + omega^2 M Phi''  (S x L)
                 for i in 0..s {
-                    let o = i * d * d + idx;
-                    let (kv, cv, mv) = (self.k[o], om * self.c[o], om2 * self.m[o]);
+                    let o = i * 3 * dd + idx;
+                    let (kv, cv, mv) = (
+                        self.kcm[o],
+                        om * self.kcm[o + dd],
+                        om2 * self.kcm[o + 2 * dd],
+                    );
                     let b = i * l;
                     for p in 0..l {
-                        g[b + p] = kv * self.basis.phi[b + p]
+                        g[i * lp + p] = kv * self.basis.phi[b + p]
                             + cv * self.basis.dphi[b + p]
                             + mv * self.basis.ddphi[b + p];
                     }
                 }
-                // J block = W^T G
-                for i in 0..s {
-                    let w = &self.basis.wgt[i * l..(i + 1) * l];
-                    let gi = &g[i * l..(i + 1) * l];
-                    for rr in 0..l {
-                        let wr = w[rr];
-                        if wr == 0.0 {
-                            continue;
+                // J block = W^T G, eight columns at a time in registers; each entry
+                // sums its samples in order from zero as before.
+                for rr in 0..l {
+                    let row = &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
+                    for p0 in (0..l).step_by(8) {
+                        let mut acc = [0.0f64; 8];
+                        for i in 0..s {
+                            let wr = self.basis.wgt[i * l + rr];
+                            if wr == 0.0 {
+                                continue;
+                            }
+                            let gi = &g[i * lp + p0..i * lp + p0 + 8];
+                            for t in 0..8 {
+                                acc[t] += wr * gi[t];
+                            }
                         }
-                        let row =
-                            &mut jac[(j * l + rr) * n + k * l..(j * l + rr) * n + (k + 1) * l];
-                        for p in 0..l {
-                            row[p] += wr * gi[p];
-                        }
+                        let m = (l - p0).min(8);
+                        row[p0..p0 + m].copy_from_slice(&acc[..m]);
                     }
                 }
             }
         }
-        // d/d omega: C q_tau + 2 omega M q_tautau
+        true
+    }
+
+    /// The Galerkin projection from the Fourier coefficients of each entry of `K, C, M`
+    /// (`X_c[k] = sum_i X_i cos k tau_i`, `X_s[k]` likewise, `k <= 2N`, one matrix
+    /// product for all entries): the products of two basis functions in the projection
+    /// are sums of harmonics `|m - n|` and `m + n` (product-to-sum), so each block is a
+    /// Toeplitz-plus-Hankel combination of these coefficients. Equal to
+    /// [`Self::project_direct`] in exact arithmetic at any sample count (the identities
+    /// hold sample by sample), `O(S N d^2 + N^2 d^2)` instead of `O(S N^2 d^2)`.
+    /// Returns `false` if cancelled.
+    #[inline(never)]
+    fn project_product_to_sum(&mut self, om: f64, jac: &mut [f64]) -> bool {
+        use faer::{linalg::matmul::matmul, Accum, MatMut, MatRef, Par};
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
+        let nh = self.basis.n_harm;
+        let n = self.size();
+        let dd = d * d;
+        let w = 2 * nh + 1;
+        if self.dft.is_empty() {
+            self.dft = dft_table(nh, s);
+            self.coef = vec![0.0; 3 * dd * 2 * w];
+        }
+        // coef (3d^2 x 2w) = KCM^T (3d^2 x S) * table (S x 2w), for the entries that
+        // vary along the orbit; an entry that is the same at every sample (the planar
+        // model's mass and damping constants, or zero) has the coefficients `S x` of
+        // its constant at k = 0 and none above (sum_i cos k tau_i = 0 for 0 < k < S).
+        let e3 = 3 * dd;
+        let (mut varying, mut constant) = (vec![], vec![]);
+        for e in 0..e3 {
+            let first = self.kcm[e];
+            if (1..s).all(|i| self.kcm[i * e3 + e] == first) {
+                constant.push((e, first));
+            } else {
+                varying.push(e);
+            }
+        }
+        let nv = varying.len();
+        self.packed.resize(s * nv, 0.0);
         for i in 0..s {
-            let w = &self.basis.wgt[i * l..(i + 1) * l];
-            for j in 0..d {
-                let mut dfo = 0.0;
-                for k in 0..d {
-                    let o = i * d * d + j * d + k;
-                    dfo +=
-                        self.c[o] * self.qt[i * d + k] + 2.0 * om * self.m[o] * self.qtt[i * d + k];
+            for (t, &e) in varying.iter().enumerate() {
+                self.packed[i * nv + t] = self.kcm[i * e3 + e];
+            }
+        }
+        self.packed_coef.resize(nv * 2 * w, 0.0);
+        matmul(
+            MatMut::from_row_major_slice_mut(&mut self.packed_coef, nv, 2 * w),
+            Accum::Replace,
+            MatRef::from_row_major_slice(&self.packed, s, nv).transpose(),
+            MatRef::from_row_major_slice(&self.dft, s, 2 * w),
+            1.0,
+            Par::Seq,
+        );
+        for (t, &e) in varying.iter().enumerate() {
+            self.coef[e * 2 * w..(e + 1) * 2 * w]
+                .copy_from_slice(&self.packed_coef[t * 2 * w..(t + 1) * 2 * w]);
+        }
+        for (e, c) in constant {
+            let row = &mut self.coef[e * 2 * w..(e + 1) * 2 * w];
+            row.fill(0.0);
+            row[0] = s as f64 * c;
+        }
+        let inv = 1.0 / s as f64;
+        // Per block, the coefficients on the signed harmonics h = -2N..2N (index
+        // h + 2N): cosines even in h, sines odd (sin(-h tau) = -sin(h tau)).
+        let e = 4 * nh + 1;
+        let z = 2 * nh;
+        let mut ext = vec![0.0; 6 * e];
+        let (mut ac, mut as_) = (vec![0.0; e], vec![0.0; e]);
+        for j in 0..d {
+            for k in 0..d {
+                if crate::cancel::cancelled() {
+                    return false;
                 }
-                for rr in 0..l {
-                    jac[(j * l + rr) * n + d * l] += w[rr] * dfo;
+                if self.zero_block(j, k) {
+                    zero_block_of(jac, n, l, j, k);
+                    continue;
+                }
+                let idx = j * d + k;
+                for x in 0..3 {
+                    let c = &self.coef[(x * dd + idx) * 2 * w..(x * dd + idx + 1) * 2 * w];
+                    let (ce, se) = ext[2 * x * e..(2 * x + 2) * e].split_at_mut(e);
+                    for h in 0..w {
+                        ce[z + h] = c[h];
+                        ce[z - h] = c[h];
+                        se[z + h] = c[w + h];
+                        se[z - h] = -c[w + h];
+                    }
+                }
+                let (kc, ks) = (&ext[0..e], &ext[e..2 * e]);
+                let (cc, cs) = (&ext[2 * e..3 * e], &ext[3 * e..4 * e]);
+                let (mc, ms) = (&ext[4 * e..5 * e], &ext[5 * e..6 * e]);
+                let base = j * l * n + k * l;
+                // Column n of a block: K phi + omega C phi' + omega^2 M phi'' with
+                // phi = cos n tau gives (K - omega^2 n^2 M) cos n tau - omega n C sin n tau,
+                // with phi = sin n tau, (K - omega^2 n^2 M) sin n tau + omega n C cos n tau.
+                // Rows: weight 1/S (mean), 2/S cos m tau, 2/S sin m tau.
+                jac[base] = inv * kc[z];
+                for m in 1..=nh {
+                    jac[base + (2 * m - 1) * n] = 2.0 * inv * kc[z + m];
+                    jac[base + 2 * m * n] = 2.0 * inv * ks[z + m];
+                }
+                for nn in 1..=nh {
+                    let nf = nn as f64;
+                    let (a2, cn) = (om * om * nf * nf, om * nf);
+                    // A = K - omega^2 n^2 M, coefficient by coefficient.
+                    for h in 0..e {
+                        ac[h] = kc[h] - a2 * mc[h];
+                        as_[h] = ks[h] - a2 * ms[h];
+                    }
+                    let (pc, ps) = (base + 2 * nn - 1, base + 2 * nn);
+                    jac[pc] = inv * (ac[z + nn] - cn * cs[z + nn]);
+                    jac[ps] = inv * (as_[z + nn] + cn * cc[z + nn]);
+                    for m in 1..=nh {
+                        // m - n and m + n as indices
+                        let (dm, sm) = (z + m - nn, z + m + nn);
+                        let (rc, rs) = ((2 * m - 1) * n, 2 * m * n);
+                        // cos m cos n = (cos(m-n) + cos(m+n))/2, cos m sin n =
+                        // (sin(m+n) - sin(m-n))/2, sin m cos n = (sin(m+n) + sin(m-n))/2,
+                        // sin m sin n = (cos(m-n) - cos(m+n))/2.
+                        jac[rc + pc] = inv * (ac[dm] + ac[sm] - cn * (cs[sm] - cs[dm]));
+                        jac[rc + ps] = inv * (as_[sm] - as_[dm] + cn * (cc[dm] + cc[sm]));
+                        jac[rs + pc] = inv * (as_[sm] + as_[dm] - cn * (cc[dm] - cc[sm]));
+                        jac[rs + ps] = inv * (ac[dm] - ac[sm] + cn * (cs[sm] + cs[dm]));
+                    }
                 }
             }
         }
+        true
+    }
+
+    /// The omega column, `d/d omega = W^T (C q_tau + 2 omega M q_tautau)`, and the
+    /// phase condition's row.
+    fn omega_column(&self, om: f64, jac: &mut [f64]) {
+        let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
+        let n = self.size();
+        let dd = d * d;
+        // Summed in a contiguous column (sample by sample from zero, as the strided
+        // column of `jac` was: the same sums).
+        let mut col = vec![0.0; d * l];
+        for i in 0..s {
+            let w = &self.basis.wgt[i * l..(i + 1) * l];
+            let kcm = &self.kcm[i * 3 * dd..(i + 1) * 3 * dd];
+            let (qt, qtt) = (&self.qt[i * d..(i + 1) * d], &self.qtt[i * d..(i + 1) * d]);
+            for j in 0..d {
+                let mut dfo = 0.0;
+                for k in 0..d {
+                    let o = j * d + k;
+                    dfo += kcm[o + dd] * qt[k] + 2.0 * om * kcm[o + 2 * dd] * qtt[k];
+                }
+                for (c, wr) in col[j * l..(j + 1) * l].iter_mut().zip(w) {
+                    *c += wr * dfo;
+                }
+            }
+        }
+        for (row, c) in col.iter().enumerate() {
+            jac[row * n + d * l] = *c;
+        }
+        let pc = self.phase_coord;
         let prow = d * l * n;
+        jac[prow..prow + n].fill(0.0);
         if self.phase_rotating {
             jac[prow + pc * l] = 1.0;
             for m in 1..=self.basis.n_harm {
@@ -641,10 +984,9 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         guess.resized(opts.n_harm)
     };
     let samples = opts.samples.unwrap_or_else(|| default_samples(opts.n_harm));
-    let mut prob = HbProblem::new(ModelAt::fixed(model), &g.winding, opts.n_harm, samples);
-    // The model as given: the problem's own parameter value, where it never fails.
-    let p = prob.param();
-    let n = prob.size();
+    count(0);
+    let mut sys = HbSystem::new(model, &g.winding, opts.n_harm, samples);
+    let n = sys.size();
     let mut x = g.unknowns();
     let mut r = vec![0.0; n];
     let mut rt = vec![0.0; n];
@@ -681,7 +1023,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         );
         return out;
     }
-    let _ = prob.jac_x(&x, p, &mut r, &mut jac);
+    sys.assemble(&x, &mut r, Some(&mut jac));
     let mut rn = max_abs(&r);
     let scale0 = max_abs(&x).max(1.0);
     for it in 1..=opts.max_iter {
@@ -702,7 +1044,8 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
             return out;
         }
         let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-        let Some(sol) = lu_solve(&jac, n, &neg) else {
+        count(1);
+        let Some(sol) = timed(Stage::Lu, || lu_solve(&jac, n, &neg)) else {
             finish(&x, &mut out, Status::Singular, rn, f64::INFINITY, it - 1);
             return out;
         };
@@ -720,7 +1063,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
                 xt[i] = x[i] + lam * dx[i];
             }
             if xt[n - 1] > 0.0 {
-                let _ = prob.residual(&xt, p, &mut rt);
+                sys.assemble(&xt, &mut rt, None);
                 rtn = max_abs(&rt);
                 let mt = l2(&rt);
                 if mt.is_finite() && mt < (1.0 - 1e-4 * lam) * merit.max(1e-300) {
@@ -750,7 +1093,10 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
             finish(&x, &mut out, Status::Converged, rn, step, it);
             return out;
         }
-        let _ = prob.jac_x(&x, p, &mut r, &mut jac);
+        // The accepted point is the last one the line search evaluated: its residual
+        // is `rt` and its samples are still in `sys`, so only the Jacobian is new.
+        r.copy_from_slice(&rt);
+        sys.jacobian_after_residual(&x, &mut jac);
         rn = max_abs(&r);
         if it == opts.max_iter {
             finish(&x, &mut out, Status::MaxIterations, rn, step, it);
@@ -1071,6 +1417,132 @@ mod tests {
         assert!(gaps[1] < gaps[0] / 30.0, "not converging as h^2: {gaps:?}");
     }
 
+    /// The Galerkin Jacobian written out sample by sample, independently of
+    /// `HbSystem`: `J[(j, r), (k, p)] = sum_i w_r(tau_i) (K phi_p + omega C phi_p' +
+    /// omega^2 M phi_p'')_jk` with the basis from `cos`/`sin` of `m tau_i`, and the omega
+    /// column `sum_i w_r (C q_tau + 2 omega M q_tautau)_j`.
+    fn direct_jacobian<D: Dynamics>(model: &D, sol: &HbSolution, s: usize) -> Vec<f64> {
+        let (d, nh) = (sol.ndof(), sol.n_harm);
+        let l = 2 * nh + 1;
+        let n = d * l + 1;
+        let om = sol.omega;
+        let mut jac = vec![0.0; n * n];
+        // basis p at tau: (phi, phi', phi'')
+        let basis = |p: usize, t: f64| -> (f64, f64, f64) {
+            if p == 0 {
+                return (1.0, 0.0, 0.0);
+            }
+            let m = p.div_ceil(2) as f64;
+            let (sn, cs) = ((m * t).sin(), (m * t).cos());
+            if p % 2 == 1 {
+                (cs, -m * sn, -m * m * cs)
+            } else {
+                (sn, m * cs, -m * m * sn)
+            }
+        };
+        let (mut q, mut v, mut a) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+        let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+        for i in 0..s {
+            let t = 2.0 * PI * i as f64 / s as f64;
+            sol.eval_rates(t, &mut q, &mut v, &mut a);
+            model.jacobians(t / om, &q, &v, &a, &mut k, &mut c, &mut m);
+            let (mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d]);
+            sol.eval(t, &mut q, &mut qt, &mut qtt);
+            for r in 0..l {
+                let wr = basis(r, t).0 * if r == 0 { 1.0 } else { 2.0 } / s as f64;
+                for j in 0..d {
+                    for kk in 0..d {
+                        let o = j * d + kk;
+                        for p in 0..l {
+                            let (f, f1, f2) = basis(p, t);
+                            jac[(j * l + r) * n + kk * l + p] +=
+                                wr * (k[o] * f + om * c[o] * f1 + om * om * m[o] * f2);
+                        }
+                        jac[(j * l + r) * n + d * l] +=
+                            wr * (c[o] * qt[kk] + 2.0 * om * m[o] * qtt[kk]);
+                    }
+                }
+            }
+        }
+        jac
+    }
+
+    #[test]
+    fn product_to_sum_jacobian_equals_the_direct_projection() {
+        use crate::model::Planar;
+        use crate::periodic::{periodic, PeriodicOptions};
+        let opts = |n_harm| PeriodicOptions {
+            hb: HbOptions {
+                n_harm,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        // Two merged balls on a converged R-R orbit (standard case), and motions of two
+        // and three balls with one rotating and one oscillating ball: a series with
+        // slowly decaying harmonics in every coordinate.
+        let two = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let three = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.3, &[1.0, 0.8, 0.6]).unwrap();
+        let rr = periodic(&two, &[true, true], None, &opts(3)).sol;
+        assert_eq!(rr.status, Status::Converged);
+        let synthetic = |winding: Vec<f64>, nh: usize| {
+            let l = 2 * nh + 1;
+            let coeffs = (0..winding.len() * l)
+                .map(|i| {
+                    let h = (i % l).div_ceil(2) as f64;
+                    0.3 * ((i * 37 % 17) as f64 / 8.0 - 1.0) / (1.0 + h * h)
+                })
+                .collect();
+            HbSolution::start(0.83, coeffs, winding, nh, Status::Converged)
+        };
+        let mut worst = 0.0f64;
+        for nh in [3, 8, 12] {
+            let rr_n = periodic(&two, &[true, true], Some(&rr), &opts(nh)).sol;
+            assert_eq!(rr_n.status, Status::Converged);
+            let cases: [(&Planar, HbSolution); 3] = [
+                (&two, rr_n),
+                (&two, synthetic(vec![0.0, 0.0, -1.0, 0.0], nh)),
+                (&three, synthetic(vec![0.0, 0.0, 0.0, -1.0, -1.0], nh)),
+            ];
+            for (model, sol) in &cases {
+                let s = default_samples(nh);
+                let expect = direct_jacobian(*model, sol, s);
+                let scale = expect.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                let mut sys = HbSystem::new(*model, &sol.winding, nh, s);
+                let n = sys.size();
+                let x = sol.unknowns();
+                let (mut r, mut jac) = (vec![0.0; n], vec![0.0; n * n]);
+                sys.assemble(&x, &mut r, Some(&mut jac));
+                // Both paths, whichever `assemble` takes at this N.
+                let (mut direct, mut pts) = (vec![0.0; n * n], vec![0.0; n * n]);
+                assert!(sys.project_direct(sol.omega, &mut direct));
+                sys.omega_column(sol.omega, &mut direct);
+                assert!(sys.project_product_to_sum(sol.omega, &mut pts));
+                sys.omega_column(sol.omega, &mut pts);
+                for row in 0..n - 1 {
+                    for col in 0..n {
+                        let e = expect[row * n + col];
+                        for (name, got) in [("assembled", &jac), ("direct", &direct), ("pts", &pts)]
+                        {
+                            let gap = (got[row * n + col] - e).abs();
+                            worst = worst.max(gap / scale);
+                            assert!(
+                                gap <= 1e-13 * scale,
+                                "N {nh} d {} {name} ({row},{col}): {} vs {e}",
+                                sol.ndof(),
+                                got[row * n + col]
+                            );
+                        }
+                    }
+                }
+                // The rotating and oscillating balls' blocks are not empty.
+                let nonzero = pts.iter().filter(|v| v.abs() > 1e-8 * scale).count();
+                assert!(nonzero > n * n / 4, "N {nh}: {nonzero} of {}", n * n);
+            }
+        }
+        println!("largest gap relative to the largest entry: {worst:.1e}");
+    }
+
     #[test]
     fn series_evaluation_and_fit_round_trip() {
         let c = [0.3, 1.0, -0.5, 0.2, 0.1];
@@ -1085,7 +1557,10 @@ mod tests {
     }
 
     /// Warm-started solves at N = 3, 6, 8, 12 for callgrind (`--ignored --exact
-    /// numerics::hb::tests::hb_profile`): per N, a `warm_solve::<N>` frame.
+    /// numerics::hb::tests::hb_profile`): 20 solves per N, all four N, or only the N in
+    /// `BALLBAL_HB_N`. Per solve: `warm_solve`'s inclusive count / 20 with
+    /// `BALLBAL_HB_N` set (the per-N copies of `warm_solve` compile to one function, so
+    /// callgrind cannot tell the N apart in a run of all four).
     #[test]
     #[ignore]
     fn hb_profile() {
@@ -1101,23 +1576,22 @@ mod tests {
             ..Default::default()
         };
         let seed12 = periodic(&near, &[true, true], Some(&seed), &opts(12)).sol;
+        let only: Option<usize> = std::env::var("BALLBAL_HB_N")
+            .ok()
+            .map(|v| v.parse().expect("BALLBAL_HB_N: a harmonic count"));
+        let ns: Vec<usize> = only.map_or(vec![3, 6, 8, 12], |n| vec![n]);
         let mut acc = 0.0;
         for _ in 0..20 {
-            acc += warm_solve::<3>(&p, &seed12, &opts(3));
-            acc += warm_solve::<6>(&p, &seed12, &opts(6));
-            acc += warm_solve::<8>(&p, &seed12, &opts(8));
-            acc += warm_solve::<12>(&p, &seed12, &opts(12));
+            for &n in &ns {
+                acc += warm_solve(&p, &seed12, &opts(n));
+            }
         }
         println!("{acc}");
     }
 
-    /// One solve; monomorphised per `N` so that callgrind reports each N apart.
+    /// One warm solve (certificates included): the frame callgrind reports.
     #[inline(never)]
-    fn warm_solve<const N: usize>(
-        p: &crate::Planar,
-        g: &HbSolution,
-        o: &crate::periodic::PeriodicOptions,
-    ) -> f64 {
+    fn warm_solve(p: &crate::Planar, g: &HbSolution, o: &crate::periodic::PeriodicOptions) -> f64 {
         crate::periodic::periodic(p, &[true, true], Some(g), o)
             .sol
             .omega
