@@ -2,7 +2,7 @@
 //! corrector, and the scan's rules for what a new solution is (same rotation pattern,
 //! resolved, certified; not an orbit already known there).
 
-use super::{Family, Found, Origin, ScanSpec};
+use super::{count, work, Family, Found, Origin, ScanSpec};
 use crate::continuation::{Corrector, Waves};
 use crate::hb::{solve, HbSolution, Status};
 use crate::periodic::finish;
@@ -24,6 +24,7 @@ impl<D: Family> Corrector for BlockWaves<'_, '_, D> {
     type Point = HbSolution;
     fn correct(&self, at: &usize, guess: &HbSolution, from: &HbSolution) -> Option<HbSolution> {
         let model = &self.params[*at];
+        count(work::WAVE_SOLVE);
         let r = solve(model, guess, &self.spec.opts.hb);
         accept(model, &r, from, self.spec).then_some(r)
     }
@@ -51,6 +52,30 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
     fn admit(&self, have: &[Found], class: usize, key: &Vec<f64>) -> bool {
         admit(have, class, key)
     }
+    fn correct_last(
+        &self,
+        at: &usize,
+        guess: &HbSolution,
+        from: &HbSolution,
+        class: usize,
+        have: &[Found],
+        new: &[Found],
+    ) -> Option<HbSolution> {
+        // Most attempts reach an orbit already found at their point: its certificate
+        // would only decide whether a later guess is tried, and there is none.
+        let model = &self.params[*at];
+        count(work::WAVE_SOLVE);
+        let r = solve(model, guess, &self.spec.opts.hb);
+        if !resolved(model, &r, from, self.spec) {
+            return None;
+        }
+        let key = self.key(&r);
+        if !admit(have, class, &key) || !admit(new, class, &key) {
+            count(work::SPARED);
+            return None;
+        }
+        certified(model, &r, self.spec).then_some(r)
+    }
     fn complete(
         &self,
         at: usize,
@@ -60,6 +85,7 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
         parent: (usize, usize),
         started: Instant,
     ) -> Option<Found> {
+        count(work::FINISH);
         let res = finish(&self.params[at], point, &self.spec.opts);
         // Refined with N = "auto" and certified: a series that fails is neither
         // reported nor continued, like a failed solve.
@@ -87,13 +113,26 @@ pub(super) fn accept<D: Family>(
     guess: &HbSolution,
     spec: &ScanSpec<'_, D>,
 ) -> bool {
-    if !(s.status == Status::Converged
+    resolved(model, s, guess, spec) && certified(model, s, spec)
+}
+
+/// [`accept`]'s first part: converged, of the guess's pattern, resolved.
+fn resolved<D: Family>(
+    model: &D,
+    s: &HbSolution,
+    guess: &HbSolution,
+    spec: &ScanSpec<'_, D>,
+) -> bool {
+    s.status == Status::Converged
         && s.winding == guess.winding
-        && s.tail_ratio_on(model.layout().support()) <= spec.max_tail)
-    {
-        return false;
-    }
+        && s.tail_ratio_on(model.layout().support()) <= spec.max_tail
+}
+
+/// [`accept`]'s second part: the orbit-closure certificate (with N = "auto" only after
+/// refinement, in `finish`).
+fn certified<D: Family>(model: &D, s: &HbSolution, spec: &ScanSpec<'_, D>) -> bool {
     spec.opts.auto.is_some() || {
+        count(work::CERTIFY);
         let mut c = s.clone();
         crate::periodic::certify(model, &mut c, &spec.opts);
         c.status == Status::Converged
