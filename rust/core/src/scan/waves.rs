@@ -5,7 +5,7 @@
 use super::{count, work, Family, Found, Origin, ScanSpec};
 use crate::continuation::{Corrector, Waves};
 use crate::hb::{solve, HbSolution, Status};
-use crate::periodic::finish;
+use crate::periodic::finish_certified;
 use std::time::Instant;
 
 /// Most solutions of one type kept at one point: a guard against a duplicate test
@@ -25,6 +25,7 @@ impl<D: Family> Corrector for BlockWaves<'_, '_, D> {
     fn correct(&self, at: &usize, guess: &HbSolution, from: &HbSolution) -> Option<HbSolution> {
         let model = &self.params[*at];
         count(work::WAVE_SOLVE);
+        CERTIFIED.set(None);
         let r = solve(model, guess, &self.spec.opts.hb);
         accept(model, &r, from, self.spec).then_some(r)
     }
@@ -65,6 +66,7 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
         // would only decide whether a later guess is tried, and there is none.
         let model = &self.params[*at];
         count(work::WAVE_SOLVE);
+        CERTIFIED.set(None);
         let r = solve(model, guess, &self.spec.opts.hb);
         if !resolved(model, &r, from, self.spec) {
             return None;
@@ -86,7 +88,12 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
         started: Instant,
     ) -> Option<Found> {
         count(work::FINISH);
-        let res = finish(&self.params[at], point, &self.spec.opts);
+        let model = &self.params[at];
+        let passed = CERTIFIED
+            .take()
+            .filter(|(m, c, _)| *m == model as *const D as usize && same_series(c, &point))
+            .map(|(_, _, closure)| closure);
+        let res = finish_certified(model, point, &self.spec.opts, passed);
         // Refined with N = "auto" and certified: a series that fails is neither
         // reported nor continued, like a failed solve.
         if res.sol.status != Status::Converged {
@@ -134,9 +141,36 @@ fn certified<D: Family>(model: &D, s: &HbSolution, spec: &ScanSpec<'_, D>) -> bo
     spec.opts.auto.is_some() || {
         count(work::CERTIFY);
         let mut c = s.clone();
-        crate::periodic::certify(model, &mut c, &spec.opts);
-        c.status == Status::Converged
+        let closure = crate::periodic::certify(model, &mut c, &spec.opts);
+        let ok = c.status == Status::Converged;
+        if let (true, Some(closure)) = (ok, closure) {
+            CERTIFIED.set(Some((model as *const D as usize, c, closure)));
+        }
+        ok
     }
+}
+
+thread_local! {
+    /// The last series this thread's continuation certified (its model's address, the
+    /// series, its closure): the step's `complete` follows on the same thread with that
+    /// very series, whose certificate `finish` then need not integrate again. Cleared
+    /// before every solve, and used only for a bit-identical series of the same model.
+    static CERTIFIED: std::cell::Cell<Option<(usize, HbSolution, f64)>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// Whether two series are the same bits in everything [`crate::periodic::certify`]
+/// reads.
+fn same_series(a: &HbSolution, b: &HbSolution) -> bool {
+    let bits = |x: &[f64], y: &[f64]| {
+        x.len() == y.len() && x.iter().zip(y).all(|(u, v)| u.to_bits() == v.to_bits())
+    };
+    a.omega.to_bits() == b.omega.to_bits()
+        && a.n_harm == b.n_harm
+        && a.samples == b.samples
+        && a.status == b.status
+        && bits(&a.coeffs, &b.coeffs)
+        && bits(&a.winding, &b.winding)
 }
 
 /// Whether an orbit of type `pattern` with `key` is new among `have`, and its type
