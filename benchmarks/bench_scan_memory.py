@@ -48,6 +48,8 @@ if setting == "floquet":
     kw = dict(patterns=["R-R"], N=3, threads=2, **grid)
     model = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+counts = getattr(ballbal._native, "scan_work_counts", lambda: [0] * 5)
+w0 = counts()
 t = time.perf_counter()
 if mode == "streamed":
     lf = ballbal.scan(model, out=out, lazy=True, **kw)
@@ -58,8 +60,9 @@ else:
     n, found = df.height, df.filter(pl.col("status") == "converged").height
 dt = time.perf_counter() - t
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+work = [b - a for a, b in zip(w0, counts())]
 print(json.dumps(dict(points=side * side, rows=n, found=found, seconds=dt,
-                      peak_mib=peak / 1024, import_mib=base / 1024)))
+                      peak_mib=peak / 1024, import_mib=base / 1024, work=work)))
 """
 
 
@@ -91,16 +94,22 @@ def main() -> None:
 
 
 def floquet(full: bool) -> None:
+    """Also the work per row (``_native.scan_work_counts``): harmonic-balance solves
+    (seeds' and continuation attempts'), certificates, Floquet analyses (solutions
+    finished), and certificates spared on attempts that reached a known orbit."""
     print(f"{'points':>9} {'rows':>9} {'found':>9} {'seconds':>8} {'us/point':>9} "
-          f"{'peak MiB':>9} {'after import':>12}")
+          f"{'peak MiB':>9} {'after import':>12} {'solves/row':>10} {'certs/row':>9} "
+          f"{'Floquet/row':>11} {'spared/row':>10}")
     sides = [100, 316] + ([1000] if full else [])
     last = None
     for side in sides:
         r = run(side, "streamed", "floquet")
         last = r
+        seed, wave, cert, fin, spared = (c / r["rows"] for c in r["work"])
         print(f"{r['points']:>9} {r['rows']:>9} {r['found']:>9} {r['seconds']:>8.1f} "
               f"{1e6 * r['seconds'] / r['points']:>9.0f} {r['peak_mib']:>9.0f} "
-              f"{r['import_mib']:>12.0f}", flush=True)
+              f"{r['import_mib']:>12.0f} {seed + wave:>10.2f} {cert:>9.2f} {fin:>11.2f} "
+              f"{spared:>10.2f}", flush=True)
     if not full and last is not None:
         print(f"10^6 points at the 10^5 rate: about "
               f"{1e6 * last['seconds'] / last['points'] / 60:.1f} minutes")

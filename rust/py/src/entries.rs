@@ -438,6 +438,14 @@ pub fn scan_stage_seconds() -> Vec<f64> {
     v
 }
 
+/// Work this process's scans did (see the core's `work_counts`): harmonic-balance
+/// solves from seeds and from continuation attempts, certificates, solutions finished
+/// (Floquet analyses), certificates spared. A benchmark's measure.
+#[pyfunction]
+pub fn scan_work_counts() -> Vec<u64> {
+    ballbal_core::scan::work_counts().to_vec()
+}
+
 /// Seconds this process has spent in certificate checks (all threads; a benchmark's
 /// measure of what they cost).
 #[pyfunction]

@@ -189,38 +189,20 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
     family: bool,
 ) -> Equilibrium {
     let d = p.ndof();
-    let z = vec![0.0; d];
     let mut r = vec![0.0; d];
     static_residual(p, q, &mut r);
     let residual = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
-    p.jacobians(0.0, q, &z, &z, &mut k, &mut c, &mut m);
-    let mut a = vec![0.0; 4 * d * d];
-    let mut col = vec![0.0; 2 * d * d];
-    state_matrix(p, 0.0, q, &k, &c, &mut col, &mut a);
-    let ev = eigenvalues(&a, 2 * d).unwrap_or_default();
-    // A perfect balance with n >= 3 balls is an (n-2)-parameter family: those
-    // directions have zero eigenvalues and say nothing about attraction.
+    let Spectrum {
+        k,
+        c,
+        m,
+        a,
+        ev,
+        index,
+        verdict,
+        neutral,
+    } = spectrum(p, q, kind, family);
     let o = p.first_ball();
-    let n_balls = d - o;
-    let neutral = if family && kind == EquilibriumKind::PerfectBalance && n_balls >= 3 {
-        n_balls - 2
-    } else {
-        0
-    };
-    let mut by_abs: Vec<&(f64, f64)> = ev.iter().collect();
-    by_abs.sort_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)));
-    let judged: Vec<&(f64, f64)> = by_abs.into_iter().skip(neutral).collect();
-    let index = judged.iter().map(|e| e.0).fold(f64::NEG_INFINITY, f64::max);
-    let verdict = if ev.is_empty() || !index.is_finite() {
-        Verdict::Marginal
-    } else if index < -EIG_TOL {
-        Verdict::Stable
-    } else if index > EIG_TOL {
-        Verdict::Unstable
-    } else {
-        Verdict::Marginal
-    };
     // The cofactor expansion's cost depends on the matrices' zero pattern and explodes
     // past a few balls (0.2 s per equilibrium at 24 balls): beyond it, Hessenberg.
     let poly = if d <= CHAR_POLY_COFACTOR_MAX {
@@ -254,6 +236,93 @@ pub fn analyse_model<D: Dynamics + ?Sized>(
         char_poly: poly,
         exhaustive: true,
     }
+}
+
+/// The linearisation at an equilibrium and the verdict its eigenvalues give.
+struct Spectrum {
+    k: Vec<f64>,
+    c: Vec<f64>,
+    m: Vec<f64>,
+    /// The state matrix, row-major `2d x 2d`.
+    a: Vec<f64>,
+    ev: Vec<(f64, f64)>,
+    index: f64,
+    verdict: Verdict,
+    neutral: usize,
+}
+
+/// [`analyse_model`]'s linearisation and verdict, without the characteristic polynomial.
+fn spectrum<D: Dynamics + ?Sized>(
+    p: &D,
+    q: &[f64],
+    kind: EquilibriumKind,
+    family: bool,
+) -> Spectrum {
+    let d = p.ndof();
+    let z = vec![0.0; d];
+    let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
+    p.jacobians(0.0, q, &z, &z, &mut k, &mut c, &mut m);
+    let mut a = vec![0.0; 4 * d * d];
+    let mut col = vec![0.0; 2 * d * d];
+    state_matrix(p, 0.0, q, &k, &c, &mut col, &mut a);
+    let ev = eigenvalues(&a, 2 * d).unwrap_or_default();
+    // A perfect balance with n >= 3 balls is an (n-2)-parameter family: those
+    // directions have zero eigenvalues and say nothing about attraction.
+    let o = p.first_ball();
+    let n_balls = d - o;
+    let neutral = if family && kind == EquilibriumKind::PerfectBalance && n_balls >= 3 {
+        n_balls - 2
+    } else {
+        0
+    };
+    let mut by_abs: Vec<&(f64, f64)> = ev.iter().collect();
+    by_abs.sort_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)));
+    let judged: Vec<&(f64, f64)> = by_abs.into_iter().skip(neutral).collect();
+    let index = judged.iter().map(|e| e.0).fold(f64::NEG_INFINITY, f64::max);
+    let verdict = if ev.is_empty() || !index.is_finite() {
+        Verdict::Marginal
+    } else if index < -EIG_TOL {
+        Verdict::Stable
+    } else if index > EIG_TOL {
+        Verdict::Unstable
+    } else {
+        Verdict::Marginal
+    };
+    Spectrum {
+        k,
+        c,
+        m,
+        a,
+        ev,
+        index,
+        verdict,
+        neutral,
+    }
+}
+
+/// The verdict of the perfect balance [`equilibria`] lists for `p` (`None` where it
+/// lists none), without analysing the other equilibria or expanding characteristic
+/// polynomials: what a scan reports at every point. Where the equilibria have closed
+/// forms, the same perfect balance [`equilibria`] would report first (its order:
+/// kind, then `x`), analysed alike.
+pub fn perfect_balance_verdict(p: &Planar) -> Option<Verdict> {
+    let n = p.n_balls();
+    let found = if n == 2 && equal_balls(p) && p.zeta > 0.0 {
+        closed_form_two_equal(p)
+    } else if n == 1 && p.zeta > 0.0 && p.omega_s > 0.0 {
+        closed_form_one(p)
+    } else {
+        return equilibria(p)
+            .into_iter()
+            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+            .map(|e| e.verdict);
+    };
+    found
+        .into_iter()
+        .filter(|(_, k)| *k == EquilibriumKind::PerfectBalance)
+        // `min_by` keeps the first of equal ones, as `sorted_analysed`'s stable sort
+        .min_by(|a, b| a.0[0].total_cmp(&b.0[0]))
+        .map(|(q, k)| spectrum(p, &q, k, true).verdict)
 }
 
 /// Whether all balls have the same mass (states that differ by relabelling are one).

@@ -2,7 +2,9 @@
 //! planar balancer and scenes, with the equilibrium reported beside every point. The
 //! scan knows only the trait.
 
-use crate::equilibria::{equilibria, Equilibrium, EquilibriumKind};
+use crate::equilibria::{
+    equilibria, perfect_balance_verdict, Equilibrium, EquilibriumKind, Verdict,
+};
 use crate::error::Result;
 use crate::model::ParamRef;
 use crate::numerics::problem::Parametric;
@@ -13,6 +15,11 @@ pub trait Family: Parametric {
     /// The equilibrium reported beside every point (`pb_exists`, `pb_stable`): the
     /// perfect balance, or with ball springs the balanced state that continues it.
     fn balance(&self) -> Option<Equilibrium>;
+    /// The verdict of [`Self::balance`], which a model may find more cheaply (a scan
+    /// asks it at every point).
+    fn balance_verdict(&self) -> Option<Verdict> {
+        self.balance().map(|e| e.verdict)
+    }
 }
 
 impl Parametric for Planar {
@@ -29,6 +36,9 @@ impl Family for Planar {
         equilibria(self)
             .into_iter()
             .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+    }
+    fn balance_verdict(&self) -> Option<Verdict> {
+        perfect_balance_verdict(self)
     }
 }
 
@@ -50,4 +60,36 @@ impl Family for Scene {
 /// A parameter's value looked up in the registry, or an error naming it.
 fn registry_value(name: &str, v: Option<f64>) -> Result<f64> {
     v.ok_or_else(|| crate::Error::param(name, "is not a parameter of this model"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scan's per-point verdict against the full list of analysed equilibria:
+    /// closed forms (one ball, two equal balls), Newton's search (unequal balls, three
+    /// balls, no damping), perfect balances that exist or not, stable or not.
+    #[test]
+    fn balance_verdict_is_the_listed_perfect_balance_verdict() {
+        let mut seen = [0usize; 3];
+        let etas: [&[f64]; 5] = [&[1.0], &[0.7], &[1.0, 1.0], &[0.4, 0.4], &[0.9, 0.6]];
+        for eta in etas {
+            for zeta in [0.0, 0.05] {
+                for om in [0.4, 0.9, 1.1, 1.6, 3.0] {
+                    let zb = vec![0.05; eta.len()];
+                    let p = Planar::new(0.2, zeta, &zb, 50.0, om, eta).unwrap();
+                    let want = p.balance().map(|e| e.verdict);
+                    assert_eq!(p.balance_verdict(), want, "eta {eta:?} zeta {zeta} Omega {om}");
+                    seen[match want {
+                        None => 0,
+                        Some(Verdict::Stable) => 1,
+                        Some(_) => 2,
+                    }] += 1;
+                }
+            }
+        }
+        let three = Planar::new(0.2, 0.05, &[0.05; 3], 50.0, 1.6, &[0.5; 3]).unwrap();
+        assert_eq!(three.balance_verdict(), three.balance().map(|e| e.verdict));
+        assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
+    }
 }

@@ -482,6 +482,17 @@ fn wound_search<D: Dynamics + ?Sized>(
 }
 
 pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptions) -> Periodic {
+    finish_certified(p, sol, opts, None)
+}
+
+/// [`finish`] of a series whose [`certify`] (with these options) already passed and
+/// gave the closure `passed`: without `auto`, that certificate is not computed again.
+pub fn finish_certified<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: HbSolution,
+    opts: &PeriodicOptions,
+    passed: Option<f64>,
+) -> Periodic {
     let mut sol = sol;
     let mut target_met = None;
     let run_floquet = |sol: &HbSolution| match (&opts.floquet, sol.status == Status::Converged) {
@@ -526,6 +537,7 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
         _ => {
             // Certificate first: a series that fails it gets no Floquet analysis.
             closure = match sol.status {
+                Status::Converged if passed.is_some() => passed,
                 Status::Converged => certify(p, &mut sol, opts),
                 // Already certified (and refused) by `periodic`'s search: keep its measure.
                 Status::NotClosed | Status::Truncated => {

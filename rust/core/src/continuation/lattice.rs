@@ -4,7 +4,7 @@
 //! solution appears. Each wave reads only what earlier waves produced and runs its
 //! points in parallel, so the result does not depend on the thread count.
 
-use super::{natural_step, Corrector};
+use super::{Corrector, Secant};
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -37,6 +37,22 @@ pub trait Waves: Corrector<At = usize> {
     /// Whether a solution of `class` with `key` is new among `have` (and its class
     /// still has room there).
     fn admit(&self, have: &[Self::Found], class: usize, key: &Self::Key) -> bool;
+    /// [`Corrector::correct`] for the last guess of a step, with the solutions known at
+    /// `at` (`have`, and `new` ones of this wave): it may refuse a point that
+    /// [`Self::admit`] refuses there, of `class`, without the checks that only decide
+    /// whether a later guess is tried (none comes after the last, and a point not
+    /// admitted gives nothing either way).
+    fn correct_last(
+        &self,
+        at: &usize,
+        guess: &Self::Point,
+        from: &Self::Point,
+        _class: usize,
+        _have: &[Self::Found],
+        _new: &[Self::Found],
+    ) -> Option<Self::Point> {
+        self.correct(at, guess, from)
+    }
     /// Completes a corrected, admitted point into a stored solution (e.g. with its
     /// stability), or refuses it; `started`: when this step began.
     fn complete(
@@ -122,9 +138,23 @@ pub fn waves<W: Waves, L: Lattice>(
                             (Some(f), Some((pp, ps))) if pp == f => Some(W::point(&known[pp][ps])),
                             _ => None,
                         };
-                        let step = natural_step(w, &q, W::point(src), previous);
-                        tries[k] += step.attempts;
-                        let Some(sol) = step.point else {
+                        // `natural_step`'s guesses (the secant, then the source itself),
+                        // the last one told what is known here.
+                        let current = W::point(src);
+                        let secant = previous.map(|b| current.secant(b));
+                        let mut point = None;
+                        for (i, guess) in secant.iter().chain(Some(current)).enumerate() {
+                            tries[k] += 1;
+                            point = if i == usize::from(secant.is_some()) {
+                                w.correct_last(&q, guess, current, k, &known[q], &new)
+                            } else {
+                                w.correct(&q, guess, current)
+                            };
+                            if point.is_some() {
+                                break;
+                            }
+                        }
+                        let Some(sol) = point else {
                             secs[k] += t.elapsed().as_secs_f64();
                             continue;
                         };

@@ -61,6 +61,32 @@ fn add_stage(i: usize, since: std::time::Instant) {
     STAGE_NS[i].fetch_add(since.elapsed().as_nanos() as u64, Ordering::Relaxed);
 }
 
+/// Work done by the scans this process ran, summed over blocks: `[harmonic-balance
+/// solves from seed simulations, harmonic-balance solves of continuation attempts,
+/// orbit-closure certificates of solved attempts, solutions finished (refinement and
+/// Floquet analysis), certificates spared (an attempt's last guess that converged to
+/// an orbit already known at its point)]`. A benchmark's measure (one relaxed atomic
+/// add per solve); nothing reads it back.
+pub fn work_counts() -> [u64; 5] {
+    std::array::from_fn(|i| WORK[i].load(Ordering::Relaxed))
+}
+
+static WORK: [std::sync::atomic::AtomicU64; 5] =
+    [const { std::sync::atomic::AtomicU64::new(0) }; 5];
+
+/// Indices into [`work_counts`].
+pub(crate) mod work {
+    pub const SEED_SOLVE: usize = 0;
+    pub const WAVE_SOLVE: usize = 1;
+    pub const CERTIFY: usize = 2;
+    pub const FINISH: usize = 3;
+    pub const SPARED: usize = 4;
+}
+
+pub(crate) fn count(i: usize) {
+    WORK[i].fetch_add(1, Ordering::Relaxed);
+}
+
 /// Runs the chunks `which` (indices into `spec.chunks()`) and hands each finished
 /// chunk's rows to `on_chunk` (from a worker thread, in completion order). Stops early,
 /// with `Error::Cancelled`, once `cancel` is set; chunks already handed over are kept.
@@ -146,8 +172,8 @@ fn scan_chunk<D: Family>(
     let pb: Vec<(bool, bool)> = params
         .par_iter()
         .map(|p| {
-            let e = p.balance();
-            (e.is_some(), e.is_some_and(|e| e.verdict == Verdict::Stable))
+            let v = p.balance_verdict();
+            (v.is_some(), v == Some(Verdict::Stable))
         })
         .collect();
     let check = || {

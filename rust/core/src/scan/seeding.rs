@@ -3,7 +3,7 @@
 
 use super::grid::Local;
 use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
-use super::{Family, Found, Origin, ScanSpec};
+use super::{count, work, Family, Found, Origin, ScanSpec};
 use crate::analysis::attractors::seed_guess;
 use crate::continuation::Lattice;
 use crate::hb::{solve, HbSolution, Status};
@@ -102,6 +102,7 @@ pub(super) fn run_seeds<D: Family>(
                 .map(|w| *w != 0.0)
                 .collect();
             let k = spec.patterns.iter().position(|r| *r == rot)?;
+            count(work::SEED_SOLVE);
             let sol = solve(model, &g, &spec.opts.hb);
             if !accept(model, &sol, &g, spec) {
                 return None;
@@ -143,6 +144,7 @@ pub(super) fn run_seeds<D: Family>(
                     return None;
                 }
                 let t = Instant::now();
+                count(work::FINISH);
                 let res = finish(&params[*p], sol.clone(), &spec.opts);
                 (res.sol.status == Status::Converged).then(|| Found {
                     pattern: *k,

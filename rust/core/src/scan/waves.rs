@@ -2,10 +2,10 @@
 //! corrector, and the scan's rules for what a new solution is (same rotation pattern,
 //! resolved, certified; not an orbit already known there).
 
-use super::{Family, Found, Origin, ScanSpec};
+use super::{count, work, Family, Found, Origin, ScanSpec};
 use crate::continuation::{Corrector, Waves};
 use crate::hb::{solve, HbSolution, Status};
-use crate::periodic::finish;
+use crate::periodic::finish_certified;
 use std::time::Instant;
 
 /// Most solutions of one type kept at one point: a guard against a duplicate test
@@ -24,6 +24,8 @@ impl<D: Family> Corrector for BlockWaves<'_, '_, D> {
     type Point = HbSolution;
     fn correct(&self, at: &usize, guess: &HbSolution, from: &HbSolution) -> Option<HbSolution> {
         let model = &self.params[*at];
+        count(work::WAVE_SOLVE);
+        CERTIFIED.set(None);
         let r = solve(model, guess, &self.spec.opts.hb);
         accept(model, &r, from, self.spec).then_some(r)
     }
@@ -51,6 +53,31 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
     fn admit(&self, have: &[Found], class: usize, key: &Vec<f64>) -> bool {
         admit(have, class, key)
     }
+    fn correct_last(
+        &self,
+        at: &usize,
+        guess: &HbSolution,
+        from: &HbSolution,
+        class: usize,
+        have: &[Found],
+        new: &[Found],
+    ) -> Option<HbSolution> {
+        // Most attempts reach an orbit already found at their point: its certificate
+        // would only decide whether a later guess is tried, and there is none.
+        let model = &self.params[*at];
+        count(work::WAVE_SOLVE);
+        CERTIFIED.set(None);
+        let r = solve(model, guess, &self.spec.opts.hb);
+        if !resolved(model, &r, from, self.spec) {
+            return None;
+        }
+        let key = self.key(&r);
+        if !admit(have, class, &key) || !admit(new, class, &key) {
+            count(work::SPARED);
+            return None;
+        }
+        certified(model, &r, self.spec).then_some(r)
+    }
     fn complete(
         &self,
         at: usize,
@@ -60,7 +87,13 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
         parent: (usize, usize),
         started: Instant,
     ) -> Option<Found> {
-        let res = finish(&self.params[at], point, &self.spec.opts);
+        count(work::FINISH);
+        let model = &self.params[at];
+        let passed = CERTIFIED
+            .take()
+            .filter(|(m, c, _)| *m == model as *const D as usize && same_series(c, &point))
+            .map(|(_, _, closure)| closure);
+        let res = finish_certified(model, point, &self.spec.opts, passed);
         // Refined with N = "auto" and certified: a series that fails is neither
         // reported nor continued, like a failed solve.
         if res.sol.status != Status::Converged {
@@ -87,17 +120,57 @@ pub(super) fn accept<D: Family>(
     guess: &HbSolution,
     spec: &ScanSpec<'_, D>,
 ) -> bool {
-    if !(s.status == Status::Converged
+    resolved(model, s, guess, spec) && certified(model, s, spec)
+}
+
+/// [`accept`]'s first part: converged, of the guess's pattern, resolved.
+fn resolved<D: Family>(
+    model: &D,
+    s: &HbSolution,
+    guess: &HbSolution,
+    spec: &ScanSpec<'_, D>,
+) -> bool {
+    s.status == Status::Converged
         && s.winding == guess.winding
-        && s.tail_ratio_on(model.layout().support()) <= spec.max_tail)
-    {
-        return false;
-    }
+        && s.tail_ratio_on(model.layout().support()) <= spec.max_tail
+}
+
+/// [`accept`]'s second part: the orbit-closure certificate (with N = "auto" only after
+/// refinement, in `finish`).
+fn certified<D: Family>(model: &D, s: &HbSolution, spec: &ScanSpec<'_, D>) -> bool {
     spec.opts.auto.is_some() || {
+        count(work::CERTIFY);
         let mut c = s.clone();
-        crate::periodic::certify(model, &mut c, &spec.opts);
-        c.status == Status::Converged
+        let closure = crate::periodic::certify(model, &mut c, &spec.opts);
+        let ok = c.status == Status::Converged;
+        if let (true, Some(closure)) = (ok, closure) {
+            CERTIFIED.set(Some((model as *const D as usize, c, closure)));
+        }
+        ok
     }
+}
+
+thread_local! {
+    /// The last series this thread's continuation certified (its model's address, the
+    /// series, its closure): the step's `complete` follows on the same thread with that
+    /// very series, whose certificate `finish` then need not integrate again. Cleared
+    /// before every solve, and used only for a bit-identical series of the same model.
+    static CERTIFIED: std::cell::Cell<Option<(usize, HbSolution, f64)>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// Whether two series are the same bits in everything [`crate::periodic::certify`]
+/// reads.
+fn same_series(a: &HbSolution, b: &HbSolution) -> bool {
+    let bits = |x: &[f64], y: &[f64]| {
+        x.len() == y.len() && x.iter().zip(y).all(|(u, v)| u.to_bits() == v.to_bits())
+    };
+    a.omega.to_bits() == b.omega.to_bits()
+        && a.n_harm == b.n_harm
+        && a.samples == b.samples
+        && a.status == b.status
+        && bits(&a.coeffs, &b.coeffs)
+        && bits(&a.winding, &b.winding)
 }
 
 /// Whether an orbit of type `pattern` with `key` is new among `have`, and its type
