@@ -79,7 +79,11 @@ mod tests {
                     let zb = vec![0.05; eta.len()];
                     let p = Planar::new(0.2, zeta, &zb, 50.0, om, eta).unwrap();
                     let want = p.balance().map(|e| e.verdict);
-                    assert_eq!(p.balance_verdict(), want, "eta {eta:?} zeta {zeta} Omega {om}");
+                    assert_eq!(
+                        p.balance_verdict(),
+                        want,
+                        "eta {eta:?} zeta {zeta} Omega {om}"
+                    );
                     seen[match want {
                         None => 0,
                         Some(Verdict::Stable) => 1,
