@@ -437,18 +437,8 @@ pub fn floquet<D: Dynamics + ?Sized>(
 /// The first pair of balls `(i, j)` whose series are the same motion (coefficients equal
 /// to 1e-9 relative, same winding): merged balls.
 pub fn merged_pair(sol: &HbSolution, first_ball: usize) -> Option<(usize, usize)> {
-    let d = sol.ndof();
-    let scale = sol.coeffs.iter().fold(1.0f64, |m, c| m.max(c.abs()));
-    (first_ball..d)
-        .flat_map(|i| (i + 1..d).map(move |j| (i, j)))
-        .find(|&(i, j)| {
-            sol.winding[i] == sol.winding[j]
-                && sol
-                    .coord(i)
-                    .iter()
-                    .zip(sol.coord(j))
-                    .all(|(a, b)| (a - b).abs() <= 1e-9 * scale)
-        })
+    // The first group's two smallest members are that pair: no ball is taken before it.
+    merged_groups(sol, first_ball).first().map(|g| (g[0], g[1]))
 }
 
 /// Merged balls' separation check on a monodromy matrix `phi` (row-major `2d x 2d`).
