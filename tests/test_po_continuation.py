@@ -274,9 +274,13 @@ def rr_zeta_b_01_down() -> ballbal.continuation.Branch:
 
 def _simulated_period(b: ballbal.Balancer, y0: np.ndarray, t_end: float) -> float:
     """Period of the attracting R-R orbit from a simulation (the core's RK45, no harmonic
-    balance): the time between the first ball's last two whole turns."""
+    balance): the time between the first ball's last two whole turns, counted from its
+    start (near the infinite-period end a turn takes most of ``t_end``; counting turns of
+    the absolute angle would make whether the start is one depend on the sign of a
+    round-off in ``b1(0) = 0``)."""
     t = np.arange(0.0, t_end, 0.05)
     b1 = ballbal.simulate(b, y0, t)["b1"].to_numpy()
+    b1 = b1 - b1[0]
     k = np.floor(b1 / (2 * np.pi))
     idx = np.nonzero(np.diff(k))[0]
     level = 2 * np.pi * np.maximum(k[idx], k[idx + 1])
