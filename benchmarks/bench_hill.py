@@ -20,10 +20,9 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import time
 from pathlib import Path
 
-import numpy as np
+from bench_periodic import match_error, median_time  # the script's own directory
 
 import ballbal
 
@@ -36,25 +35,6 @@ CALLGRIND = {(3, 2): (146.9e6, 14.1e6), (8, 2): (347.7e6, 14.2e6),
              (3, 3): (234.4e6, 15.1e6), (8, 3): (610.1e6, 15.1e6)}
 
 
-def median_time(f, repeats: int = 15) -> tuple[float, object]:
-    ts = []
-    out = None
-    for _ in range(repeats):
-        t = time.perf_counter()
-        out = f()
-        ts.append(time.perf_counter() - t)
-    return float(np.median(ts)), out
-
-
-def match_error(a, ref) -> float:
-    left = list(a)
-    worst = 0.0
-    for r in sorted(ref, key=lambda z: -abs(z)):
-        k = int(np.argmin([abs(z - r) for z in left]))
-        worst = max(worst, abs(left.pop(k) - r) / max(1.0, abs(r)))
-    return worst
-
-
 def case(name: str, b: ballbal.Balancer, seed: ballbal.PeriodicSolution, N: int) -> None:
     sol = ballbal.periodic(b, "R-R", N=N, guess=seed, hill=False)
     ref = ballbal.periodic(b, "R-R", N=N, guess=sol, rtol=1e-12, atol=1e-14,
@@ -63,10 +43,10 @@ def case(name: str, b: ballbal.Balancer, seed: ballbal.PeriodicSolution, N: int)
     def run(**kw):
         return ballbal.periodic(b, "R-R", N=N, guess=sol, **kw)
 
-    t_hb, _ = median_time(lambda: run(floquet=False, hill=False))
-    t_rk, _ = median_time(lambda: run(rtol=1e-6, atol=1e-9, hill=False))
-    t_mg, _ = median_time(lambda: run(rtol=1e-6, hill=False, floquet_method="magnus"))
-    t_hill, h = median_time(lambda: run(floquet=False, hill=True))
+    t_hb, _ = median_time(lambda: run(floquet=False, hill=False), 15)
+    t_rk, _ = median_time(lambda: run(rtol=1e-6, atol=1e-9, hill=False), 15)
+    t_mg, _ = median_time(lambda: run(rtol=1e-6, hill=False, floquet_method="magnus"), 15)
+    t_hill, h = median_time(lambda: run(floquet=False, hill=True), 15)
     rk, mg, hl = t_rk - t_hb, t_mg - t_hb, t_hill - t_hb
     err = match_error(h.hill_multipliers, ref.multipliers)
     print(f"{name:>9} N = {N}: Hill {hl * 1e3:6.2f} ms (error {err:.1e}, "

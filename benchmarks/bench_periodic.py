@@ -33,7 +33,7 @@ import numpy as np
 import ballbal
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
-from shooting import monodromy_multipliers, shoot  # noqa: E402
+from shooting import match_error, monodromy_multipliers, shoot  # noqa: E402
 
 
 def median_time(f, repeats=30):
@@ -43,15 +43,6 @@ def median_time(f, repeats=30):
         out = f()
         ts.append(time.perf_counter() - t)
     return float(np.median(ts)), out
-
-
-def match_error(a, ref) -> float:
-    left = list(a)
-    worst = 0.0
-    for r in sorted(ref, key=lambda z: -abs(z)):
-        k = int(np.argmin([abs(z - r) for z in left]))
-        worst = max(worst, abs(left.pop(k) - r) / max(1.0, abs(r)))
-    return worst
 
 
 STAGES = ("residual (AFT)", "model K,C,M", "Jacobian projection", "LU")

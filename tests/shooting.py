@@ -39,6 +39,17 @@ def shoot(b, y_guess, T_guess, winding, phase_index):
     return y0, z[-1]
 
 
+def match_error(a, ref) -> float:
+    """Largest distance between paired multipliers (each reference one with the nearest
+    unused one), relative to the larger of 1 and the reference's modulus."""
+    left = list(a)
+    worst = 0.0
+    for r in sorted(ref, key=lambda z: -abs(z)):
+        k = int(np.argmin([abs(z - r) for z in left]))
+        worst = max(worst, abs(left.pop(k) - r) / max(1.0, abs(r)))
+    return worst
+
+
 def monodromy_multipliers(b, y0, T, h=1e-6):
     n2 = len(y0)
     M = np.empty((n2, n2))

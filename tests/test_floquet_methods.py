@@ -13,23 +13,12 @@ import ballbal
 from ballbal.exceptions import ParameterError, ParameterTypeError
 
 from reference import rhs
-from shooting import flow
+from shooting import flow, match_error
 
 THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 # (Omega, eta, pattern): the standard R-R case (balls merged), the hard R-R case
 # (period ~106), an unstable O-O and a stable R-O orbit of the zeta_b = 0.05 map.
 POINTS = [(1.2, 1.0, "R-R"), (1.0, 0.7, "R-R"), (1.1, 0.4, "O-O"), (1.3, 0.7, "R-O")]
-
-
-def match_error(a: np.ndarray, ref: np.ndarray) -> float:
-    """Largest distance between paired multipliers (each reference one with the nearest
-    unused one), relative to the larger of 1 and the reference's modulus."""
-    left = list(a)
-    worst = 0.0
-    for r in sorted(ref, key=lambda z: -abs(z)):
-        k = int(np.argmin([abs(z - r) for z in left]))
-        worst = max(worst, abs(left.pop(k) - r) / max(1.0, abs(r)))
-    return worst
 
 
 @pytest.fixture(scope="module")
