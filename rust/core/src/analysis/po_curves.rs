@@ -2117,22 +2117,16 @@ mod tests {
         o.arc.ds_max = 0.02;
         let start = periodic(&p, &[true, true], None, &o.periodic);
         let b = periodic_branch(&p, "eta", &start.sol, &o).unwrap();
-        let e = b
-            .events
-            .iter()
-            .find(|e| e.kind == PoEventKind::PeriodDoubling)
-            .expect("a PD event");
-        let base = p.with_param("eta", e.p).unwrap();
         let mut co = curve_opts(6, (0.3, 1.5), (1.15, 1.25), 6);
         (co.arc.ds, co.arc.ds_max) = (0.05, 0.2);
-        let c = periodic_curve(
-            &base,
+        let c = curve_at_event(
+            &p,
+            &b,
+            PoEventKind::PeriodDoubling,
             ["eta", "Omega"],
             PoCurveKind::PeriodDoubling,
-            &e.point.result.sol,
             &co,
-        )
-        .unwrap();
+        );
         assert!(c.points.len() >= 8, "{:?}", c.stop);
         let (lo, hi) = c
             .points
@@ -2184,28 +2178,41 @@ mod tests {
         (sc, b)
     }
 
+    /// The curve of `kind` in `names` through the first `event` of `b`, a branch of `p`
+    /// in `names[0]`.
+    fn curve_at_event<D: Parametric>(
+        p: &D,
+        b: &crate::analysis::po_branch::PoBranch,
+        event: PoEventKind,
+        names: [&str; 2],
+        kind: PoCurveKind,
+        co: &PoCurveOptions,
+    ) -> PoCurve {
+        let e = b
+            .events
+            .iter()
+            .find(|e| e.kind == event)
+            .unwrap_or_else(|| panic!("a {event:?} event"));
+        let base = p.with_param(names[0], e.p).unwrap();
+        periodic_curve(&base, names, kind, &e.point.result.sol, co).unwrap()
+    }
+
     /// Along the NS curve in (zeta, rho), the monodromy of every point's series (the
     /// variational equations integrated by RK45, not the Hill matrix the curve is defined
     /// by) has a complex pair on the unit circle at the curve's angle.
     #[test]
     fn neimark_sacker_curve_points_have_a_monodromy_pair_on_the_unit_circle() {
         let (sc, b) = whirl_branch(5, 0.12);
-        let e = b
-            .events
-            .iter()
-            .find(|e| e.kind == PoEventKind::NeimarkSacker)
-            .expect("an NS event");
-        let base = sc.with_param("zeta", e.p).unwrap();
         let mut co = curve_opts(5, (0.05, 0.3), (0.48, 0.52), 3);
         (co.arc.ds, co.arc.ds_max) = (0.01, 0.02);
-        let c = periodic_curve(
-            &base,
+        let c = curve_at_event(
+            &sc,
+            &b,
+            PoEventKind::NeimarkSacker,
             ["zeta", "rho"],
             PoCurveKind::NeimarkSacker,
-            &e.point.result.sol,
             &co,
-        )
-        .unwrap();
+        );
         assert!(c.points.len() >= 4, "{:?}", c.stop);
         for pt in &c.points {
             let theta = pt.theta.expect("an NS curve's angle");
@@ -2248,22 +2255,16 @@ mod tests {
                 e.point.omega()
             );
         }
-        let e = b
-            .events
-            .iter()
-            .find(|e| e.kind == PoEventKind::NeimarkSacker)
-            .expect("an NS event");
-        let base = sc.with_param("zeta", e.p).unwrap();
         let mut co = curve_opts(n, (0.0, 1.0), (0.3, 1.0), 40);
         (co.arc.ds, co.arc.ds_max) = (0.01, 0.05);
-        let c = periodic_curve(
-            &base,
+        let c = curve_at_event(
+            &sc,
+            &b,
+            PoEventKind::NeimarkSacker,
             ["zeta", "rho"],
             PoCurveKind::NeimarkSacker,
-            &e.point.result.sol,
             &co,
-        )
-        .unwrap();
+        );
         println!("curve {:?} {:?}", c.stop, t.elapsed());
         for pt in &c.points {
             let m = &pt.result.floquet.as_ref().expect("multipliers").multipliers;
