@@ -1278,12 +1278,9 @@ mod tests {
         }
     }
 
-    /// Cost and error of RK45 and Magnus monodromies at thesis points (run with
-    /// `--ignored --nocapture`): the calibration behind the Magnus defaults.
-    #[test]
-    #[ignore]
-    fn magnus_study() {
-        use std::time::Instant;
+    /// The studies' orbits: five thesis points (zeta = zeta_b = 0.05) at N = 3 and 8,
+    /// each with its multipliers from an rtol 1e-12 RK45 monodromy as the reference.
+    fn study_orbits(mut f: impl FnMut(&str, usize, &Planar, &HbSolution, &Floquet)) {
         let cases: [(&str, f64, f64, [bool; 2]); 5] = [
             ("std R-R", 1.2, 1.0, [true, true]),
             ("hard R-R", 1.0, 0.7, [true, true]),
@@ -1314,75 +1311,86 @@ mod tests {
                     ..Default::default()
                 };
                 let reference = floquet(&p, &sol, &tight).unwrap();
-                let time = |f: &dyn Fn() -> Floquet| {
-                    let t = Instant::now();
-                    let mut out = f();
-                    for _ in 0..19 {
-                        out = f();
-                    }
-                    (t.elapsed().as_secs_f64() / 20.0 * 1e6, out)
-                };
-                println!(
-                    "{name} N={n_harm} T={:.1} mults {:?}",
-                    sol.period(),
-                    reference
-                        .multipliers
-                        .iter()
-                        .map(|z| z.0.hypot(z.1))
-                        .collect::<Vec<_>>()
-                );
-                for rtol in [1e-5, 1e-6, 1e-7, 1e-8] {
-                    let o = FloquetOptions {
-                        rtol,
-                        atol: rtol * 1e-3,
-                        ..Default::default()
-                    };
-                    let (us, f) = time(&|| floquet(&p, &sol, &o).unwrap());
-                    let e = multiplier_distance(&f.multipliers, &reference.multipliers);
-                    println!(
-                        "  rk45   rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e}",
-                        f.steps
-                    );
-                }
-                let n2 = 8;
-                let rho = state_norm(&mut orbit_state_matrix(&p, &sol), n2, sol.period());
-                println!("  ||A||_1 {rho:.2}");
-                for k in [8, 16, 32, 64, 128, 256] {
-                    let t = Instant::now();
-                    let mut phi = vec![];
-                    for _ in 0..20 {
-                        phi = crate::numerics::magnus::monodromy_fixed(
-                            orbit_state_matrix(&p, &sol),
-                            n2,
-                            sol.period(),
-                            k,
-                        );
-                    }
-                    let us = t.elapsed().as_secs_f64() / 20.0 * 1e6;
-                    let ev = eigenvalues(&phi, n2).unwrap();
-                    let e = multiplier_distance(&ev, &reference.multipliers);
-                    let hr = sol.period() / k as f64 * rho;
-                    println!(
-                        "  magnus K {k:4}: {us:8.0} us err {e:.1e} h||A|| {hr:.2} C(1e-6) {:.1}",
-                        hr / e.powf(1.0 / 6.0)
-                    );
-                }
-                for rtol in [1e-5, 1e-6, 1e-7, 1e-8] {
-                    let o = FloquetOptions {
-                        method: FloquetMethod::Magnus,
-                        rtol,
-                        ..Default::default()
-                    };
-                    let (us, f) = time(&|| floquet(&p, &sol, &o).unwrap());
-                    let e = multiplier_distance(&f.multipliers, &reference.multipliers);
-                    println!(
-                        "  magnus rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e} est {:.1e}",
-                        f.steps,
-                        f.method_error.unwrap()
-                    );
-                }
+                f(name, n_harm, &p, &sol, &reference);
             }
         }
+    }
+
+    /// Cost and error of RK45 and Magnus monodromies at thesis points (run with
+    /// `--ignored --nocapture`): the calibration behind the Magnus defaults.
+    #[test]
+    #[ignore]
+    fn magnus_study() {
+        use std::time::Instant;
+        study_orbits(|name, n_harm, p, sol, reference| {
+            let time = |f: &dyn Fn() -> Floquet| {
+                let t = Instant::now();
+                let mut out = f();
+                for _ in 0..19 {
+                    out = f();
+                }
+                (t.elapsed().as_secs_f64() / 20.0 * 1e6, out)
+            };
+            println!(
+                "{name} N={n_harm} T={:.1} mults {:?}",
+                sol.period(),
+                reference
+                    .multipliers
+                    .iter()
+                    .map(|z| z.0.hypot(z.1))
+                    .collect::<Vec<_>>()
+            );
+            for rtol in [1e-5, 1e-6, 1e-7, 1e-8] {
+                let o = FloquetOptions {
+                    rtol,
+                    atol: rtol * 1e-3,
+                    ..Default::default()
+                };
+                let (us, f) = time(&|| floquet(p, sol, &o).unwrap());
+                let e = multiplier_distance(&f.multipliers, &reference.multipliers);
+                println!(
+                    "  rk45   rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e}",
+                    f.steps
+                );
+            }
+            let n2 = 8;
+            let rho = state_norm(&mut orbit_state_matrix(p, sol), n2, sol.period());
+            println!("  ||A||_1 {rho:.2}");
+            for k in [8, 16, 32, 64, 128, 256] {
+                let t = Instant::now();
+                let mut phi = vec![];
+                for _ in 0..20 {
+                    phi = crate::numerics::magnus::monodromy_fixed(
+                        orbit_state_matrix(p, sol),
+                        n2,
+                        sol.period(),
+                        k,
+                    );
+                }
+                let us = t.elapsed().as_secs_f64() / 20.0 * 1e6;
+                let ev = eigenvalues(&phi, n2).unwrap();
+                let e = multiplier_distance(&ev, &reference.multipliers);
+                let hr = sol.period() / k as f64 * rho;
+                println!(
+                    "  magnus K {k:4}: {us:8.0} us err {e:.1e} h||A|| {hr:.2} C(1e-6) {:.1}",
+                    hr / e.powf(1.0 / 6.0)
+                );
+            }
+            for rtol in [1e-5, 1e-6, 1e-7, 1e-8] {
+                let o = FloquetOptions {
+                    method: FloquetMethod::Magnus,
+                    rtol,
+                    ..Default::default()
+                };
+                let (us, f) = time(&|| floquet(p, sol, &o).unwrap());
+                let e = multiplier_distance(&f.multipliers, &reference.multipliers);
+                println!(
+                    "  magnus rtol {rtol:e}: {us:8.0} us steps {:5} err {e:.1e} est {:.1e}",
+                    f.steps,
+                    f.method_error.unwrap()
+                );
+            }
+        });
     }
 
     /// Hill's error estimate against the truncation error measured against a tight RK45
@@ -1391,62 +1399,32 @@ mod tests {
     #[test]
     #[ignore]
     fn hill_study() {
-        let cases: [(&str, f64, f64, [bool; 2]); 5] = [
-            ("std R-R", 1.2, 1.0, [true, true]),
-            ("hard R-R", 1.0, 0.7, [true, true]),
-            ("O-O", 1.1, 0.4, [false, false]),
-            ("R-O stable", 1.3, 0.7, [true, false]),
-            ("R-O unstable", 1.1, 0.6, [true, false]),
-        ];
-        for n_harm in [3, 8] {
-            for (name, om, eta, pat) in cases {
-                let p = Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap();
-                let opts = PeriodicOptions {
-                    hb: HbOptions {
-                        n_harm,
-                        ..Default::default()
-                    },
-                    ..Default::default()
-                };
-                let r = periodic(&p, &pat, None, &opts);
-                if r.sol.status != crate::hb::Status::Converged {
-                    println!("{name} N={n_harm}: {:?}", r.sol.status);
-                    continue;
-                }
-                let sol = r.sol;
-                let tight = FloquetOptions {
-                    rtol: 1e-12,
-                    atol: 1e-14,
-                    max_steps: 10_000_000,
-                    ..Default::default()
-                };
-                let reference = floquet(&p, &sol, &tight).unwrap();
-                let old = hill_multipliers_dense(&p, &sol, (n_harm + 4).clamp(8, 24)).unwrap();
-                println!(
-                    "{name} N={n_harm} T={:.1} omega {:.3} old err {:.1e} mods {:?}",
-                    sol.period(),
-                    sol.omega,
-                    multiplier_distance(&old, &reference.multipliers),
-                    reference
-                        .multipliers
-                        .iter()
-                        .map(|z| z.0.hypot(z.1))
-                        .collect::<Vec<_>>()
-                );
-                for h in 2..=16 {
-                    let hl = hill_at(&p, &sol, h).unwrap();
-                    let e = multiplier_distance(&hl.multipliers, &reference.multipliers);
-                    println!("  H {h:2}: est {:9.1e} err {e:9.1e}", hl.error);
-                }
-                let a = hill(&p, &sol, HILL_TOL, HILL_MAX).unwrap();
-                println!(
-                    "  adaptive: H {} est {:.1e} err {:.1e}",
-                    a.n_hill,
-                    a.error,
-                    multiplier_distance(&a.multipliers, &reference.multipliers)
-                );
+        study_orbits(|name, n_harm, p, sol, reference| {
+            let old = hill_multipliers_dense(p, sol, (n_harm + 4).clamp(8, 24)).unwrap();
+            println!(
+                "{name} N={n_harm} T={:.1} omega {:.3} old err {:.1e} mods {:?}",
+                sol.period(),
+                sol.omega,
+                multiplier_distance(&old, &reference.multipliers),
+                reference
+                    .multipliers
+                    .iter()
+                    .map(|z| z.0.hypot(z.1))
+                    .collect::<Vec<_>>()
+            );
+            for h in 2..=16 {
+                let hl = hill_at(p, sol, h).unwrap();
+                let e = multiplier_distance(&hl.multipliers, &reference.multipliers);
+                println!("  H {h:2}: est {:9.1e} err {e:9.1e}", hl.error);
             }
-        }
+            let a = hill(p, sol, HILL_TOL, HILL_MAX).unwrap();
+            println!(
+                "  adaptive: H {} est {:.1e} err {:.1e}",
+                a.n_hill,
+                a.error,
+                multiplier_distance(&a.multipliers, &reference.multipliers)
+            );
+        });
     }
 
     /// Instruction counts under callgrind: `valgrind --tool=callgrind <test binary>
