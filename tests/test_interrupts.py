@@ -22,6 +22,11 @@ CALLS = {
     # N = 256 takes under a second: O-O-O (several starts, each a harmonic-balance
     # solve of 2565 unknowns, Newton steps of ~0.4 s at most) keeps it long.
     "periodic_3balls_N256": 'periodic(Balancer(eta=(0.5,) * 3), "O-O-O", N=256)',
+    # Six balls, straight into Newton from an N = 3 guess: each step factorises a
+    # 4105-row Jacobian, which took 1.5-4 s in one faer call that Ctrl-C waited for
+    # (lags of 3.2-4.5 s measured); the blocked LU polls between panels.
+    "periodic_6balls_N256": ('b = Balancer(eta=(0.3,) * 6); periodic(b, "R-R-R-R-R-R", '
+                             'N=256, guess=periodic(b, "R-R-R-R-R-R", N=3))'),
     "simulate_long": "simulate(Balancer(), t_eval=[0.0, 1e6])",
     "equilibria_springs": "equilibria(Scene(Balancer(eta=(0.04,) * 64), springs=0.5))",
     # balanced states in parallel (rayon threads must see the cancellation too)

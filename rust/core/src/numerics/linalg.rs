@@ -29,6 +29,25 @@ pub struct LuSolve {
 /// Returns `None` when the matrix is numerically singular or the result is not finite.
 pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
     let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+    if n >= crate::numerics::blocked_lu::BLOCKED_MIN_ROWS {
+        // Long enough that Ctrl-C must not wait for it; `None` when cancelled (the
+        // caller's result is discarded then).
+        let lu = crate::numerics::blocked_lu::BlockedLu::factor(m)?;
+        let (umax, umin) = lu.pivots().fold((0.0f64, f64::INFINITY), |(hi, lo), v| {
+            (hi.max(v), lo.min(v))
+        });
+        if !(umin > umax * 1e-15) || !umax.is_finite() {
+            return None;
+        }
+        let x = lu.solve(b);
+        if x.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        return Some(LuSolve {
+            x,
+            pivot_ratio: umax / umin,
+        });
+    }
     let lu = m.partial_piv_lu();
     let u = lu.U();
     let (mut umax, mut umin) = (0.0f64, f64::INFINITY);

@@ -2,6 +2,7 @@
 //! dense linear algebra, harmonic balance and Floquet multipliers. Nothing here knows
 //! a concrete model.
 
+pub mod blocked_lu;
 pub mod floquet;
 pub mod hb;
 pub mod linalg;

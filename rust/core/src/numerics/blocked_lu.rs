@@ -1,0 +1,227 @@
+//! A partial-pivoting LU that can be cancelled between column panels.
+//!
+//! faer's own factorisation is one uninterruptible call: at N = 256 with 6 balls (a
+//! 4100-row harmonic-balance Jacobian) it takes over a second, with 10 balls several,
+//! and Ctrl-C waited for it. This right-looking blocked form does the same arithmetic
+//! through faer's kernels (a panel's LU, a unit-lower triangular solve and one matrix
+//! product per panel) and polls [`crate::cancel`] before each panel, so a cancelled
+//! call returns within one panel's work. Only large systems take this path (see
+//! [`BLOCKED_MIN_ROWS`]); below it faer's call is short and its rounding stays as it was.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::lu::partial_pivoting::factor::{lu_in_place, lu_in_place_scratch};
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{
+    solve_unit_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::prelude::{Reborrow, ReborrowMut};
+use faer::{Accum, Mat, Par};
+
+/// Systems with at least this many rows are factorised panel by panel (faer's LU of a
+/// 1024-row matrix takes about 50 ms here, the longest Ctrl-C then waits).
+pub const BLOCKED_MIN_ROWS: usize = 1024;
+
+/// Columns per panel: wide enough that the trailing update is a real matrix product,
+/// narrow enough that one panel of the largest systems takes a small part of a second.
+const PANEL: usize = 128;
+
+/// Columns of the trailing update between two polls.
+const UPDATE_COLS: usize = 512;
+
+/// `P A = L U` of a square matrix, factors stored in place (unit lower `L` below the
+/// diagonal); `perm[i]` is the row of `A` that ends in row `i`.
+pub struct BlockedLu {
+    lu: Mat<f64>,
+    perm: Vec<usize>,
+}
+
+impl BlockedLu {
+    /// Factorises `a` (consumed), or `None` once cancellation was asked for.
+    pub fn factor(mut a: Mat<f64>) -> Option<Self> {
+        let n = a.nrows();
+        assert_eq!(n, a.ncols(), "blocked LU of a non-square matrix");
+        let mut perm: Vec<usize> = (0..n).collect();
+        let mut buf = MemBuffer::new(lu_in_place_scratch::<usize, f64>(
+            n,
+            PANEL,
+            Par::Seq,
+            Default::default(),
+        ));
+        let mut p = vec![0usize; n];
+        let mut p_inv = vec![0usize; n];
+        let mut tmp = vec![0.0; n];
+        let mut moved: Vec<usize> = Vec::with_capacity(n);
+        for k in (0..n).step_by(PANEL) {
+            if crate::cancel::cancelled() {
+                return None;
+            }
+            let b = PANEL.min(n - k);
+            let m = n - k;
+            lu_in_place(
+                a.as_mut().submatrix_mut(k, k, m, b),
+                &mut p[..m],
+                &mut p_inv[..m],
+                Par::Seq,
+                MemStack::new(&mut buf),
+                Default::default(),
+            );
+            // The panel swapped its own rows; the same rows of the other columns and of
+            // the permutation follow.
+            // At most 2b rows moved (b transpositions): only those are copied.
+            moved.clear();
+            moved.extend((0..m).filter(|&i| p[i] != i));
+            for j in (0..k).chain(k + b..n) {
+                let mut col = a.as_mut().col_mut(j);
+                for (t, &i) in moved.iter().enumerate() {
+                    tmp[t] = col[k + p[i]];
+                }
+                for (t, &i) in moved.iter().enumerate() {
+                    col[k + i] = tmp[t];
+                }
+            }
+            let old: Vec<usize> = perm[k..].to_vec();
+            for i in 0..m {
+                perm[k + i] = old[p[i]];
+            }
+            if k + b < n {
+                let (left, right) = a.as_mut().split_at_col_mut(k + b);
+                let (top, bottom) = right.split_at_row_mut(k + b);
+                let mut u12 = top.subrows_mut(k, b);
+                let panel = left.rb().submatrix(k, k, m, b);
+                solve_unit_lower_triangular_in_place(panel.subrows(0, b), u12.rb_mut(), Par::Seq);
+                // The trailing update is most of a panel's work (0.4 s for the first
+                // panel of a 4105-row system on a loaded machine): in column slices,
+                // each preceded by a poll.
+                let mut bottom = bottom;
+                let cols = bottom.ncols();
+                for j in (0..cols).step_by(UPDATE_COLS) {
+                    if crate::cancel::cancelled() {
+                        return None;
+                    }
+                    let w = UPDATE_COLS.min(cols - j);
+                    matmul(
+                        bottom.rb_mut().subcols_mut(j, w),
+                        Accum::Add,
+                        panel.subrows(b, m - b),
+                        u12.rb().subcols(j, w),
+                        -1.0,
+                        Par::Seq,
+                    );
+                }
+            }
+        }
+        Some(BlockedLu { lu: a, perm })
+    }
+
+    /// `|u_ii|` for every `i`.
+    pub fn pivots(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..self.lu.nrows()).map(|i| self.lu[(i, i)].abs())
+    }
+
+    /// Solves `A x = b`.
+    pub fn solve(&self, b: &[f64]) -> Vec<f64> {
+        let n = self.lu.nrows();
+        let mut x = Mat::<f64>::from_fn(n, 1, |i, _| b[self.perm[i]]);
+        solve_unit_lower_triangular_in_place(self.lu.as_ref(), x.as_mut(), Par::Seq);
+        solve_upper_triangular_in_place(self.lu.as_ref(), x.as_mut(), Par::Seq);
+        (0..n).map(|i| x[(i, 0)]).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A reproducible, well-mixed test matrix that needs pivoting: small diagonal.
+    fn matrix(n: usize) -> Mat<f64> {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        Mat::from_fn(n, n, |i, j| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let r = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            if i == j {
+                1e-3 * r
+            } else {
+                r
+            }
+        })
+    }
+
+    #[test]
+    fn blocked_lu_solves_like_a_dense_residual_says() {
+        // Sizes below, at and across panel boundaries.
+        for n in [5, 128, 129, 300, 517] {
+            let a = matrix(n);
+            let x_true: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.1).collect();
+            let b: Vec<f64> = (0..n)
+                .map(|i| (0..n).map(|j| a[(i, j)] * x_true[j]).sum())
+                .collect();
+            let lu = BlockedLu::factor(a.clone()).unwrap();
+            // P A = L U, entry by entry, against the factors' own product.
+            let mut worst = 0.0f64;
+            for i in 0..n {
+                for j in 0..n {
+                    let s: f64 = (0..=i.min(j))
+                        .map(|k| {
+                            let l = if k == i { 1.0 } else { lu.lu[(i, k)] };
+                            l * lu.lu[(k, j)]
+                        })
+                        .sum();
+                    worst = worst.max((s - a[(lu.perm[i], j)]).abs());
+                }
+            }
+            assert!(worst < 1e-12 * n as f64, "n {n}: |PA - LU| {worst:e}");
+            let x = lu.solve(&b);
+            let err = x
+                .iter()
+                .zip(&x_true)
+                .map(|(u, v)| (u - v).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-8, "n {n}: solution error {err:e}");
+            // Partial pivoting: every multiplier at most 1 in magnitude.
+            for j in 0..n {
+                for i in j + 1..n {
+                    assert!(lu.lu[(i, j)].abs() <= 1.0 + 1e-15);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_cancelled_factorisation_stops() {
+        let tok = crate::cancel::Token::new();
+        tok.cancel();
+        let out = crate::cancel::with(Some(tok), || BlockedLu::factor(matrix(300)));
+        assert!(out.is_none());
+    }
+
+    /// Wall time against faer's one-call LU at harmonic-balance sizes:
+    /// `cargo test --release -p ballbal-core blocked_lu_timing -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn blocked_lu_timing() {
+        use faer::prelude::*;
+        // BLU_N / BLU_ONLY (blocked | faer): one size, one method (for callgrind).
+        let sizes: Vec<usize> =
+            std::env::var("BLU_N").map_or(vec![1024, 2048, 4105], |v| vec![v.parse().unwrap()]);
+        let only = std::env::var("BLU_ONLY").unwrap_or_default();
+        for n in sizes {
+            let a = matrix(n);
+            let t = std::time::Instant::now();
+            if only != "faer" {
+                let _ = BlockedLu::factor(a.clone()).unwrap();
+            }
+            let blocked = t.elapsed().as_secs_f64();
+            let t = std::time::Instant::now();
+            if only != "blocked" {
+                let _ = a.partial_piv_lu();
+            }
+            let faer = t.elapsed().as_secs_f64();
+            println!(
+                "n {n}: blocked {blocked:.3} s, faer {faer:.3} s, ratio {:.2}",
+                blocked / faer
+            );
+        }
+    }
+}
