@@ -201,7 +201,6 @@ mod tests {
     #[test]
     #[ignore]
     fn blocked_lu_timing() {
-        use faer::prelude::*;
         // BLU_N / BLU_ONLY (blocked | faer): one size, one method (for callgrind).
         let sizes: Vec<usize> =
             std::env::var("BLU_N").map_or(vec![1024, 2048, 4105], |v| vec![v.parse().unwrap()]);
