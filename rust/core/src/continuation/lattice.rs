@@ -79,7 +79,13 @@ pub trait Waves: Corrector<At = usize> {
     /// target point's task and the pool thread it ran on, and how long the serial work
     /// around it took (its targets, the merge of its results). For a caller that
     /// measures parallel efficiency; nothing by default.
-    fn wave_times(&self, _parallel: Duration, _tasks: &[(Option<usize>, Duration)], _serial: Duration) {}
+    fn wave_times(
+        &self,
+        _parallel: Duration,
+        _tasks: &[(Option<usize>, Duration)],
+        _serial: Duration,
+    ) {
+    }
 }
 
 /// Corrector calls and the time of failed steps, per grid point and class.
