@@ -19,6 +19,7 @@ Hill's the extra of ``hill=True``.
 
     python benchmarks/bench_scan.py                       # everything (minutes)
     python benchmarks/bench_scan.py --quick               # thesis grids, N = 3
+    python benchmarks/bench_scan.py --fine                # fine grid, profiled runs only
     python benchmarks/bench_scan.py --quick --old /work/ref/before_pkg
 
 The hardware's own ceiling for the 1-to-2 speed-up is printed beside it: the same
@@ -27,6 +28,16 @@ synchronisation). Two processes that each slow down by a factor s when they shar
 machine give a throughput ratio 2 / s: a threaded scan cannot beat that, whatever its
 load balance, so the speed-up's shortfall splits into the machine's part (2 - ceiling)
 and the scan's own (ceiling - speed-up).
+
+Parallel efficiency per stage (from ``_native.scan_profile``): on 2 threads, the busy
+time (summed durations of the stage's tasks on both pool threads) over 2 x the stage's
+wall time, beside the one-thread wall and the two-thread bound the stage's steps allow
+(per barrier step max(busy / 2, longest task), from the one-thread run's task times):
+the one-thread total over the summed bounds is the speed-up the scan's structure
+allows, apart from the machine. Seed tasks are not timed one by one (their stage's
+efficiency is its one-thread over two-thread wall, over 2). The waves are also run with
+their target points started in point order (``_native.scan_wave_order(False)``), as
+before longest-first ordering.
 """
 
 from __future__ import annotations
@@ -50,19 +61,18 @@ grid = {k: tuple(v) for k, v in grid.items()}
 b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=zb, delta=50.0)
 out = {}
 ballbal.scan(b, patterns=pats, N=N, threads=1, Omega=(1.0, 1.1, 0.1), eta=(1.0, 1.1, 0.1))
-for threads in (1, 2):
+# repeat 0: only the profiled runs, once each (the fine grid within a minute)
+light = repeat == 0
+repeat = max(repeat, 1)
+for threads in () if light else (1, 2):
     best = float("inf")
     for _ in range(repeat):
         t = time.perf_counter()
         df = ballbal.scan(b, patterns=pats, N=N, threads=threads, **grid)
         best = min(best, time.perf_counter() - t)
     out[threads] = best
-sols = df.filter(df["status"] == "converged")
-out["points"] = df.select(list(grid)).unique().height
-out["sols"] = sols.height
-out["stable"] = int((sols["stability"] == "stable").sum())
 stages = getattr(_native, "scan_stage_seconds", None)
-if stages is not None:
+if stages is not None and not light:
     s0 = stages()
     t = time.perf_counter()
     ballbal.scan(b, patterns=pats, N=N, threads=1, **grid)
@@ -75,6 +85,31 @@ if stages is not None:
     t = time.perf_counter()
     ballbal.scan(b, patterns=pats, N=N, threads=1, hill=True, **grid)
     out["hill"] = time.perf_counter() - t
+prof = getattr(_native, "scan_profile", None)
+if prof is not None:
+    order = _native.scan_wave_order
+    out["profile"] = {}
+    for key, threads, longest in (("1", 1, True), ("2", 2, True), ("2 plain", 2, False)):
+        order(longest)
+        best = None
+        for _ in range(repeat):
+            p0, s0 = prof(), _native.scan_stage_seconds()
+            t = time.perf_counter()
+            df = ballbal.scan(b, patterns=pats, N=N, threads=threads, **grid)
+            total = time.perf_counter() - t
+            p1, s1 = prof(), _native.scan_stage_seconds()
+            run = {"stages": [[y - x for x, y in zip(a, c)] for a, c in zip(p0, p1)],
+                   "table": s1[4] - s0[4], "total": total}
+            if best is None or total < best["total"]:
+                best = run
+        out["profile"][key] = best
+    order(True)
+    if light:
+        out[1], out[2] = out["profile"]["1"]["total"], out["profile"]["2"]["total"]
+sols = df.filter(df["status"] == "converged")
+out["points"] = df.select(list(grid)).unique().height
+out["sols"] = sols.height
+out["stable"] = int((sols["stability"] == "stable").sum())
 print(json.dumps(out))
 """
 
@@ -86,6 +121,7 @@ grid, pats, N, zb, repeat = json.loads(sys.argv[1])
 grid = {k: tuple(v) for k, v in grid.items()}
 b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=zb, delta=50.0)
 ballbal.scan(b, patterns=pats, N=N, threads=1, Omega=(1.0, 1.1, 0.1), eta=(1.0, 1.1, 0.1))
+repeat = max(repeat, 1)
 best = float("inf")
 for _ in range(repeat):
     t = time.perf_counter()
@@ -120,12 +156,68 @@ def measure(grid: dict, pats: tuple[str, ...], N: int, zb: float, repeat: int,
     return json.loads(r.stdout)
 
 
+STAGES = ("balance", "seeds", "waves", "glue", "rows")
+
+
+def efficiency(label: str, N: int, prof: dict) -> list[str]:
+    """Per stage on 2 threads: wall, busy (summed task durations of both threads),
+    parallel efficiency busy / (2 wall); beside it the one-thread wall and the two-thread
+    bound from the one-thread run's tasks (max(busy / 2, longest task) per step, summed),
+    and the same waves with their target points started in point order ("plain")."""
+    one, two, plain = prof["1"], prof["2"], prof["2 plain"]
+    lines = [f"{label}, N {N}: stage       1 thr s  2 thr s  busy 2 s  efficiency  "
+             f"bound 2 s  (waves in point order: 2 thr s, efficiency)"]
+    bound = 0.0
+    busy1 = busy2 = 0.0
+    for i, name in enumerate(STAGES):
+        w1, b1_bound = one["stages"][i][0], one["stages"][i][1]
+        w2 = two["stages"][i][0]
+        busy = sum(two["stages"][i][5:])
+        timed = name != "seeds"
+        if timed:
+            busy1 += sum(one["stages"][i][5:])
+            busy2 += busy
+            bound += b1_bound
+        else:
+            bound += w1 / 2  # untimed tasks: counted as perfectly parallel
+        if w2 <= 0:
+            eff = f"{'-':>10}"
+        elif timed:
+            eff = f"{busy / (2 * w2):>10.2f}"
+        else:
+            eff = f"{w1 / (2 * w2):>9.2f}*"
+        pw = plain["stages"][i][0]
+        pe = sum(plain["stages"][i][5:]) / (2 * pw) if timed and pw > 0 else float("nan")
+        shown = busy if timed else float("nan")
+        lines.append(f"{'':>24}{name:<10} {w1:>8.3f} {w2:>8.3f} {shown:>9.3f} {eff} "
+                     f"{b1_bound if timed else w1 / 2:>10.3f}   ({pw:.3f}, {pe:.2f})")
+    t1, t2 = one["table"], two["table"]
+    # The calling thread builds a chunk's table while the pool computes the next ones:
+    # on one thread it uses the otherwise idle core, on two it takes a share of them.
+    compute1 = sum(one["stages"][i][0] for i in range(len(STAGES)))
+    bound = max(bound, (compute1 + t1) / 2)
+    lines.append(f"{'':>24}{'table':<10} {t1:>8.3f} {t2:>8.3f}   (serial, on the calling thread)")
+    T1, T2 = one["total"], two["total"]
+    slow = busy2 / busy1 if busy1 > 0 else float("nan")
+    lines.append(f"{'':>24}total      {T1:>8.3f} {T2:>8.3f}  speed-up {T1 / T2:.2f} "
+                 f"(waves in point order {T1 / plain['total']:.2f}); allowed by the scan's "
+                 f"steps {T1 / bound:.2f} (seeds counted perfectly parallel, the table "
+                 f"sharing the cores); timed tasks take {slow:.2f} x as long on 2 threads as "
+                 f"on 1 (the machine's share); whole run: timed busy / (2 x wall) "
+                 f"{busy2 / (2 * T2):.2f} (blocks that run at once make per-stage walls "
+                 f"overlap: then only this one counts)")
+    return lines
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
     old = sys.argv[sys.argv.index("--old") + 1] if "--old" in sys.argv else None
-    rows = [("thesis, zeta_b 0.05", THESIS, ALL, 3, 0.05, 3),
-            ("thesis, zeta_b 0.1", THESIS, ALL, 3, 0.1, 3)]
-    if not quick:
+    rows: list[tuple[str, dict, tuple[str, ...], int, float, int]] = [
+        ("thesis, zeta_b 0.05", THESIS, ALL, 3, 0.05, 3),
+        ("thesis, zeta_b 0.1", THESIS, ALL, 3, 0.1, 3)]
+    if "--fine" in sys.argv:
+        rows = [("fine 101x111, zb 0.05", FINE, ("R-R",), 3, 0.05, 0)]
+    elif not quick:
         rows += [("thesis, zeta_b 0.05", THESIS, ALL, 8, 0.05, 3),
                  ("thesis, zeta_b 0.1", THESIS, ALL, 8, 0.1, 3),
                  ("fine 101x111, zb 0.05", FINE, ("R-R",), 3, 0.05, 1)]
@@ -134,6 +226,7 @@ def main() -> None:
           + (f" {'old 1 thr':>9} {'old 2 thr':>9} {'old s-up':>8} {'new/old 1':>9}"
              if old else ""))
     stage_lines = []
+    eff_lines: list[str] = []
     for label, grid, pats, N, zb, repeat in rows:
         t0 = time.perf_counter()
         new = measure(grid, pats, N, zb, repeat)
@@ -155,7 +248,13 @@ def main() -> None:
                 f"{table:.3f} + rest {total - pb - seeds - waves - rows_ - table:.3f}; "
                 f"Floquet ~{total - new['no_floquet']:.3f}, Hill would add "
                 f"{new['hill'] - total:.3f}")
+        if "profile" in new:
+            eff_lines += efficiency(label, N, new["profile"])
         del t0
+    if eff_lines:
+        print("\nparallel efficiency per stage (* seeds: one-thread over two-thread wall / 2,"
+              " the machine's share included):")
+        print("\n".join(eff_lines))
     if stage_lines:
         print("\nper stage, one thread (seconds):")
         print("\n".join(stage_lines))

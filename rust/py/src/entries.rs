@@ -438,6 +438,21 @@ pub fn scan_stage_seconds() -> Vec<f64> {
     v
 }
 
+/// Where this process's scans' threads waited (see the core's `scan::profile`): per
+/// stage (balance, seeds, waves, glue, rows) `[wall, bound, span, steps, tasks, busy of
+/// pool thread 0, 1, ...]`, seconds summed over blocks. A benchmark's measure.
+#[pyfunction]
+pub fn scan_profile() -> Vec<Vec<f64>> {
+    ballbal_core::scan::profile::profile()
+}
+
+/// Whether the continuation waves start their biggest target points first (the
+/// default; the table is the same either way). A benchmark's switch.
+#[pyfunction]
+pub fn scan_wave_order(longest_first: bool) {
+    ballbal_core::continuation::lattice::set_longest_first(longest_first);
+}
+
 /// Work this process's scans did (see the core's `work_counts`): harmonic-balance
 /// solves from seeds and from continuation attempts, certificates, solutions finished
 /// (Floquet analyses), certificates spared. A benchmark's measure.

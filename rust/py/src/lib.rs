@@ -74,6 +74,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::hb_stage_profile, m)?)?;
     m.add_function(wrap_pyfunction!(entries::hb_stage_seconds, m)?)?;
     m.add_function(wrap_pyfunction!(entries::scan_work_counts, m)?)?;
+    m.add_function(wrap_pyfunction!(entries::scan_profile, m)?)?;
+    m.add_function(wrap_pyfunction!(entries::scan_wave_order, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::validate_bearing, m)?)?;
     rotor::register(m)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_force, m)?)?;

@@ -8,14 +8,24 @@ use super::{Corrector, Secant};
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// A grid of parameter points numbered `0..size()`.
 pub trait Lattice: Sync {
     fn size(&self) -> usize;
     /// Neighbours of `p` as (neighbour, the point on the far side of `p` from it),
-    /// in increasing order.
+    /// in increasing order. Symmetric: `q` is a neighbour of `p` when `p` is one of `q`.
     fn neighbours(&self, p: usize) -> Vec<(usize, Option<usize>)>;
+}
+
+/// What a step at a point knows there, for the last guess (see [`Waves::attempt`]).
+pub struct Known<'a, F> {
+    /// The class of the solution continued.
+    pub class: usize,
+    /// Solutions stored at the point.
+    pub have: &'a [F],
+    /// Solutions this wave found there so far.
+    pub new: &'a [F],
 }
 
 /// What the waves need beyond the corrector: stored solutions and how to tell a new
@@ -26,7 +36,12 @@ pub trait Waves: Corrector<At = usize> {
     type Found: Send + Sync;
     /// A description by which the same solution is recognised.
     type Key: Send + Sync;
+    /// A corrected point with what its correction learned about it (e.g. a certificate
+    /// that [`Self::complete`] then need not compute again).
+    type Corrected: Send;
     fn point(f: &Self::Found) -> &Self::Point;
+    /// The point of a correction.
+    fn corrected(c: &Self::Corrected) -> &Self::Point;
     /// Solutions are counted per class (e.g. a rotation pattern).
     fn class(f: &Self::Found) -> usize;
     /// The (grid point, solution) it was continued from.
@@ -37,33 +52,40 @@ pub trait Waves: Corrector<At = usize> {
     /// Whether a solution of `class` with `key` is new among `have` (and its class
     /// still has room there).
     fn admit(&self, have: &[Self::Found], class: usize, key: &Self::Key) -> bool;
-    /// [`Corrector::correct`] for the last guess of a step, with the solutions known at
-    /// `at` (`have`, and `new` ones of this wave): it may refuse a point that
-    /// [`Self::admit`] refuses there, of `class`, without the checks that only decide
-    /// whether a later guess is tried (none comes after the last, and a point not
-    /// admitted gives nothing either way).
-    fn correct_last(
+    /// [`Corrector::correct`] with what it learned. For the last guess of a step,
+    /// `last` tells what is known at `at`: the correction may then refuse a point that
+    /// [`Self::admit`] refuses there without the checks that only decide whether a
+    /// later guess is tried (none comes after the last, and a point not admitted gives
+    /// nothing either way).
+    fn attempt(
         &self,
-        at: &usize,
+        at: usize,
         guess: &Self::Point,
         from: &Self::Point,
-        _class: usize,
-        _have: &[Self::Found],
-        _new: &[Self::Found],
-    ) -> Option<Self::Point> {
-        self.correct(at, guess, from)
-    }
+        last: Option<Known<'_, Self::Found>>,
+    ) -> Option<Self::Corrected>;
     /// Completes a corrected, admitted point into a stored solution (e.g. with its
     /// stability), or refuses it; `started`: when this step began.
     fn complete(
         &self,
         at: usize,
-        point: Self::Point,
+        point: Self::Corrected,
         class: usize,
         key: Self::Key,
         parent: (usize, usize),
         started: Instant,
     ) -> Option<Self::Found>;
+    /// Told after every wave: how long its parallel part took, the duration of every
+    /// target point's task and the pool thread it ran on, and how long the serial work
+    /// around it took (its targets, the merge of its results). For a caller that
+    /// measures parallel efficiency; nothing by default.
+    fn wave_times(
+        &self,
+        _parallel: Duration,
+        _tasks: &[(Option<usize>, Duration)],
+        _serial: Duration,
+    ) {
+    }
 }
 
 /// Corrector calls and the time of failed steps, per grid point and class.
@@ -82,9 +104,18 @@ impl Tally {
     }
 }
 
-/// One target point's share of a wave: its new solutions, and the attempts and time
-/// of failures per class.
-type PointWave<F> = (Vec<F>, Vec<usize>, Vec<f64>);
+/// One target point's share of a wave: its new solutions, the attempts and time of
+/// failures per class, and the task's duration and pool thread.
+type PointWave<F> = (Vec<F>, Vec<usize>, Vec<f64>, (Option<usize>, Duration));
+
+static LONGEST_FIRST: AtomicBool = AtomicBool::new(true);
+
+/// Whether [`waves`] starts a wave's target points with the most sources first (the
+/// default) rather than in point order. The result is the same; a wave whose biggest
+/// task starts last ends with one thread working alone. A benchmark's switch.
+pub fn set_longest_first(on: bool) {
+    LONGEST_FIRST.store(on, Ordering::Relaxed);
+}
 
 /// Runs continuation waves from `frontier` (indices `(point, solution)` into `sols`)
 /// until no new solution appears; new solutions are appended to `sols`. Stops with
@@ -99,86 +130,60 @@ pub fn waves<W: Waves, L: Lattice>(
 ) -> Result<()> {
     let npts = lattice.size();
     let classes = tally.attempts.first().map_or(0, |a| a.len());
+    let mut fresh_at: Vec<Vec<usize>> = vec![vec![]; npts];
     while !frontier.is_empty() {
-        let mut fresh_at: Vec<Vec<usize>> = vec![vec![]; npts];
+        let glue = Instant::now();
         for &(p, s) in &frontier {
             fresh_at[p].push(s);
         }
-        let targets: Vec<usize> = (0..npts)
-            .filter(|&q| {
-                lattice
-                    .neighbours(q)
-                    .iter()
-                    .any(|(p, _)| !fresh_at[*p].is_empty())
-            })
+        // The points with a fresh neighbour: the neighbours of fresh points (the
+        // relation is symmetric), in point order.
+        let mut targets: Vec<usize> = frontier
+            .iter()
+            .flat_map(|&(p, _)| lattice.neighbours(p).into_iter().map(|(q, _)| q))
             .collect();
+        targets.sort_unstable();
+        targets.dedup();
+        // Started with the most sources first, so that a wave's biggest tasks do not
+        // run alone at its end; the results are merged in point order all the same.
+        let sources = |q: usize| -> usize {
+            lattice
+                .neighbours(q)
+                .iter()
+                .map(|(p, _)| fresh_at[*p].len())
+                .sum()
+        };
+        let mut order: Vec<(usize, usize)> = targets.iter().map(|&q| (sources(q), q)).collect();
+        if LONGEST_FIRST.load(Ordering::Relaxed) {
+            order.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+        }
+        let mut serial = glue.elapsed();
         let known: &[Vec<W::Found>] = sols;
-        let results: Vec<PointWave<W::Found>> = targets
+        let fresh: &[Vec<usize>] = &fresh_at;
+        let parallel = Instant::now();
+        let mut done: Vec<(usize, PointWave<W::Found>)> = order
             .par_iter()
-            .map(|&q| {
-                let mut new: Vec<W::Found> = vec![];
-                let mut tries = vec![0usize; classes];
-                let mut secs = vec![0.0f64; classes];
-                for (p, far) in lattice.neighbours(q) {
-                    for &s in &fresh_at[p] {
-                        if cancel.load(Ordering::Relaxed) {
-                            return (new, tries, secs);
-                        }
-                        let src = &known[p][s];
-                        // Continuing back to where a solution came from, or again from a
-                        // solution already continued here, gives nothing new.
-                        if W::parent(src).is_some_and(|(pp, _)| pp == q)
-                            || known[q].iter().any(|f| W::parent(f) == Some((p, s)))
-                        {
-                            continue;
-                        }
-                        let k = W::class(src);
-                        let t = Instant::now();
-                        let previous = match (far, W::parent(src)) {
-                            (Some(f), Some((pp, ps))) if pp == f => Some(W::point(&known[pp][ps])),
-                            _ => None,
-                        };
-                        // `natural_step`'s guesses (the secant, then the source itself),
-                        // the last one told what is known here.
-                        let current = W::point(src);
-                        let secant = previous.map(|b| current.secant(b));
-                        let mut point = None;
-                        for (i, guess) in secant.iter().chain(Some(current)).enumerate() {
-                            tries[k] += 1;
-                            point = if i == usize::from(secant.is_some()) {
-                                w.correct_last(&q, guess, current, k, &known[q], &new)
-                            } else {
-                                w.correct(&q, guess, current)
-                            };
-                            if point.is_some() {
-                                break;
-                            }
-                        }
-                        let Some(sol) = point else {
-                            secs[k] += t.elapsed().as_secs_f64();
-                            continue;
-                        };
-                        let key = w.key(&sol);
-                        // Before completing (e.g. a Floquet analysis), which a known
-                        // solution does not need.
-                        if !w.admit(&known[q], k, &key) || !w.admit(&new, k, &key) {
-                            secs[k] += t.elapsed().as_secs_f64();
-                            continue;
-                        }
-                        match w.complete(q, sol, k, key, (p, s), t) {
-                            Some(f) => new.push(f),
-                            None => secs[k] += t.elapsed().as_secs_f64(),
-                        }
-                    }
-                }
-                (new, tries, secs)
+            .with_max_len(1)
+            .map(|&(_, q)| {
+                let t0 = Instant::now();
+                let (new, tries, secs) = wave_at(w, lattice, known, fresh, q, classes, cancel);
+                let task = (rayon::current_thread_index(), t0.elapsed());
+                (q, (new, tries, secs, task))
             })
             .collect();
+        let parallel = parallel.elapsed();
         if cancel.load(Ordering::Relaxed) {
             return Err(Error::Cancelled);
         }
+        let glue = Instant::now();
+        done.sort_unstable_by_key(|d| d.0);
+        let mut tasks = Vec::with_capacity(done.len());
+        for &(p, _) in &frontier {
+            fresh_at[p].clear();
+        }
         frontier.clear();
-        for (&q, (new, tries, secs)) in targets.iter().zip(results) {
+        for (q, (new, tries, secs, task)) in done {
+            tasks.push(task);
             for k in 0..classes {
                 tally.attempts[q][k] += tries[k];
                 tally.fail_secs[q][k] += secs[k];
@@ -190,8 +195,79 @@ pub fn waves<W: Waves, L: Lattice>(
                 }
             }
         }
+        serial += glue.elapsed();
+        w.wave_times(parallel, &tasks, serial);
     }
     Ok(())
+}
+
+/// The steps of a wave into point `q`: from every fresh solution at its neighbours.
+fn wave_at<W: Waves, L: Lattice>(
+    w: &W,
+    lattice: &L,
+    known: &[Vec<W::Found>],
+    fresh_at: &[Vec<usize>],
+    q: usize,
+    classes: usize,
+    cancel: &AtomicBool,
+) -> (Vec<W::Found>, Vec<usize>, Vec<f64>) {
+    let mut new: Vec<W::Found> = vec![];
+    let mut tries = vec![0usize; classes];
+    let mut secs = vec![0.0f64; classes];
+    for (p, far) in lattice.neighbours(q) {
+        for &s in &fresh_at[p] {
+            if cancel.load(Ordering::Relaxed) {
+                return (new, tries, secs);
+            }
+            let src = &known[p][s];
+            // Continuing back to where a solution came from, or again from a
+            // solution already continued here, gives nothing new.
+            if W::parent(src).is_some_and(|(pp, _)| pp == q)
+                || known[q].iter().any(|f| W::parent(f) == Some((p, s)))
+            {
+                continue;
+            }
+            let k = W::class(src);
+            let t = Instant::now();
+            let previous = match (far, W::parent(src)) {
+                (Some(f), Some((pp, ps))) if pp == f => Some(W::point(&known[pp][ps])),
+                _ => None,
+            };
+            // `natural_step`'s guesses (the secant, then the source itself), the last
+            // one told what is known here.
+            let current = W::point(src);
+            let secant = previous.map(|b| current.secant(b));
+            let mut point = None;
+            for (i, guess) in secant.iter().chain(Some(current)).enumerate() {
+                tries[k] += 1;
+                let last = (i == usize::from(secant.is_some())).then_some(Known {
+                    class: k,
+                    have: &known[q],
+                    new: &new,
+                });
+                point = w.attempt(q, guess, current, last);
+                if point.is_some() {
+                    break;
+                }
+            }
+            let Some(sol) = point else {
+                secs[k] += t.elapsed().as_secs_f64();
+                continue;
+            };
+            let key = w.key(W::corrected(&sol));
+            // Before completing (e.g. a Floquet analysis), which a known solution does
+            // not need.
+            if !w.admit(&known[q], k, &key) || !w.admit(&new, k, &key) {
+                secs[k] += t.elapsed().as_secs_f64();
+                continue;
+            }
+            match w.complete(q, sol, k, key, (p, s), t) {
+                Some(f) => new.push(f),
+                None => secs[k] += t.elapsed().as_secs_f64(),
+            }
+        }
+    }
+    (new, tries, secs)
 }
 
 #[cfg(test)]
@@ -245,8 +321,15 @@ mod tests {
     impl Waves for Cubic {
         type Found = F;
         type Key = f64;
+        type Corrected = X;
         fn point(f: &F) -> &X {
             &f.x
+        }
+        fn corrected(c: &X) -> &X {
+            c
+        }
+        fn attempt(&self, at: usize, guess: &X, from: &X, _: Option<Known<'_, F>>) -> Option<X> {
+            self.correct(&at, guess, from)
         }
         fn class(_: &F) -> usize {
             0

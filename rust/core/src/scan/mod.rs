@@ -27,6 +27,7 @@
 //! through [`Family`].
 
 mod grid;
+pub mod profile;
 pub mod rows;
 mod seeding;
 pub mod spec;
@@ -155,6 +156,7 @@ fn scan_chunk<D: Family>(
     range: Range<usize>,
     cancel: &AtomicBool,
 ) -> Result<Vec<ScanRow>> {
+    let glue = std::time::Instant::now();
     let geo = Local::new(spec, &range);
     let npts = geo.size();
     let np = spec.patterns.len();
@@ -168,14 +170,18 @@ fn scan_chunk<D: Family>(
             Ok(q)
         })
         .collect::<Result<_>>()?;
+    profile::serial(profile::GLUE, glue.elapsed());
     let t = std::time::Instant::now();
-    let pb: Vec<(bool, bool)> = params
+    let (pb, tasks): (Vec<(bool, bool)>, Vec<profile::Task>) = params
         .par_iter()
         .map(|p| {
-            let v = p.balance_verdict();
-            (v.is_some(), v == Some(Verdict::Stable))
+            profile::timed(|| {
+                let v = p.balance_verdict();
+                (v.is_some(), v == Some(Verdict::Stable))
+            })
         })
-        .collect();
+        .unzip();
+    profile::step(profile::BALANCE, t.elapsed(), &tasks);
     let check = || {
         if cancel.load(Ordering::Relaxed) {
             Err(Error::Cancelled)
@@ -189,6 +195,7 @@ fn scan_chunk<D: Family>(
     let t = std::time::Instant::now();
     let (tasks, starts) = seeding::seed_tasks(spec, &geo, &range, &pb);
     let (mut sols, frontier) = seeding::run_seeds(spec, &params, &tasks, &starts, cancel);
+    profile::step(profile::SEEDS, t.elapsed(), &[]);
     add_stage(1, t);
     check()?;
 
@@ -202,6 +209,7 @@ fn scan_chunk<D: Family>(
     add_stage(2, t);
     let t = std::time::Instant::now();
     let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &pb);
+    profile::serial(profile::ROWS, t.elapsed());
     add_stage(3, t);
     Ok(rows)
 }

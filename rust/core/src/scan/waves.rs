@@ -2,11 +2,12 @@
 //! corrector, and the scan's rules for what a new solution is (same rotation pattern,
 //! resolved, certified; not an orbit already known there).
 
-use super::{count, work, Family, Found, Origin, ScanSpec};
+use super::{count, profile, work, Family, Found, Origin, ScanSpec};
+use crate::continuation::lattice::Known;
 use crate::continuation::{Corrector, Waves};
 use crate::hb::{solve, HbSolution, Status};
 use crate::periodic::finish_certified;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Most solutions of one type kept at one point: a guard against a duplicate test
 /// that a pathological orbit family might slip through.
@@ -19,23 +20,31 @@ pub(super) struct BlockWaves<'s, 'a, D: Family> {
     pub params: &'s [D],
 }
 
+/// An accepted series and the closure of its orbit-closure certificate, when the
+/// certificate was computed (without N = "auto"), which `finish` then need not
+/// integrate again.
+pub(super) struct Certified {
+    sol: HbSolution,
+    closure: Option<f64>,
+}
+
 impl<D: Family> Corrector for BlockWaves<'_, '_, D> {
     type At = usize;
     type Point = HbSolution;
     fn correct(&self, at: &usize, guess: &HbSolution, from: &HbSolution) -> Option<HbSolution> {
-        let model = &self.params[*at];
-        count(work::WAVE_SOLVE);
-        CERTIFIED.set(None);
-        let r = solve(model, guess, &self.spec.opts.hb);
-        accept(model, &r, from, self.spec).then_some(r)
+        self.attempt(*at, guess, from, None).map(|c| c.sol)
     }
 }
 
 impl<D: Family> Waves for BlockWaves<'_, '_, D> {
     type Found = Found;
     type Key = Vec<f64>;
+    type Corrected = Certified;
     fn point(f: &Found) -> &HbSolution {
         &f.res.sol
+    }
+    fn corrected(c: &Certified) -> &HbSolution {
+        &c.sol
     }
     fn class(f: &Found) -> usize {
         f.pattern
@@ -53,35 +62,37 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
     fn admit(&self, have: &[Found], class: usize, key: &Vec<f64>) -> bool {
         admit(have, class, key)
     }
-    fn correct_last(
+    fn attempt(
         &self,
-        at: &usize,
+        at: usize,
         guess: &HbSolution,
         from: &HbSolution,
-        class: usize,
-        have: &[Found],
-        new: &[Found],
-    ) -> Option<HbSolution> {
-        // Most attempts reach an orbit already found at their point: its certificate
-        // would only decide whether a later guess is tried, and there is none.
-        let model = &self.params[*at];
+        last: Option<Known<'_, Found>>,
+    ) -> Option<Certified> {
+        let model = &self.params[at];
         count(work::WAVE_SOLVE);
-        CERTIFIED.set(None);
-        let r = solve(model, guess, &self.spec.opts.hb);
+        let mut r = solve(model, guess, &self.spec.opts.hb);
         if !resolved(model, &r, from, self.spec) {
             return None;
         }
-        let key = self.key(&r);
-        if !admit(have, class, &key) || !admit(new, class, &key) {
-            count(work::SPARED);
-            return None;
+        // Most last attempts reach an orbit already found at their point: its
+        // certificate would only decide whether a later guess is tried, and there is
+        // none.
+        if let Some(k) = last {
+            let key = self.key(&r);
+            if !admit(k.have, k.class, &key) || !admit(k.new, k.class, &key) {
+                count(work::SPARED);
+                return None;
+            }
         }
-        certified(model, &r, self.spec).then_some(r)
+        // In place: a refused series is dropped.
+        let closure = certified(model, &mut r, self.spec)?;
+        Some(Certified { sol: r, closure })
     }
     fn complete(
         &self,
         at: usize,
-        point: HbSolution,
+        point: Certified,
         class: usize,
         key: Vec<f64>,
         parent: (usize, usize),
@@ -89,11 +100,7 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
     ) -> Option<Found> {
         count(work::FINISH);
         let model = &self.params[at];
-        let passed = CERTIFIED
-            .take()
-            .filter(|(m, c, _)| *m == model as *const D as usize && same_series(c, &point))
-            .map(|(_, _, closure)| closure);
-        let res = finish_certified(model, point, &self.spec.opts, passed);
+        let res = finish_certified(model, point.sol, &self.spec.opts, point.closure);
         // Refined with N = "auto" and certified: a series that fails is neither
         // reported nor continued, like a failed solve.
         if res.sol.status != Status::Converged {
@@ -108,6 +115,10 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
             seconds: started.elapsed().as_secs_f64(),
         })
     }
+    fn wave_times(&self, parallel: Duration, tasks: &[profile::Task], serial: Duration) {
+        profile::step(profile::WAVES, parallel, tasks);
+        profile::serial(profile::GLUE, serial);
+    }
 }
 
 /// A converged, resolved solution of the same rotation pattern as its guess, whose
@@ -120,7 +131,7 @@ pub(super) fn accept<D: Family>(
     guess: &HbSolution,
     spec: &ScanSpec<'_, D>,
 ) -> bool {
-    resolved(model, s, guess, spec) && certified(model, s, spec)
+    resolved(model, s, guess, spec) && certified(model, &mut s.clone(), spec).is_some()
 }
 
 /// [`accept`]'s first part: converged, of the guess's pattern, resolved.
@@ -136,41 +147,19 @@ fn resolved<D: Family>(
 }
 
 /// [`accept`]'s second part: the orbit-closure certificate (with N = "auto" only after
-/// refinement, in `finish`).
-fn certified<D: Family>(model: &D, s: &HbSolution, spec: &ScanSpec<'_, D>) -> bool {
-    spec.opts.auto.is_some() || {
-        count(work::CERTIFY);
-        let mut c = s.clone();
-        let closure = crate::periodic::certify(model, &mut c, &spec.opts);
-        let ok = c.status == Status::Converged;
-        if let (true, Some(closure)) = (ok, closure) {
-            CERTIFIED.set(Some((model as *const D as usize, c, closure)));
-        }
-        ok
+/// refinement, in `finish`). `None` when refused, else the closure when computed.
+/// The certificate may mark `s` refused.
+fn certified<D: Family>(
+    model: &D,
+    s: &mut HbSolution,
+    spec: &ScanSpec<'_, D>,
+) -> Option<Option<f64>> {
+    if spec.opts.auto.is_some() {
+        return Some(None);
     }
-}
-
-thread_local! {
-    /// The last series this thread's continuation certified (its model's address, the
-    /// series, its closure): the step's `complete` follows on the same thread with that
-    /// very series, whose certificate `finish` then need not integrate again. Cleared
-    /// before every solve, and used only for a bit-identical series of the same model.
-    static CERTIFIED: std::cell::Cell<Option<(usize, HbSolution, f64)>> =
-        const { std::cell::Cell::new(None) };
-}
-
-/// Whether two series are the same bits in everything [`crate::periodic::certify`]
-/// reads.
-fn same_series(a: &HbSolution, b: &HbSolution) -> bool {
-    let bits = |x: &[f64], y: &[f64]| {
-        x.len() == y.len() && x.iter().zip(y).all(|(u, v)| u.to_bits() == v.to_bits())
-    };
-    a.omega.to_bits() == b.omega.to_bits()
-        && a.n_harm == b.n_harm
-        && a.samples == b.samples
-        && a.status == b.status
-        && bits(&a.coeffs, &b.coeffs)
-        && bits(&a.winding, &b.winding)
+    count(work::CERTIFY);
+    let closure = crate::periodic::certify(model, s, &spec.opts);
+    (s.status == Status::Converged).then_some(closure)
 }
 
 /// Whether an orbit of type `pattern` with `key` is new among `have`, and its type
