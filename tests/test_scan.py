@@ -262,3 +262,21 @@ def test_command_line_scan_and_plot(tmp_path):
     r = subprocess.run(exe + ["scan", str(bad), "--Omega", "1:2:0.5", "-o", str(tmp_path / "x")],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 2 and "unknown key(s) zetta" in r.stderr
+
+
+@pytest.mark.parametrize("rows", [
+    [[0.5, -0.25], None, [1.0, 2.0]],          # one length, a row without multipliers
+    [[0.5], None, [1.0, 2.0, 3.0]],            # mixed lengths
+    [None, None],                              # none at all
+    [],                                        # an empty chunk
+])
+def test_multiplier_column_matches_a_list_of_structs(rows: list[list[float] | None]) -> None:
+    from ballbal.scan import MULTIPLIER, _multipliers
+    im = [None if r is None else [-2.0 * v for v in r] for r in rows]
+    expected = pl.Series("multipliers", [
+        None if r is None else [{"re": a, "im": b} for a, b in zip(r, i, strict=True)]
+        for r, i in zip(rows, im, strict=True)
+    ], dtype=MULTIPLIER)
+    got = _multipliers(rows, im)
+    assert got.name == "multipliers" and got.dtype == MULTIPLIER
+    assert got.to_list() == expected.to_list()
