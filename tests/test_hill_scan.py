@@ -8,12 +8,12 @@ from __future__ import annotations
 import numpy as np
 import polars as pl
 import pytest
+from test_floquet_methods import shooting_multipliers
 
 import ballbal
 from ballbal.exceptions import ParameterError
 
 from shooting import flow, match_error
-from test_floquet_methods import shooting_multipliers
 
 THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 
