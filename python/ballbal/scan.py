@@ -169,7 +169,9 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
     then resume; ``guess_atol`` only where it is not ``guess_rtol / 1000`` (what those
     keywords implied). The Floquet method only where it is not RK45: directories written
     before it was an option hold RK45 multipliers; they resume with
-    ``floquet_method="rk45"`` and are refused with any other method."""
+    ``floquet_method="rk45"`` and are refused with any other method. Hill's target only
+    where Hill runs and it is not ``"multipliers"`` (what every earlier Hill verdict
+    used), likewise."""
     h, f, g = o.harmonic_balance, o.floquet, o.guess
     d: dict[str, Any] = {
         "N": h._start, "auto": h._auto_target, "N_max": h.N_max, "hill": f.hill,
@@ -181,6 +183,8 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
     }
     if f.method != "rk45":
         d["floquet_method"] = f.method
+    if f.hill and f.hill_target != "multipliers":
+        d["hill_target"] = f.hill_target
     if g.atol != g.rtol * 1e-3:
         d["guess_atol"] = g.atol
     return d

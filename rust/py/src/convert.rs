@@ -4,7 +4,7 @@
 
 use crate::bearing::BearingArgs;
 use crate::errors::CoreResult;
-use ballbal_core::floquet::{FloquetMethod, FloquetOptions};
+use ballbal_core::floquet::{FloquetMethod, FloquetOptions, HillTarget};
 use ballbal_core::hb::HbOptions;
 use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
@@ -238,6 +238,7 @@ pub struct FloquetArgs {
     max_trivial: f64,
     monodromy: bool,
     hill: bool,
+    hill_target: String,
 }
 
 /// `ballbal.options.GuessSearch`.
@@ -285,6 +286,7 @@ impl PeriodicArgs {
             }),
             hill: f.hill,
             hill_judging: Some((f.margin, f.max_trivial)),
+            hill_target: HillTarget::parse(&f.hill_target).py()?,
             hb: HbOptions {
                 n_harm: h.start,
                 samples: h.samples,

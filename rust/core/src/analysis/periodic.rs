@@ -5,7 +5,8 @@
 
 use crate::error::check_range;
 use crate::floquet::{
-    floquet, hill, judge, Floquet, FloquetOptions, Stability, HILL_MAX, HILL_TOL,
+    floquet, hill, hill_verdict, judge, Floquet, FloquetOptions, HillTarget, Stability, HILL_MAX,
+    HILL_TOL,
 };
 use crate::hb::{defect_closure, solve, HbOptions, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
@@ -176,6 +177,9 @@ pub struct PeriodicOptions {
     /// `(margin, max_trivial)` for Hill's verdict when `floquet` is `None` (with a
     /// monodromy both verdicts use the Floquet options'); `None`: the defaults.
     pub hill_judging: Option<(f64, f64)>,
+    /// What Hill's truncation is enlarged for: the multipliers to [`HILL_TOL`], or (a
+    /// scan's default) only as far as its verdict needs.
+    pub hill_target: HillTarget,
     /// Largest integrated ODE defect ([`defect_closure`]) of a converged series; above
     /// it the result is `NotClosed`.
     pub max_closure: f64,
@@ -193,6 +197,7 @@ impl Default for PeriodicOptions {
             auto: None,
             hill: false,
             hill_judging: None,
+            hill_target: HillTarget::Multipliers,
             max_closure: MAX_CLOSURE,
             max_tail: MAX_TAIL,
         }
@@ -557,10 +562,15 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
         };
         // The truncation's error estimate widens the margin as the trivial multiplier's
         // error does: a truncation that cannot resolve the exponents gives no verdict.
-        hill(p, &sol, HILL_TOL, HILL_MAX).ok().map(|h| {
-            let v = judge(&h.multipliers, margin.max(h.error), max_trivial);
-            (h.multipliers, v.stability)
-        })
+        match opts.hill_target {
+            HillTarget::Multipliers => hill(p, &sol, HILL_TOL, HILL_MAX).ok().map(|h| {
+                let v = judge(&h.multipliers, margin.max(h.error), max_trivial);
+                (h.multipliers, v.stability)
+            }),
+            HillTarget::Verdict => hill_verdict(p, &sol, margin, max_trivial, HILL_MAX)
+                .ok()
+                .map(|(h, v)| (h.multipliers, v.stability)),
+        }
     } else {
         None
     };

@@ -679,11 +679,117 @@ pub fn hill<D: Dynamics + ?Sized>(
     tol: f64,
     n_max: usize,
 ) -> Result<Hill> {
+    hill_until(model, sol, hill_start(sol), n_max, |_| tol)
+}
+
+/// What Hill's truncation is enlarged for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HillTarget {
+    /// The multipliers to [`HILL_TOL`] ([`hill`]): `periodic()`'s cross-check.
+    Multipliers,
+    /// The verdict only ([`hill_verdict`]): a scan's cross-check, whose table keeps
+    /// Hill's verdict but not its multipliers.
+    Verdict,
+}
+
+impl HillTarget {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            HillTarget::Multipliers => "multipliers",
+            HillTarget::Verdict => "verdict",
+        }
+    }
+
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "multipliers" => Ok(HillTarget::Multipliers),
+            "verdict" => Ok(HillTarget::Verdict),
+            _ => Err(crate::Error::param_range(
+                "hill_target",
+                format!("must be 'multipliers' or 'verdict', got {name:?}"),
+                "'multipliers' or 'verdict'",
+            )),
+        }
+    }
+}
+
+/// Error estimate at which [`hill_verdict`] stops even when its verdict is still open
+/// (a multiplier within that of the unit circle): the scan's multipliers are good to
+/// about 1e-5, and its monodromy's verdict margin is at least its trivial multiplier's
+/// error (1e-6 to 1e-2 at N = 3).
+pub const HILL_VERDICT_TOL: f64 = 1e-6;
+
+/// How many times its error estimate the leading non-trivial modulus must be from 1
+/// before [`hill_verdict`] takes its verdict as settled. The estimate bounded the
+/// measured error at every truncation in `hill_study`, by factors of 1.5 (the coarsest
+/// truncations of the period-106 orbit) to 50; 10 leaves room for a coarser one.
+pub const HILL_VERDICT_ROOM: f64 = 10.0;
+
+/// Hill's multipliers at the smallest truncation that settles the verdict, and that
+/// verdict (judged as `periodic` judges Hill's: `margin` widened to the estimate). The
+/// truncation, from [`hill_verdict_start`], is enlarged until the estimate is below
+///
+/// * the leading non-trivial modulus' distance from 1 over [`HILL_VERDICT_ROOM`], if
+///   that distance exceeds `margin` and the trivial multiplier's error (then the
+///   verdict is definite with room to spare), or
+/// * the trivial multiplier's error (the truncation no longer limits the verdict: it
+///   is judged against that error anyway, which the harmonic balance's truncation sets),
+///   or [`HILL_VERDICT_TOL`], whichever is larger,
+///
+/// or it reaches `n_max`. A verdict the estimate leaves open is undetermined, as in
+/// [`hill`]; the multipliers are only as accurate as the estimate says (1e-2 at worst
+/// for a clear verdict), which is why `periodic()` keeps [`HillTarget::Multipliers`].
+pub fn hill_verdict<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    margin: f64,
+    max_trivial: f64,
+    n_max: usize,
+) -> Result<(Hill, Judgement)> {
+    let r = hill_until(model, sol, hill_verdict_start(sol), n_max, |r| {
+        let j = judge(&r.multipliers, margin, max_trivial);
+        let dist = (j.max_modulus - 1.0).abs();
+        let settled = if j.trivial_error <= max_trivial && dist > margin.max(j.trivial_error) {
+            dist / HILL_VERDICT_ROOM
+        } else {
+            0.0
+        };
+        HILL_VERDICT_TOL.max(j.trivial_error).max(settled)
+    })?;
+    let j = judge(&r.multipliers, margin.max(r.error), max_trivial);
+    Ok((r, j))
+}
+
+/// First truncation [`hill_verdict`] tries: `1.5 / sqrt(omega)` harmonics (at least 3),
+/// half of [`hill_start`]'s: in `hill_study` it gave estimates of 2e-3 to 2e-2 (errors
+/// 6e-5 to 1e-2), enough for a verdict on a leading modulus 0.02 to 0.2 from 1.
+pub fn hill_verdict_start(sol: &HbSolution) -> usize {
+    let h = 1.5 / sol.omega.abs().sqrt();
+    if h.is_finite() {
+        (h.ceil() as usize).clamp(3, HILL_MAX)
+    } else {
+        HILL_MAX
+    }
+}
+
+/// Hill's multipliers from truncation `start`, enlarged until the estimate is at most
+/// `goal` of the attempt (or the truncation reaches `n_max`); the attempt with the
+/// smallest estimate. A failed attempt predicts the next truncation from how fast its
+/// estimate decays with the harmonic (the spread between copies one and two harmonics
+/// apart), with one harmonic to spare.
+fn hill_until<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    start: usize,
+    n_max: usize,
+    goal: impl Fn(&Hill) -> f64,
+) -> Result<Hill> {
     let n_max = n_max.max(1);
-    let mut h = hill_start(sol).min(n_max);
+    let mut h = start.min(n_max);
     let mut best: Option<Hill> = None;
     loop {
         let r = hill_at(model, sol, h)?;
+        let tol = goal(&r);
         let done = r.error <= tol || h >= n_max;
         let decay = r.decay;
         let error = r.error;
@@ -1237,6 +1343,85 @@ mod tests {
             let r = hill(&p, &sol, HILL_TOL, HILL_MAX).unwrap();
             assert!(r.error <= HILL_TOL, "{r:?}");
             assert!(multiplier_distance(&r.multipliers, &reference) <= HILL_TOL);
+        }
+    }
+
+    /// The scan's verdict target against a tight RK45 monodromy at the studies' orbits:
+    /// the multipliers within the estimate, the verdict the reference's (judged alike)
+    /// or undetermined, never the opposite; a definite verdict wherever the reference's
+    /// leading modulus is clear of 1 by more than the trivial multiplier's error; and a
+    /// truncation no larger than the multipliers target's.
+    #[test]
+    fn hill_verdict_confirms_the_tight_verdict() {
+        let mut definite = 0;
+        study_orbits(|name, n_harm, p, sol, reference| {
+            let (margin, max_trivial) = (1e-6, MAX_TRIVIAL);
+            let (r, j) = hill_verdict(p, sol, margin, max_trivial, HILL_MAX).unwrap();
+            let err = multiplier_distance(&r.multipliers, &reference.multipliers);
+            assert!(err <= r.error, "{name} N={n_harm}: {err:e} > {:e}", r.error);
+            let tight = judge(&reference.multipliers, margin, max_trivial);
+            assert!(
+                j.stability == tight.stability || j.stability == Stability::Undetermined,
+                "{name} N={n_harm}: {:?} vs {:?}",
+                j.stability,
+                tight.stability
+            );
+            let clear = (tight.max_modulus - 1.0).abs() > 2.0 * tight.trivial_error.max(margin);
+            if tight.trivial_error <= max_trivial && clear {
+                assert_eq!(j.stability, tight.stability, "{name} N={n_harm}");
+                definite += 1;
+            }
+            let strict = hill(p, sol, HILL_TOL, HILL_MAX).unwrap();
+            assert!(r.n_hill <= strict.n_hill, "{name} N={n_harm}");
+        });
+        // the standard R-R, O-O and stable R-O orbits at N = 3 and 8, the hard R-R at 8
+        assert!(definite >= 7, "{definite}");
+    }
+
+    /// A truncation too coarse to settle the verdict gives none: at the stable R-O orbit
+    /// (leading modulus 0.945) H = 2 leaves an estimate of the order of the distance to
+    /// 1, and the period-106 orbit resolves no exponents below H = 5 (estimate
+    /// infinite); both are undetermined when `n_max` stops there, and definite (stable)
+    /// when the truncation may grow.
+    #[test]
+    fn hill_verdict_is_undetermined_when_the_truncation_cannot_settle_it() {
+        let cases: [(f64, f64, usize, usize); 2] = [(1.3, 0.7, 3, 2), (1.0, 0.7, 8, 4)];
+        for (om, eta, n_harm, n_max) in cases {
+            let p = Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap();
+            let pat: &[bool] = if eta == 0.7 && om == 1.3 {
+                &[true, false]
+            } else {
+                &[true, true]
+            };
+            let opts = PeriodicOptions {
+                hb: HbOptions {
+                    n_harm,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            let sol = periodic(&p, pat, None, &opts).sol;
+            assert_eq!(sol.status, crate::hb::Status::Converged, "{om} {eta}");
+            let tight = FloquetOptions {
+                rtol: 1e-12,
+                atol: 1e-14,
+                max_steps: 10_000_000,
+                ..Default::default()
+            };
+            let reference = floquet(&p, &sol, &tight).unwrap();
+            assert_eq!(reference.stability, Stability::Stable);
+            // hill_verdict_start would begin above n_max: the cap is what limits it
+            let (r, j) = hill_verdict(&p, &sol, 1e-6, MAX_TRIVIAL, n_max).unwrap();
+            assert_eq!(r.n_hill, n_max);
+            let lead = judge(&r.multipliers, 1e-6, MAX_TRIVIAL).max_modulus;
+            assert!(
+                !(r.error < (lead - 1.0).abs()),
+                "{om} {eta}: {:e} {lead}",
+                r.error
+            );
+            assert_eq!(j.stability, Stability::Undetermined, "{om} {eta}: {r:?}");
+            let (_, j) = hill_verdict(&p, &sol, 1e-6, MAX_TRIVIAL, HILL_MAX).unwrap();
+            assert_eq!(j.stability, Stability::Stable, "{om} {eta}");
         }
     }
 
