@@ -20,6 +20,11 @@ Instructions per warm solve (certificates included), 2026-11-23, before -> after
 product-to-sum Jacobian (N > 3) and the reuse of the accepted trial's residual:
 N = 3: 2.41 M -> 1.87 M, N = 6: 6.71 M -> 3.01 M, N = 8: 11.46 M -> 4.47 M,
 N = 12: 26.7 M -> 8.36 M; N = 8 / N = 3: 4.75 -> 2.39.
+Then (same harness, 2026-11-23 night) with chord steps ending the N > 3 solves (3 LU
+factorisations and Jacobians instead of 4, two chord steps of one residual and one solve
+each), the basis and DFT tables kept per thread, sampling vectorised along the samples
+and faer factoring the row-major view: N = 3: 1.87 M -> CH3, N = 6: 3.01 M -> CH6,
+N = 8: 4.45 M -> CH8, N = 12: 8.36 M -> CH12; N = 8 / N = 3: 2.38 -> CHR.
 """
 
 from __future__ import annotations
@@ -57,8 +62,9 @@ def harmonic_balance(b, seed) -> None:
     solve's time."""
     from ballbal import _native
 
-    print("\nharmonic balance, warm start from the fine-grid neighbour (no Floquet):")
-    print(f"{'N':>3} {'S':>4} {'unknowns':>8} {'HB solve [us]':>14} {'iters':>6} "
+    print("\nharmonic balance, warm start from the fine-grid neighbour (no Floquet; LUs: "
+          "factorisations per solve, fewer than iterations where chord steps end it):")
+    print(f"{'N':>3} {'S':>4} {'unknowns':>8} {'HB solve [us]':>14} {'LUs':>6} "
           f"{'residuals':>9} {'ratio to N=3':>13}")
     base = None
     rows = []

@@ -388,7 +388,8 @@ const STAGES: usize = 4;
 static PROFILE_ON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 static STAGE_NANOS: [std::sync::atomic::AtomicU64; STAGES] =
     [const { std::sync::atomic::AtomicU64::new(0) }; STAGES];
-/// Solves, Newton iterations (LU solves) and residual evaluations.
+/// Solves, LU factorisations (Newton iterations other than chord steps) and residual
+/// evaluations.
 static COUNTS: [std::sync::atomic::AtomicU64; 3] =
     [const { std::sync::atomic::AtomicU64::new(0) }; 3];
 
@@ -405,7 +406,7 @@ pub fn stage_profile(on: bool) {
 }
 
 /// Seconds per [`Stage`] (in its order) since [`stage_profile`] switched the timers on,
-/// then the number of solves, Newton iterations and residual evaluations.
+/// then the number of solves, LU factorisations and residual evaluations.
 pub fn stage_seconds() -> [f64; STAGES + 3] {
     use std::sync::atomic::Ordering::Relaxed;
     let mut out = [0.0; STAGES + 3];
@@ -836,7 +837,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         // model's mass and damping constants, or zero) has the coefficients `S x` of
         // its constant at k = 0 and none above (sum_i cos k tau_i = 0 for 0 < k < S).
         let e3 = 3 * dd;
-        let (mut varying, mut constant) = (vec![], vec![]);
+        let (mut varying, mut constant) = (Vec::with_capacity(e3), Vec::with_capacity(e3));
         for e in 0..e3 {
             let first = self.kcm[e];
             if (1..s).all(|i| self.kcm[i * e3 + e] == first) {
@@ -875,8 +876,9 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         // h + 2N): cosines even in h, sines odd (sin(-h tau) = -sin(h tau)).
         let e = 4 * nh + 1;
         let z = 2 * nh;
-        let mut ext = vec![0.0; 6 * e];
-        let (mut ac, mut as_) = (vec![0.0; e], vec![0.0; e]);
+        let mut work = vec![0.0; 8 * e];
+        let (ext, rest) = work.split_at_mut(6 * e);
+        let (ac, as_) = rest.split_at_mut(e);
         for j in 0..d {
             for k in 0..d {
                 if crate::cancel::cancelled() {
@@ -1082,9 +1084,10 @@ fn max_abs(v: &[f64]) -> f64 {
 /// instructions; a chord step is one residual and one solve). Converged means what it
 /// means for Newton (residual and step below their tolerances) and, after a chord step,
 /// also that the error it leaves, about `theta` times the step, is below the round-off of
-/// the unknowns, so the result is Newton's to round-off. A chord step that does not
-/// contract as expected hands back to Newton at its point. N <= 3 iterates exactly as
-/// before (see [`DIRECT_PROJECTION_MAX_HARM`]); `iterations` counts chord steps too.
+/// the unknowns, so the result is Newton's to round-off. A run of chord steps that does
+/// not end the solve so is undone: Newton goes on from where it started, on the path it
+/// would have taken without it. N <= 3 iterates exactly as before (see
+/// [`DIRECT_PROJECTION_MAX_HARM`]); `iterations` counts chord steps too.
 pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptions) -> HbSolution {
     solve_with(model, guess, opts, opts.n_harm > DIRECT_PROJECTION_MAX_HARM).0
 }
@@ -1154,7 +1157,26 @@ fn solve_with<D: Dynamics + ?Sized>(
     // While chord steps are taken: their contraction estimate, how many have been
     // taken in a row and the size of the last one.
     let (mut theta, mut chord_run, mut chord_last) = (f64::NAN, 0usize, f64::NAN);
-    for it in 1..=opts.max_iter {
+    // Where a run of chord steps started: the point, and the iteration count there.
+    let mut saved: (Vec<f64>, usize) = (vec![], 0);
+    let mut it = 0;
+    // A run of chord steps that did not end the solve is undone: back to the point it
+    // started from, and on as Newton goes on from there (the residual and Jacobian
+    // there recomputed, the same arithmetic; the same iteration count), so that chord
+    // steps change no Newton path, only how a converging one ends.
+    macro_rules! undo_chord_run {
+        () => {{
+            x.copy_from_slice(&saved.0);
+            it = saved.1;
+            stale = false;
+            last = f64::NAN;
+            sys.assemble(&x, &mut r, Some(&mut jac));
+            rn = max_abs(&r);
+            continue;
+        }};
+    }
+    while it < opts.max_iter {
+        it += 1;
         // A cancelled solve's result is discarded by whoever cancelled it (see `cancel`).
         if crate::cancel::cancelled() {
             finish(
@@ -1179,6 +1201,9 @@ fn solve_with<D: Dynamics + ?Sized>(
             lu = timed(Stage::Lu, || lu_factor(&jac, n));
         }
         let Some(dx) = lu.as_ref().and_then(|f| timed(Stage::Lu, || f.solve(&neg))) else {
+            if was_chord {
+                undo_chord_run!();
+            }
             finish(&x, &mut out, Status::Singular, rn, f64::INFINITY, it - 1);
             return (out, factorizations);
         };
@@ -1213,6 +1238,9 @@ fn solve_with<D: Dynamics + ?Sized>(
             lam *= 0.5;
         }
         if !accepted {
+            if was_chord {
+                undo_chord_run!();
+            }
             finish(&x, &mut out, Status::Diverged, rn, max_abs(&dx), it);
             return (out, factorizations);
         }
@@ -1220,6 +1248,9 @@ fn solve_with<D: Dynamics + ?Sized>(
         x.copy_from_slice(&xt);
         rn = rtn;
         if max_abs(&x) > 1e8 * scale0 {
+            if was_chord {
+                undo_chord_run!();
+            }
             finish(&x, &mut out, Status::Diverged, rn, step, it);
             return (out, factorizations);
         }
@@ -1252,18 +1283,22 @@ fn solve_with<D: Dynamics + ?Sized>(
             } else {
                 theta <= 1e-2
             };
-            stale = lam == 1.0 && contracting && chord_run < 4;
-            if !stale {
-                last = f64::NAN;
+            if !(lam == 1.0 && contracting && chord_run < 4) {
+                undo_chord_run!();
             }
         } else {
             let prev = last;
             last = if lam == 1.0 { step } else { f64::NAN };
             // Chord steps next when the quadratic rate the last two Newton steps show
             // makes the factors at hand contract by 1e-3 or better (NaN compares false).
+            // The run (at most 4 steps) ends before max_iter.
             theta = 2.0 * (last / (prev * prev)) * last;
-            stale = chord && last < prev && theta <= 1e-3;
+            stale = chord && last < prev && theta <= 1e-3 && it + 5 <= opts.max_iter;
             (chord_run, chord_last) = (0, f64::NAN);
+            if stale {
+                saved.0.clone_from(&x);
+                saved.1 = it;
+            }
         }
         if !stale {
             sys.jacobian_after_residual(&x, &mut jac);
