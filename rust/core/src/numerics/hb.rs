@@ -1089,8 +1089,16 @@ fn max_abs(v: &[f64]) -> f64 {
 /// would have taken without it. N <= 3 iterates exactly as before (see
 /// [`DIRECT_PROJECTION_MAX_HARM`]); `iterations` counts chord steps too.
 pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptions) -> HbSolution {
-    solve_with(model, guess, opts, opts.n_harm > DIRECT_PROJECTION_MAX_HARM).0
+    let chord = CHORD_STEPS && opts.n_harm > DIRECT_PROJECTION_MAX_HARM;
+    solve_with(model, guess, opts, chord).0
 }
+
+/// Whether [`solve`] ends converging N > 3 solves with chord steps. Off: with them the
+/// zeta_b 0.05, N = 8 thesis scan found one solution more than before (Omega 1.2, eta
+/// 0.4, O-O: a continuation solve of 36 iterations converged, trivial-multiplier error
+/// 0.66, where the saved scan has none), not yet explained; on, a warm N = 8 solve
+/// takes 3.65 M instead of about 4.1 M instructions (N = 8 / N = 3 = 2.01).
+pub const CHORD_STEPS: bool = false;
 
 /// Newton with a final chord step allowed or not, and the number of LU factorisations.
 fn solve_with<D: Dynamics + ?Sized>(
