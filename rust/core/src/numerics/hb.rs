@@ -470,9 +470,12 @@ fn dft_table(n_harm: usize, samples: usize) -> Vec<f64> {
 /// of it, 0.5 MiB): every warm solve of a scan builds a system of the same size.
 const SHARED_TABLES_MAX: usize = 16_384;
 
+/// `(N, samples)`, the basis and the DFT table built for them.
+type SharedTables = (usize, usize, Arc<Basis>, Arc<Vec<f64>>);
+
 thread_local! {
     /// The basis and DFT tables of the last few `(N, samples)` this thread solved at.
-    static TABLES: std::cell::RefCell<Vec<(usize, usize, Arc<Basis>, Arc<Vec<f64>>)>> =
+    static TABLES: std::cell::RefCell<Vec<SharedTables>> =
         const { std::cell::RefCell::new(Vec::new()) };
 }
 
