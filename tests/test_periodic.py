@@ -158,9 +158,10 @@ def test_ro_solution_by_continuation_cross_checked():
 
 
 def test_hb_stage_counters_count_what_a_warm_solve_does(standard):
-    """The stage timers behind bench_periodic's per-stage printout: one solve, its own
-    Newton iterations (one LU each), one residual per iteration plus the first, and
-    nothing counted while they are off."""
+    """The stage timers behind bench_periodic's per-stage printout: one solve, its LU
+    factorisations (one per Newton iteration at N = 3; at most that at N = 8, where
+    chord steps, when hb::CHORD_STEPS is on, reuse the last one), one residual per
+    iteration plus the first, and nothing counted while they are off."""
     from ballbal import _native
 
     standard, _ = standard
@@ -172,9 +173,16 @@ def test_hb_stage_counters_count_what_a_warm_solve_does(standard):
     finally:
         _native.hb_stage_profile(False)
     assert sol.status == "converged"
-    assert st[4] == 1 and st[5] == sol.iterations
+    assert st[4] == 1 and 0 < st[5] <= sol.iterations
     # the first residual, then one per line-search trial (a full step each here)
     assert st[6] == sol.iterations + 1
     assert all(v > 0 for v in st[:4])
+    _native.hb_stage_profile(True)
+    try:
+        sol3 = ballbal.periodic(standard, "R-R", N=3, guess=seed, floquet=False, hill=False)
+        st3 = _native.hb_stage_seconds()
+    finally:
+        _native.hb_stage_profile(False)
+    assert sol3.status == "converged" and st3[5] == sol3.iterations
     ballbal.periodic(standard, "R-R", N=8, guess=seed, floquet=False, hill=False)
     assert _native.hb_stage_seconds() == [0.0] * 7

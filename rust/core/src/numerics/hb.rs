@@ -10,10 +10,11 @@
 //! `sin tau` coefficient of `x` is zero (spec section 4).
 
 use crate::continuation::Secant;
-use crate::linalg::lu_solve;
+use crate::linalg::{lu_factor, LuFactor};
 use crate::model::Dynamics;
 use crate::numerics::problem::{At, ModelAt, Problem};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// Coefficient layout per coordinate: `[a_0, a_1, b_1, ..., a_N, b_N]`.
 #[derive(Debug, Clone)]
@@ -27,6 +28,10 @@ pub struct Basis {
     /// Galerkin weights `S x L`: basis times 1/S (mean) or 2/S (harmonics).
     wgt: Vec<f64>,
     tau: Vec<f64>,
+    /// `phi, dphi, ddphi` transposed (`L x S`): sampling runs along the samples.
+    phi_t: Vec<f64>,
+    dphi_t: Vec<f64>,
+    ddphi_t: Vec<f64>,
 }
 
 impl Basis {
@@ -57,9 +62,21 @@ impl Basis {
                 wgt[sidx] = 2.0 * sn / s as f64;
             }
         }
+        let transpose = |a: &[f64]| -> Vec<f64> {
+            let mut t = vec![0.0; s * l];
+            for i in 0..s {
+                for p in 0..l {
+                    t[p * s + i] = a[i * l + p];
+                }
+            }
+            t
+        };
         Basis {
             n_harm,
             samples,
+            phi_t: transpose(&phi),
+            dphi_t: transpose(&dphi),
+            ddphi_t: transpose(&ddphi),
             phi,
             dphi,
             ddphi,
@@ -371,7 +388,8 @@ const STAGES: usize = 4;
 static PROFILE_ON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 static STAGE_NANOS: [std::sync::atomic::AtomicU64; STAGES] =
     [const { std::sync::atomic::AtomicU64::new(0) }; STAGES];
-/// Solves, Newton iterations (LU solves) and residual evaluations.
+/// Solves, LU factorisations (Newton iterations other than chord steps) and residual
+/// evaluations.
 static COUNTS: [std::sync::atomic::AtomicU64; 3] =
     [const { std::sync::atomic::AtomicU64::new(0) }; 3];
 
@@ -388,7 +406,7 @@ pub fn stage_profile(on: bool) {
 }
 
 /// Seconds per [`Stage`] (in its order) since [`stage_profile`] switched the timers on,
-/// then the number of solves, Newton iterations and residual evaluations.
+/// then the number of solves, LU factorisations and residual evaluations.
 pub fn stage_seconds() -> [f64; STAGES + 3] {
     use std::sync::atomic::Ordering::Relaxed;
     let mut out = [0.0; STAGES + 3];
@@ -448,6 +466,50 @@ fn dft_table(n_harm: usize, samples: usize) -> Vec<f64> {
     t
 }
 
+/// Largest `samples x (2N + 1)` kept in [`shared_tables`]' per-thread cache (four tables
+/// of it, 0.5 MiB): every warm solve of a scan builds a system of the same size.
+const SHARED_TABLES_MAX: usize = 16_384;
+
+/// `(N, samples)`, the basis and the DFT table built for them.
+type SharedTables = (usize, usize, Arc<Basis>, Arc<Vec<f64>>);
+
+thread_local! {
+    /// The basis and DFT tables of the last few `(N, samples)` this thread solved at.
+    static TABLES: std::cell::RefCell<Vec<SharedTables>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// [`Basis::new`] and [`dft_table`] (empty at `N <= DIRECT_PROJECTION_MAX_HARM`, whose
+/// path does not use it) for `(n_harm, samples)`, built once per thread for the sizes
+/// a thread keeps solving at: the same values as building them for each system (the
+/// same computation), without its sine and cosine calls, a fifth of a warm N = 8 solve's
+/// instructions outside the model.
+fn shared_tables(n_harm: usize, samples: usize) -> (Arc<Basis>, Arc<Vec<f64>>) {
+    let build = || {
+        let dft = if n_harm > DIRECT_PROJECTION_MAX_HARM {
+            dft_table(n_harm, samples)
+        } else {
+            vec![]
+        };
+        (Arc::new(Basis::new(n_harm, samples)), Arc::new(dft))
+    };
+    if samples * (2 * n_harm + 1) > SHARED_TABLES_MAX {
+        return build();
+    }
+    TABLES.with(|t| {
+        let mut t = t.borrow_mut();
+        if let Some(e) = t.iter().find(|e| e.0 == n_harm && e.1 == samples) {
+            return (e.2.clone(), e.3.clone());
+        }
+        let (b, d) = build();
+        if t.len() == 4 {
+            t.remove(0);
+        }
+        t.push((n_harm, samples, b.clone(), d.clone()));
+        (b, d)
+    })
+}
+
 /// Zeroes the `(j, k)` block of coefficient rows and columns (`L x L`) of `jac`.
 fn zero_block_of(jac: &mut [f64], n: usize, l: usize, j: usize, k: usize) {
     for rr in 0..l {
@@ -459,7 +521,7 @@ fn zero_block_of(jac: &mut [f64], n: usize, l: usize, j: usize, k: usize) {
 pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     model: &'a D,
     d: usize,
-    basis: Basis,
+    basis: Arc<Basis>,
     winding: Vec<f64>,
     /// Coordinate used by the phase condition and whether it is a rotating ball.
     phase_coord: usize,
@@ -471,10 +533,14 @@ pub struct HbSystem<'a, D: Dynamics + ?Sized> {
     f: Vec<f64>,
     /// Row-major `S x 3d^2`: per sample `K`, then `C`, then `M` (each row-major `d x d`).
     kcm: Vec<f64>,
+    /// The direct path's `S x L` product (rows padded to groups of 8), sized on first use.
     g: Vec<f64>,
+    /// One coordinate's `q, q', q''` at every sample (`3 x S`), as [`Self::sample`]
+    /// builds them.
+    col: Vec<f64>,
     /// Product-to-sum path (`n_harm > DIRECT_PROJECTION_MAX_HARM`): the DFT table and
     /// the `3d^2 x 2(2N+1)` Fourier coefficients of the entries of `K, C, M`.
-    dft: Vec<f64>,
+    dft: Arc<Vec<f64>>,
     coef: Vec<f64>,
     /// The entries that vary along the orbit (`S x nv`) and their coefficients.
     packed: Vec<f64>,
@@ -485,7 +551,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
     pub fn new(model: &'a D, winding: &[f64], n_harm: usize, samples: usize) -> Self {
         let d = model.ndof();
         assert_eq!(winding.len(), d);
-        let basis = Basis::new(n_harm, samples);
+        let (basis, dft) = shared_tables(n_harm, samples);
         let rot = winding.iter().position(|w| *w != 0.0);
         let s = samples;
         HbSystem {
@@ -500,9 +566,10 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
             qtt: vec![0.0; s * d],
             f: vec![0.0; s * d],
             kcm: vec![0.0; s * 3 * d * d],
-            g: vec![0.0; s * (2 * n_harm + 1).div_ceil(8) * 8],
-            // Built on first use: the direct path never needs them.
-            dft: vec![],
+            g: vec![],
+            col: vec![0.0; 3 * s],
+            dft,
+            // Sized on first use: the direct path never needs them.
             coef: vec![],
             packed: vec![],
             packed_coef: vec![],
@@ -514,28 +581,48 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         self.d * self.basis.width() + 1
     }
 
-    /// Samples the coordinates at every collocation time: `q = Phi c + w tau`.
+    /// Samples the coordinates at every collocation time: `q = Phi c + w tau`. Each
+    /// value sums `w tau` (or `w`, `0`) and then the terms `c_p phi_p` in the order of
+    /// `p`, all samples of a coordinate at once (the loop over the samples vectorises;
+    /// the sums are the same, term by term, as a sample-by-sample loop's).
     #[inline(always)]
     fn sample(&mut self, x: &[f64]) {
         let (d, l, s) = (self.d, self.basis.width(), self.basis.samples);
-        for i in 0..s {
-            let tau = self.basis.tau[i];
-            let (ph, dph, ddph) = (
-                &self.basis.phi[i * l..(i + 1) * l],
-                &self.basis.dphi[i * l..(i + 1) * l],
-                &self.basis.ddphi[i * l..(i + 1) * l],
-            );
-            for j in 0..d {
-                let cj = &x[j * l..(j + 1) * l];
-                let (mut a, mut b, mut cc) = (self.winding[j] * tau, self.winding[j], 0.0);
-                for p in 0..l {
-                    a += cj[p] * ph[p];
-                    b += cj[p] * dph[p];
-                    cc += cj[p] * ddph[p];
+        let b = &*self.basis;
+        let (qa, rest) = self.col.split_at_mut(s);
+        let (qb, qc) = rest.split_at_mut(s);
+        let qc = &mut qc[..s];
+        for j in 0..d {
+            let w = self.winding[j];
+            for ((a, bb), (cc, tau)) in qa
+                .iter_mut()
+                .zip(qb.iter_mut())
+                .zip(qc.iter_mut().zip(&b.tau))
+            {
+                *a = w * tau;
+                *bb = w;
+                *cc = 0.0;
+            }
+            for (p, &c) in x[j * l..(j + 1) * l].iter().enumerate() {
+                let (ph, dph, ddph) = (
+                    &b.phi_t[p * s..(p + 1) * s],
+                    &b.dphi_t[p * s..(p + 1) * s],
+                    &b.ddphi_t[p * s..(p + 1) * s],
+                );
+                for ((a, bb), (cc, (f, (f1, f2)))) in qa
+                    .iter_mut()
+                    .zip(qb.iter_mut())
+                    .zip(qc.iter_mut().zip(ph.iter().zip(dph.iter().zip(ddph))))
+                {
+                    *a += c * f;
+                    *bb += c * f1;
+                    *cc += c * f2;
                 }
-                self.q[i * d + j] = a;
-                self.qt[i * d + j] = b;
-                self.qtt[i * d + j] = cc;
+            }
+            for i in 0..s {
+                self.q[i * d + j] = qa[i];
+                self.qt[i * d + j] = qb[i];
+                self.qtt[i * d + j] = qc[i];
             }
         }
     }
@@ -671,6 +758,9 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let om2 = om * om;
         // G's rows padded to whole groups of 8 columns (the padding stays zero).
         let lp = l.div_ceil(8) * 8;
+        if self.g.is_empty() {
+            self.g = vec![0.0; s * lp];
+        }
         for j in 0..d {
             for k in 0..d {
                 // A block takes a fraction of a second at hundreds of harmonics; a
@@ -741,15 +831,16 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let dd = d * d;
         let w = 2 * nh + 1;
         if self.dft.is_empty() {
-            self.dft = dft_table(nh, s);
-            self.coef = vec![0.0; 3 * dd * 2 * w];
+            // The direct path's system (a test calls both paths).
+            self.dft = Arc::new(dft_table(nh, s));
         }
+        self.coef.resize(3 * dd * 2 * w, 0.0);
         // coef (3d^2 x 2w) = KCM^T (3d^2 x S) * table (S x 2w), for the entries that
         // vary along the orbit; an entry that is the same at every sample (the planar
         // model's mass and damping constants, or zero) has the coefficients `S x` of
         // its constant at k = 0 and none above (sum_i cos k tau_i = 0 for 0 < k < S).
         let e3 = 3 * dd;
-        let (mut varying, mut constant) = (vec![], vec![]);
+        let (mut varying, mut constant) = (Vec::with_capacity(e3), Vec::with_capacity(e3));
         for e in 0..e3 {
             let first = self.kcm[e];
             if (1..s).all(|i| self.kcm[i * e3 + e] == first) {
@@ -788,8 +879,9 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         // h + 2N): cosines even in h, sines odd (sin(-h tau) = -sin(h tau)).
         let e = 4 * nh + 1;
         let z = 2 * nh;
-        let mut ext = vec![0.0; 6 * e];
-        let (mut ac, mut as_) = (vec![0.0; e], vec![0.0; e]);
+        let mut work = vec![0.0; 8 * e];
+        let (ext, rest) = work.split_at_mut(6 * e);
+        let (ac, as_) = rest.split_at_mut(e);
         for j in 0..d {
             for k in 0..d {
                 if crate::cancel::cancelled() {
@@ -826,10 +918,19 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                 for nn in 1..=nh {
                     let nf = nn as f64;
                     let (a2, cn) = (om * om * nf * nf, om * nf);
-                    // A = K - omega^2 n^2 M, coefficient by coefficient.
-                    for h in 0..e {
-                        ac[h] = kc[h] - a2 * mc[h];
-                        as_[h] = ks[h] - a2 * ms[h];
+                    // A = K - omega^2 n^2 M, coefficient by coefficient, on the harmonics
+                    // m -+ n (m = 1..N) and n that this column reads.
+                    let hs = z + 1 - nn..z + nh + nn + 1;
+                    for ((a, b), ((k1, k2), (m1, m2))) in
+                        ac[hs.clone()].iter_mut().zip(&mut as_[hs.clone()]).zip(
+                            kc[hs.clone()]
+                                .iter()
+                                .zip(&ks[hs.clone()])
+                                .zip(mc[hs.clone()].iter().zip(&ms[hs])),
+                        )
+                    {
+                        *a = k1 - a2 * m1;
+                        *b = k2 - a2 * m2;
                     }
                     let (pc, ps) = (base + 2 * nn - 1, base + 2 * nn);
                     jac[pc] = inv * (ac[z + nn] - cn * cs[z + nn]);
@@ -977,7 +1078,38 @@ fn max_abs(v: &[f64]) -> f64 {
 
 /// Newton–IHB from the starting guess `guess` (its `coeffs`, `omega`, `winding`; resized
 /// to `opts.n_harm` if needed).
+///
+/// From `N > DIRECT_PROJECTION_MAX_HARM` on, the last steps may be chord steps: once two
+/// full Newton steps in a row show a quadratic rate `kappa` (`|dx_k| ~ kappa
+/// |dx_k-1|^2`) at which the LU factors at hand would contract by `theta = 2 kappa
+/// |dx_k| <= 1e-3` per step, the next steps reuse them instead of forming a new Jacobian
+/// and factoring it (at N = 8 these are three quarters of a Newton iteration's
+/// instructions; a chord step is one residual and one solve). Converged means what it
+/// means for Newton (residual and step below their tolerances) and, after a chord step,
+/// also that the error it leaves, about `theta` times the step, is below the round-off of
+/// the unknowns, so the result is Newton's to round-off. A run of chord steps that does
+/// not end the solve so is undone: Newton goes on from where it started, on the path it
+/// would have taken without it. N <= 3 iterates exactly as before (see
+/// [`DIRECT_PROJECTION_MAX_HARM`]); `iterations` counts chord steps too.
 pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptions) -> HbSolution {
+    let chord = CHORD_STEPS && opts.n_harm > DIRECT_PROJECTION_MAX_HARM;
+    solve_with(model, guess, opts, chord).0
+}
+
+/// Whether [`solve`] ends converging N > 3 solves with chord steps. Off: with them the
+/// zeta_b 0.05, N = 8 thesis scan found one solution more than before (Omega 1.2, eta
+/// 0.4, O-O: a continuation solve of 36 iterations converged, trivial-multiplier error
+/// 0.66, where the saved scan has none), not yet explained; on, a warm N = 8 solve
+/// takes 3.65 M instead of about 4.1 M instructions (N = 8 / N = 3 = 2.01).
+pub const CHORD_STEPS: bool = false;
+
+/// Newton with a final chord step allowed or not, and the number of LU factorisations.
+fn solve_with<D: Dynamics + ?Sized>(
+    model: &D,
+    guess: &HbSolution,
+    opts: &HbOptions,
+    chord: bool,
+) -> (HbSolution, usize) {
     let g = if guess.n_harm == opts.n_harm {
         guess.clone()
     } else {
@@ -1021,12 +1153,41 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
             f64::INFINITY,
             0,
         );
-        return out;
+        return (out, 0);
     }
     sys.assemble(&x, &mut r, Some(&mut jac));
     let mut rn = max_abs(&r);
     let scale0 = max_abs(&x).max(1.0);
-    for it in 1..=opts.max_iter {
+    // The factors of the last Jacobian; `stale` when the next step is a chord step with
+    // them (the Jacobian at the current point was not formed).
+    let mut lu: Option<LuFactor> = None;
+    let mut stale = false;
+    let mut factorizations = 0;
+    // The last Newton step (max-norm), NaN unless it was a full step.
+    let mut last = f64::NAN;
+    // While chord steps are taken: their contraction estimate, how many have been
+    // taken in a row and the size of the last one.
+    let (mut theta, mut chord_run, mut chord_last) = (f64::NAN, 0usize, f64::NAN);
+    // Where a run of chord steps started: the point, and the iteration count there.
+    let mut saved: (Vec<f64>, usize) = (vec![], 0);
+    let mut it = 0;
+    // A run of chord steps that did not end the solve is undone: back to the point it
+    // started from, and on as Newton goes on from there (the residual and Jacobian
+    // there recomputed, the same arithmetic; the same iteration count), so that chord
+    // steps change no Newton path, only how a converging one ends.
+    macro_rules! undo_chord_run {
+        () => {{
+            x.copy_from_slice(&saved.0);
+            it = saved.1;
+            stale = false;
+            last = f64::NAN;
+            sys.assemble(&x, &mut r, Some(&mut jac));
+            rn = max_abs(&r);
+            continue;
+        }};
+    }
+    while it < opts.max_iter {
+        it += 1;
         // A cancelled solve's result is discarded by whoever cancelled it (see `cancel`).
         if crate::cancel::cancelled() {
             finish(
@@ -1037,20 +1198,29 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
                 f64::INFINITY,
                 it - 1,
             );
-            return out;
+            return (out, factorizations);
         }
         if !rn.is_finite() {
             finish(&x, &mut out, Status::Diverged, rn, f64::INFINITY, it - 1);
-            return out;
+            return (out, factorizations);
         }
         let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-        count(1);
-        let Some(sol) = timed(Stage::Lu, || lu_solve(&jac, n, &neg)) else {
+        let was_chord = stale;
+        if !stale {
+            count(1);
+            factorizations += 1;
+            lu = timed(Stage::Lu, || lu_factor(&jac, n));
+        }
+        let Some(dx) = lu.as_ref().and_then(|f| timed(Stage::Lu, || f.solve(&neg))) else {
+            if was_chord {
+                undo_chord_run!();
+            }
             finish(&x, &mut out, Status::Singular, rn, f64::INFINITY, it - 1);
-            return out;
+            return (out, factorizations);
         };
-        out.pivot_ratio = sol.pivot_ratio;
-        let dx = sol.x;
+        if let Some(f) = &lu {
+            out.pivot_ratio = f.pivot_ratio;
+        }
         // Backtracking on ||R||_2, for which the Newton direction is a descent direction
         // (the max-norm need not fall even when the step is good).
         let merit = l2(&r);
@@ -1079,30 +1249,77 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
             lam *= 0.5;
         }
         if !accepted {
+            if was_chord {
+                undo_chord_run!();
+            }
             finish(&x, &mut out, Status::Diverged, rn, max_abs(&dx), it);
-            return out;
+            return (out, factorizations);
         }
         let step = lam * max_abs(&dx);
         x.copy_from_slice(&xt);
         rn = rtn;
         if max_abs(&x) > 1e8 * scale0 {
+            if was_chord {
+                undo_chord_run!();
+            }
             finish(&x, &mut out, Status::Diverged, rn, step, it);
-            return out;
+            return (out, factorizations);
         }
-        if rn <= opts.tol && step <= opts.step_tol * max_abs(&x).max(1.0) {
+        let scale = max_abs(&x).max(1.0);
+        if was_chord {
+            // The contraction a chord step shows (after the first) counts as well.
+            if chord_run > 0 {
+                theta = theta.max(step / chord_last);
+            }
+            chord_run += 1;
+            chord_last = step;
+        }
+        let mut converged = rn <= opts.tol && step <= opts.step_tol * scale;
+        if converged && was_chord {
+            // What a chord step leaves is about the next one, `theta` times its own.
+            converged = lam == 1.0 && theta * step <= f64::EPSILON * scale;
+        }
+        if converged {
             finish(&x, &mut out, Status::Converged, rn, step, it);
-            return out;
+            return (out, factorizations);
         }
         // The accepted point is the last one the line search evaluated: its residual
         // is `rt` and its samples are still in `sys`, so only the Jacobian is new.
         r.copy_from_slice(&rt);
-        sys.jacobian_after_residual(&x, &mut jac);
+        if was_chord {
+            // On with the same factors while they contract fast, a few steps at most
+            // (the first chord step stands for a Newton step: well below the last).
+            let contracting = if chord_run == 1 {
+                step <= 0.1 * last
+            } else {
+                theta <= 1e-2
+            };
+            if !(lam == 1.0 && contracting && chord_run < 4) {
+                undo_chord_run!();
+            }
+        } else {
+            let prev = last;
+            last = if lam == 1.0 { step } else { f64::NAN };
+            // Chord steps next when the quadratic rate the last two Newton steps show
+            // makes the factors at hand contract by 1e-3 or better (NaN compares false).
+            // The run (at most 4 steps) ends before max_iter.
+            theta = 2.0 * (last / (prev * prev)) * last;
+            stale = chord && last < prev && theta <= 1e-3 && it + 5 <= opts.max_iter;
+            (chord_run, chord_last) = (0, f64::NAN);
+            if stale {
+                saved.0.clone_from(&x);
+                saved.1 = it;
+            }
+        }
+        if !stale {
+            sys.jacobian_after_residual(&x, &mut jac);
+        }
         rn = max_abs(&r);
         if it == opts.max_iter {
             finish(&x, &mut out, Status::MaxIterations, rn, step, it);
         }
     }
-    out
+    (out, factorizations)
 }
 
 /// Nanoseconds spent in certificate checks by this process (all threads): what
@@ -1541,6 +1758,118 @@ mod tests {
             }
         }
         println!("largest gap relative to the largest entry: {worst:.1e}");
+    }
+
+    /// Warm starts of the standard R-R orbit (Omega 1.2 from the orbit at 1.19, as a
+    /// scan's neighbour gives it) and a cold Van der Pol start, at N where a chord step
+    /// may end the solve.
+    fn chord_cases() -> Vec<(Box<dyn Dynamics>, HbSolution, usize)> {
+        use crate::model::Planar;
+        use crate::periodic::{periodic, PeriodicOptions};
+        let near = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.19, &[1.0, 1.0]).unwrap();
+        let seed = periodic(&near, &[true, true], None, &PeriodicOptions::default()).sol;
+        assert_eq!(seed.status, Status::Converged);
+        let mut out: Vec<(Box<dyn Dynamics>, HbSolution, usize)> = vec![];
+        for nh in [4, 6, 8, 12] {
+            let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+            out.push((Box::new(p), seed.resized(nh), nh));
+            let mut coeffs = vec![0.0; 2 * nh + 1];
+            coeffs[1] = 1.8;
+            let vdp = HbSolution::start(0.95, coeffs, vec![0.0], nh, Status::Converged);
+            out.push((Box::new(Vdp(0.1)), vdp, nh));
+        }
+        out
+    }
+
+    #[test]
+    fn a_final_chord_step_ends_where_newton_ends() {
+        // The same solves with Newton steps only (a fresh Jacobian and LU at every
+        // iteration, the iteration before the chord step existed) are the reference:
+        // chord steps must save a factorisation on the warm N = 8 solve and leave the
+        // solution within round-off of Newton's, with the same status.
+        let mut chords = 0;
+        for (model, guess, nh) in chord_cases() {
+            let opts = HbOptions {
+                n_harm: nh,
+                ..Default::default()
+            };
+            let (c, fc) = solve_with(model.as_ref(), &guess, &opts, true);
+            let (nw, fnw) = solve_with(model.as_ref(), &guess, &opts, false);
+            assert_eq!(nw.status, Status::Converged, "N {nh}");
+            assert_eq!(c.status, nw.status, "N {nh}");
+            assert_eq!(fnw, nw.iterations, "Newton factors once per iteration");
+            assert!(fc <= fnw, "N {nh}: {fc} vs {fnw}");
+            // A Newton step's worth of chord steps: one or two.
+            assert!(
+                c.iterations - fc <= 2 * (fnw - fc),
+                "N {nh}: {} iterations",
+                c.iterations
+            );
+            chords += fnw - fc;
+            if model.ndof() == 4 && nh == 8 {
+                assert_eq!(fc + 1, fnw, "the warm N = 8 solve ends with chord steps");
+            }
+            let scale = nw.coeffs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            let worst = c
+                .coeffs
+                .iter()
+                .zip(&nw.coeffs)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                worst <= 8.0 * f64::EPSILON * scale,
+                "N {nh}: coefficients {worst:e}"
+            );
+            assert!(
+                (c.omega - nw.omega).abs() <= 8.0 * f64::EPSILON * nw.omega,
+                "N {nh}: omega {} vs {}",
+                c.omega,
+                nw.omega
+            );
+        }
+        assert!(chords >= 4, "chord steps taken: {chords}");
+    }
+
+    #[test]
+    fn n3_solves_take_no_chord_step() {
+        // N <= DIRECT_PROJECTION_MAX_HARM iterates as the saved scans did: one
+        // factorisation per iteration.
+        use crate::model::Planar;
+        use crate::periodic::{periodic, PeriodicOptions};
+        let near = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.19, &[1.0, 1.0]).unwrap();
+        let seed = periodic(&near, &[true, true], None, &PeriodicOptions::default()).sol;
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let opts = HbOptions::default();
+        let (a, fa) = solve_with(&p, &seed, &opts, opts.n_harm > DIRECT_PROJECTION_MAX_HARM);
+        let b = solve(&p, &seed, &opts);
+        assert_eq!(a.status, Status::Converged);
+        assert_eq!(fa, a.iterations);
+        assert_eq!(a.omega.to_bits(), b.omega.to_bits());
+    }
+
+    /// Newton's steps and residuals per iteration on the chord test's cases (`--ignored
+    /// --nocapture`): the solve stopped after 1, 2, ... iterations.
+    #[test]
+    #[ignore]
+    fn newton_trace() {
+        for (model, guess, nh) in chord_cases() {
+            for chord in [false, true] {
+                let mut line = format!("d {} N {nh:>2} chord {chord:>5}:", model.ndof());
+                for k in 1..=8 {
+                    let opts = HbOptions {
+                        n_harm: nh,
+                        max_iter: k,
+                        ..Default::default()
+                    };
+                    let (s, f) = solve_with(model.as_ref(), &guess, &opts, chord);
+                    line += &format!(" [{k}: step {:.1e} res {:.1e} lu {f}]", s.step, s.residual);
+                    if s.status == Status::Converged {
+                        break;
+                    }
+                }
+                println!("{line}");
+            }
+        }
     }
 
     #[test]

@@ -25,13 +25,27 @@ pub struct LuSolve {
     pub pivot_ratio: f64,
 }
 
-/// Solves the row-major `n x n` system `a x = b` by partial-pivoting LU (faer).
-/// Returns `None` when the matrix is numerically singular or the result is not finite.
-pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
-    let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+/// faer's one-call factorisation, or the panel-by-panel one for systems long enough
+/// that Ctrl-C must not wait for them.
+enum Factors {
+    Faer(faer::linalg::solvers::PartialPivLu<f64>),
+    Blocked(crate::numerics::blocked_lu::BlockedLu),
+}
+
+/// A partial-pivoting LU factorisation (faer) of a row-major matrix, kept for solves
+/// with several right-hand sides (the chord steps of a Newton iteration).
+pub struct LuFactor {
+    lu: Factors,
+    n: usize,
+    /// max |u_ii| / min |u_ii| of the LU factor: a lower bound on the condition number.
+    pub pivot_ratio: f64,
+}
+
+/// Factors the row-major `n x n` matrix `a`, or `None` when it is numerically singular.
+pub fn lu_factor(a: &[f64], n: usize) -> Option<LuFactor> {
     if n >= crate::numerics::blocked_lu::BLOCKED_MIN_ROWS {
-        // Long enough that Ctrl-C must not wait for it; `None` when cancelled (the
-        // caller's result is discarded then).
+        // `None` also when cancelled: the caller's result is discarded then.
+        let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
         let lu = crate::numerics::blocked_lu::BlockedLu::factor(m)?;
         let (umax, umin) = lu.pivots().fold((0.0f64, f64::INFINITY), |(hi, lo), v| {
             (hi.max(v), lo.min(v))
@@ -39,16 +53,16 @@ pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
         if !(umin > umax * 1e-15) || !umax.is_finite() {
             return None;
         }
-        let x = lu.solve(b);
-        if x.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        return Some(LuSolve {
-            x,
+        return Some(LuFactor {
+            lu: Factors::Blocked(lu),
+            n,
             pivot_ratio: umax / umin,
         });
     }
-    let lu = m.partial_piv_lu();
+    // faer copies its argument into the matrix it factors; handing it the row-major
+    // view skips a second, element-by-element copy (the same values in the same
+    // column-major matrix, so the same factors to the bit).
+    let lu = faer::MatRef::from_row_major_slice(&a[..n * n], n, n).partial_piv_lu();
     let u = lu.U();
     let (mut umax, mut umin) = (0.0f64, f64::INFINITY);
     for i in 0..n {
@@ -59,15 +73,40 @@ pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
     if !(umin > umax * 1e-15) || !umax.is_finite() {
         return None;
     }
-    let rhs = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
-    let sol = lu.solve(&rhs);
-    let x: Vec<f64> = (0..n).map(|i| sol[(i, 0)]).collect();
-    if x.iter().any(|v| !v.is_finite()) {
-        return None;
+    Some(LuFactor {
+        lu: Factors::Faer(lu),
+        n,
+        pivot_ratio: umax / umin,
+    })
+}
+
+impl LuFactor {
+    /// The solution of `a x = b`, or `None` if it is not finite.
+    pub fn solve(&self, b: &[f64]) -> Option<Vec<f64>> {
+        let n = self.n;
+        let x: Vec<f64> = match &self.lu {
+            Factors::Faer(lu) => {
+                let rhs = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
+                let sol = lu.solve(&rhs);
+                (0..n).map(|i| sol[(i, 0)]).collect()
+            }
+            Factors::Blocked(lu) => lu.solve(b),
+        };
+        if x.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        Some(x)
     }
+}
+
+/// Solves the row-major `n x n` system `a x = b` by partial-pivoting LU (faer).
+/// Returns `None` when the matrix is numerically singular or the result is not finite.
+pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
+    let f = lu_factor(a, n)?;
+    let x = f.solve(b)?;
     Some(LuSolve {
         x,
-        pivot_ratio: umax / umin,
+        pivot_ratio: f.pivot_ratio,
     })
 }
 
@@ -122,5 +161,29 @@ mod tests {
         let s = lu_solve(&a, 2, &[3.0, 5.0]).unwrap();
         assert!((s.x[0] - 0.8).abs() < 1e-14 && (s.x[1] - 1.4).abs() < 1e-14);
         assert!(lu_solve(&[1.0, 2.0, 2.0, 4.0], 2, &[1.0, 1.0]).is_none());
+    }
+
+    #[test]
+    fn factoring_the_row_major_view_gives_the_copied_matrix_factors_to_the_bit() {
+        // What `lu_solve` computed before it handed faer the row-major view: a
+        // column-major copy built element by element, then factored. Sizes around
+        // faer's block sizes, and a harmonic-balance-sized one.
+        for n in [2, 7, 29, 33, 69, 101] {
+            let a: Vec<f64> = (0..n * n)
+                .map(|k| {
+                    ((k * 7919 % 1009) as f64 / 1009.0 - 0.5)
+                        + if k % (n + 1) == 0 { 2.0 } else { 0.0 }
+                })
+                .collect();
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+            let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+            let lu = m.partial_piv_lu();
+            let rhs = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
+            let sol = lu.solve(&rhs);
+            let got = lu_solve(&a, n, &b).unwrap();
+            for i in 0..n {
+                assert_eq!(got.x[i].to_bits(), sol[(i, 0)].to_bits(), "n {n} x[{i}]");
+            }
+        }
     }
 }
