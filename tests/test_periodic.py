@@ -1,3 +1,5 @@
+from typing import Any
+
 import numpy as np
 import pytest
 
@@ -166,23 +168,22 @@ def test_hb_stage_counters_count_what_a_warm_solve_does(standard):
 
     standard, _ = standard
     seed = ballbal.periodic(standard.replace(Omega=1.19), "R-R", N=8)
-    _native.hb_stage_profile(True)
-    try:
-        sol = ballbal.periodic(standard, "R-R", N=8, guess=seed, floquet=False, hill=False)
-        st = _native.hb_stage_seconds()
-    finally:
-        _native.hb_stage_profile(False)
+
+    def profiled(n: int) -> tuple[Any, list[float]]:
+        _native.hb_stage_profile(True)
+        try:
+            sol = ballbal.periodic(standard, "R-R", N=n, guess=seed, floquet=False, hill=False)
+            return sol, _native.hb_stage_seconds()
+        finally:
+            _native.hb_stage_profile(False)
+
+    sol, st = profiled(8)
     assert sol.status == "converged"
     assert st[4] == 1 and 0 < st[5] <= sol.iterations
     # the first residual, then one per line-search trial (a full step each here)
     assert st[6] == sol.iterations + 1
     assert all(v > 0 for v in st[:4])
-    _native.hb_stage_profile(True)
-    try:
-        sol3 = ballbal.periodic(standard, "R-R", N=3, guess=seed, floquet=False, hill=False)
-        st3 = _native.hb_stage_seconds()
-    finally:
-        _native.hb_stage_profile(False)
+    sol3, st3 = profiled(3)
     assert sol3.status == "converged" and st3[5] == sol3.iterations
     ballbal.periodic(standard, "R-R", N=8, guess=seed, floquet=False, hill=False)
     assert _native.hb_stage_seconds() == [0.0] * 7

@@ -764,7 +764,12 @@ pub fn hill_verdict<D: Dynamics + ?Sized>(
 /// half of [`hill_start`]'s: in `hill_study` it gave estimates of 2e-3 to 2e-2 (errors
 /// 6e-5 to 1e-2), enough for a verdict on a leading modulus 0.02 to 0.2 from 1.
 pub fn hill_verdict_start(sol: &HbSolution) -> usize {
-    let h = 1.5 / sol.omega.abs().sqrt();
+    start_at(1.5, sol)
+}
+
+/// `ceil(c / sqrt(omega))` harmonics, at least 3 and at most [`HILL_MAX`].
+fn start_at(c: f64, sol: &HbSolution) -> usize {
+    let h = c / sol.omega.abs().sqrt();
     if h.is_finite() {
         (h.ceil() as usize).clamp(3, HILL_MAX)
     } else {
@@ -820,12 +825,7 @@ fn hill_until<D: Dynamics + ?Sized>(
 /// estimate of [`HILL_TOL`] on the first attempt in all but one case (the period-106
 /// R-R orbit at N = 8, one retry).
 pub fn hill_start(sol: &HbSolution) -> usize {
-    let h = 3.0 / sol.omega.abs().sqrt();
-    if h.is_finite() {
-        (h.ceil() as usize).clamp(3, HILL_MAX)
-    } else {
-        HILL_MAX
-    }
+    start_at(3.0, sol)
 }
 
 /// Fourier coefficients `A_k`, `k = 0..=k_max`, of the state matrix along the series
