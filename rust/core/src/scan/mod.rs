@@ -194,7 +194,7 @@ fn scan_chunk<D: Family>(
 
     let t = std::time::Instant::now();
     let (tasks, starts) = seeding::seed_tasks(spec, &geo, &range, &pb);
-    let (mut sols, frontier) = seeding::run_seeds(spec, &params, &tasks, &starts, cancel);
+    let (mut sols, frontier) = seeding::run_seeds(spec, &params, &tasks, &starts, &pb, cancel);
     profile::step(profile::SEEDS, t.elapsed(), &[]);
     add_stage(1, t);
     check()?;

@@ -83,12 +83,21 @@ pub(super) fn run_seeds<D: Family>(
     params: &[D],
     tasks: &[(usize, usize)],
     starts: &[usize],
+    pb: &[(bool, bool)],
     cancel: &AtomicBool,
 ) -> (Vec<Vec<Found>>, Vec<(usize, usize)>) {
     let n_harm = spec.opts.hb.n_harm;
-    let cands: Vec<Candidate> = tasks
+    // Starts where the perfect balance is not stable first: they are the long ones
+    // (simulations that never settle run the whole window), and a long task started
+    // last leaves the other threads idle. Only the schedule changes: the candidates
+    // are put back in task order below.
+    let mut order: Vec<usize> = (0..tasks.len()).collect();
+    order.sort_by_key(|&i| (pb[tasks[i].0].1, i));
+    let mut cands: Vec<(usize, Candidate)> = order
         .par_iter()
-        .map(|&(p, s)| {
+        .with_max_len(1)
+        .map(|&i| (i, tasks[i]))
+        .map(|(i, (p, s))| {
             if cancel.load(Ordering::Relaxed) {
                 return None;
             }
@@ -108,12 +117,14 @@ pub(super) fn run_seeds<D: Family>(
                 return None;
             }
             let key = orbit_key(&sol, model.layout().support());
-            Some((p, k, sol, key, t.elapsed().as_secs_f64()))
+            Some((i, (p, k, sol, key, t.elapsed().as_secs_f64())))
         })
         .collect::<Vec<_>>()
         .into_iter()
         .flatten()
         .collect();
+    cands.sort_unstable_by_key(|c| c.0);
+    let cands: Vec<Candidate> = cands.into_iter().map(|c| c.1).collect();
     // finished[i]: None = not analysed yet, Some(None) = refused by `finish`.
     let mut finished: Vec<Option<Option<Found>>> = (0..cands.len()).map(|_| None).collect();
     loop {
