@@ -34,8 +34,7 @@ time (summed durations of the stage's tasks on both pool threads) over 2 x the s
 wall time, beside the one-thread wall and the two-thread bound the stage's steps allow
 (per barrier step max(busy / 2, longest task), from the one-thread run's task times):
 the one-thread total over the summed bounds is the speed-up the scan's structure
-allows, apart from the machine. Seed tasks are not timed one by one (their stage's
-efficiency is its one-thread over two-thread wall, over 2). The waves are also run with
+allows, apart from the machine. The waves are also run with
 their target points started in point order (``_native.scan_wave_order(False)``), as
 before longest-first ordering.
 """
@@ -173,24 +172,14 @@ def efficiency(label: str, N: int, prof: dict) -> list[str]:
         w1, b1_bound = one["stages"][i][0], one["stages"][i][1]
         w2 = two["stages"][i][0]
         busy = sum(two["stages"][i][5:])
-        timed = name != "seeds"
-        if timed:
-            busy1 += sum(one["stages"][i][5:])
-            busy2 += busy
-            bound += b1_bound
-        else:
-            bound += w1 / 2  # untimed tasks: counted as perfectly parallel
-        if w2 <= 0:
-            eff = f"{'-':>10}"
-        elif timed:
-            eff = f"{busy / (2 * w2):>10.2f}"
-        else:
-            eff = f"{w1 / (2 * w2):>9.2f}*"
+        busy1 += sum(one["stages"][i][5:])
+        busy2 += busy
+        bound += b1_bound
+        eff = f"{busy / (2 * w2):>10.2f}" if w2 > 0 else f"{'-':>10}"
         pw = plain["stages"][i][0]
-        pe = sum(plain["stages"][i][5:]) / (2 * pw) if timed and pw > 0 else float("nan")
-        shown = busy if timed else float("nan")
-        lines.append(f"{'':>24}{name:<10} {w1:>8.3f} {w2:>8.3f} {shown:>9.3f} {eff} "
-                     f"{b1_bound if timed else w1 / 2:>10.3f}   ({pw:.3f}, {pe:.2f})")
+        pe = sum(plain["stages"][i][5:]) / (2 * pw) if pw > 0 else float("nan")
+        lines.append(f"{'':>24}{name:<10} {w1:>8.3f} {w2:>8.3f} {busy:>9.3f} {eff} "
+                     f"{b1_bound:>10.3f}   ({pw:.3f}, {pe:.2f})")
     t1, t2 = one["table"], two["table"]
     # The calling thread builds a chunk's table while the pool computes the next ones:
     # on one thread it uses the otherwise idle core, on two it takes a share of them.
@@ -201,9 +190,9 @@ def efficiency(label: str, N: int, prof: dict) -> list[str]:
     slow = busy2 / busy1 if busy1 > 0 else float("nan")
     lines.append(f"{'':>24}total      {T1:>8.3f} {T2:>8.3f}  speed-up {T1 / T2:.2f} "
                  f"(waves in point order {T1 / plain['total']:.2f}); allowed by the scan's "
-                 f"steps {T1 / bound:.2f} (seeds counted perfectly parallel, the table "
-                 f"sharing the cores); timed tasks take {slow:.2f} x as long on 2 threads as "
-                 f"on 1 (the machine's share); whole run: timed busy / (2 x wall) "
+                 f"steps {T1 / bound:.2f} (the table sharing the cores); timed tasks take "
+                 f"{slow:.2f} x as long on 2 threads as on 1 (the machine's share); "
+                 f"whole run: timed busy / (2 x wall) "
                  f"{busy2 / (2 * T2):.2f} (blocks that run at once make per-stage walls "
                  f"overlap: then only this one counts)")
     return lines
@@ -252,8 +241,7 @@ def main() -> None:
             eff_lines += efficiency(label, N, new["profile"])
         del t0
     if eff_lines:
-        print("\nparallel efficiency per stage (* seeds: one-thread over two-thread wall / 2,"
-              " the machine's share included):")
+        print("\nparallel efficiency per stage:")
         print("\n".join(eff_lines))
     if stage_lines:
         print("\nper stage, one thread (seconds):")

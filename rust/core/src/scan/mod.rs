@@ -194,8 +194,9 @@ fn scan_chunk<D: Family>(
 
     let t = std::time::Instant::now();
     let (tasks, starts) = seeding::seed_tasks(spec, &geo, &range, &pb);
+    profile::serial(profile::GLUE, t.elapsed());
+    // Its parallel steps record themselves.
     let (mut sols, frontier) = seeding::run_seeds(spec, &params, &tasks, &starts, &pb, cancel);
-    profile::step(profile::SEEDS, t.elapsed(), &[]);
     add_stage(1, t);
     check()?;
 

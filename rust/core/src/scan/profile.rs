@@ -19,8 +19,7 @@ use std::time::{Duration, Instant};
 /// The stages, in [`profile`]'s order.
 pub const STAGES: [&str; 5] = ["balance", "seeds", "waves", "glue", "rows"];
 pub(crate) const BALANCE: usize = 0;
-/// Seed simulations, their solves and Floquet analyses (wall time only: their tasks are
-/// not timed one by one).
+/// Seed simulations with their solves, then the Floquet analyses of the orbits kept.
 pub(crate) const SEEDS: usize = 1;
 /// The continuation waves' parallel part (the target points' corrections and Floquet).
 pub(crate) const WAVES: usize = 2;
@@ -55,9 +54,8 @@ static PROFILE: [Stage; 5] = [const {
 /// Per stage (see [`STAGES`]), summed over the blocks of the scans this process ran:
 /// `[wall, bound, span, steps, tasks, busy of pool thread 0, 1, ..., THREADS - 1]`,
 /// times in seconds. `bound`: the two-thread bound; `span`: the summed longest task of
-/// every step (the least wall time on any number of threads). Stages without timed
-/// tasks (seeds) have zero busy time and their wall time as bound and span. Blocks that run at once (several per grid) each count
-/// their own wall time.
+/// every step (the least wall time on any number of threads). Blocks that run at once
+/// (several per grid) each count their own wall time.
 pub fn profile() -> Vec<Vec<f64>> {
     let s = |a: &AtomicU64| a.load(Relaxed) as f64 * 1e-9;
     PROFILE

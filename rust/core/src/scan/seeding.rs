@@ -3,7 +3,7 @@
 
 use super::grid::Local;
 use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
-use super::{count, work, Family, Found, Origin, ScanSpec};
+use super::{count, profile, work, Family, Found, Origin, ScanSpec};
 use crate::analysis::attractors::seed_guess;
 use crate::continuation::Lattice;
 use crate::hb::{solve, HbSolution, Status};
@@ -93,36 +93,38 @@ pub(super) fn run_seeds<D: Family>(
     // are put back in task order below.
     let mut order: Vec<usize> = (0..tasks.len()).collect();
     order.sort_by_key(|&i| (pb[tasks[i].0].1, i));
-    let mut cands: Vec<(usize, Candidate)> = order
+    let t = Instant::now();
+    let (cands, times): (Vec<Option<(usize, Candidate)>>, Vec<profile::Task>) = order
         .par_iter()
         .with_max_len(1)
         .map(|&i| (i, tasks[i]))
         .map(|(i, (p, s))| {
-            if cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            let t = Instant::now();
-            let model = &params[p];
-            // This point's own states: "at rest in the ground frame" depends on its spin.
-            let y0 = &initial_states(model)[starts[s]];
-            let g = seed_guess(model, y0, n_harm, &spec.opts.guess)?;
-            let rot: Vec<bool> = g.winding[model.layout().balls()]
-                .iter()
-                .map(|w| *w != 0.0)
-                .collect();
-            let k = spec.patterns.iter().position(|r| *r == rot)?;
-            count(work::SEED_SOLVE);
-            let sol = solve(model, &g, &spec.opts.hb);
-            if !accept(model, &sol, &g, spec) {
-                return None;
-            }
-            let key = orbit_key(&sol, model.layout().support());
-            Some((i, (p, k, sol, key, t.elapsed().as_secs_f64())))
+            profile::timed(|| {
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let t = Instant::now();
+                let model = &params[p];
+                // This point's own states: "at rest in the ground frame" depends on its spin.
+                let y0 = &initial_states(model)[starts[s]];
+                let g = seed_guess(model, y0, n_harm, &spec.opts.guess)?;
+                let rot: Vec<bool> = g.winding[model.layout().balls()]
+                    .iter()
+                    .map(|w| *w != 0.0)
+                    .collect();
+                let k = spec.patterns.iter().position(|r| *r == rot)?;
+                count(work::SEED_SOLVE);
+                let sol = solve(model, &g, &spec.opts.hb);
+                if !accept(model, &sol, &g, spec) {
+                    return None;
+                }
+                let key = orbit_key(&sol, model.layout().support());
+                Some((i, (p, k, sol, key, t.elapsed().as_secs_f64())))
+            })
         })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .flatten()
-        .collect();
+        .unzip();
+    profile::step(profile::SEEDS, t.elapsed(), &times);
+    let mut cands: Vec<(usize, Candidate)> = cands.into_iter().flatten().collect();
     cands.sort_unstable_by_key(|c| c.0);
     let cands: Vec<Candidate> = cands.into_iter().map(|c| c.1).collect();
     // finished[i]: None = not analysed yet, Some(None) = refused by `finish`.
@@ -147,26 +149,30 @@ pub(super) fn run_seeds<D: Family>(
         if todo.is_empty() {
             break;
         }
-        let done: Vec<Option<Found>> = todo
+        let t = Instant::now();
+        let (done, times): (Vec<Option<Found>>, Vec<profile::Task>) = todo
             .par_iter()
             .map(|&i| {
-                let (p, k, sol, key, secs) = &cands[i];
-                if cancel.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let t = Instant::now();
-                count(work::FINISH);
-                let res = finish(&params[*p], sol.clone(), &spec.opts);
-                (res.sol.status == Status::Converged).then(|| Found {
-                    pattern: *k,
-                    res,
-                    origin: Origin::Seed,
-                    parent: None,
-                    key: key.clone(),
-                    seconds: secs + t.elapsed().as_secs_f64(),
+                profile::timed(|| {
+                    let (p, k, sol, key, secs) = &cands[i];
+                    if cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    let t = Instant::now();
+                    count(work::FINISH);
+                    let res = finish(&params[*p], sol.clone(), &spec.opts);
+                    (res.sol.status == Status::Converged).then(|| Found {
+                        pattern: *k,
+                        res,
+                        origin: Origin::Seed,
+                        parent: None,
+                        key: key.clone(),
+                        seconds: secs + t.elapsed().as_secs_f64(),
+                    })
                 })
             })
-            .collect();
+            .unzip();
+        profile::step(profile::SEEDS, t.elapsed(), &times);
         for (i, f) in todo.into_iter().zip(done) {
             finished[i] = Some(f);
         }
