@@ -23,11 +23,10 @@ N = 12: 26.7 M -> 8.36 M; N = 8 / N = 3: 4.75 -> 2.39.
 Then (same harness, 2026-11-23 night): the basis and DFT tables kept per thread, sampling
 vectorised along the samples and faer factoring the row-major view (every result the
 same to the bit): N = 3: 1.87 M -> 1.82 M, N = 6: 3.00 M -> 2.76 M, N = 8: 4.45 M ->
-4.06 M, N = 12: 8.32 M -> 7.45 M; N = 8 / N = 3: 2.38 -> 2.23. With chord steps ending
-the N > 3 solves as well (``hb::CHORD_STEPS``, off: one thesis N = 8 scan gained a
-solution with them): N = 6: 2.51 M, N = 8: 3.65 M, N = 12: 6.61 M; N = 8 / N = 3: 2.01.
-At N = 8 with chord steps: Jacobians 1.05 M (projection 0.67 M), residuals 0.96 M
-(6 per solve), LU 0.81 M + solves 0.17 M, defect certificate 0.52 M.
+4.06 M, N = 12: 8.32 M -> 7.45 M; N = 8 / N = 3: 2.38 -> 2.23. Chord steps ending the
+N > 3 solves (reusing the last LU) measured N = 8 / N = 3 = 2.01 but made one thesis
+N = 8 scan gain a solution, unexplained, and were taken out again (commit e6f873a has
+them).
 """
 
 from __future__ import annotations
@@ -66,7 +65,7 @@ def harmonic_balance(b, seed) -> None:
     from ballbal import _native
 
     print("\nharmonic balance, warm start from the fine-grid neighbour (no Floquet; LUs: "
-          "factorisations per solve, fewer than iterations if chord steps end it):")
+          "factorisations per solve, one per Newton iteration):")
     print(f"{'N':>3} {'S':>4} {'unknowns':>8} {'HB solve [us]':>14} {'LUs':>6} "
           f"{'residuals':>9} {'ratio to N=3':>13}")
     base = None

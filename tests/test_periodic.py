@@ -161,9 +161,8 @@ def test_ro_solution_by_continuation_cross_checked():
 
 def test_hb_stage_counters_count_what_a_warm_solve_does(standard):
     """The stage timers behind bench_periodic's per-stage printout: one solve, its LU
-    factorisations (one per Newton iteration at N = 3; at most that at N = 8, where
-    chord steps, when hb::CHORD_STEPS is on, reuse the last one), one residual per
-    iteration plus the first, and nothing counted while they are off."""
+    factorisations (at most one per Newton iteration), one residual per iteration plus
+    the first, and nothing counted while they are off."""
     from ballbal import _native
 
     standard, _ = standard

@@ -10,7 +10,7 @@
 //! `sin tau` coefficient of `x` is zero (spec section 4).
 
 use crate::continuation::Secant;
-use crate::linalg::{lu_factor, LuFactor};
+use crate::linalg::lu_solve;
 use crate::model::Dynamics;
 use crate::numerics::problem::{At, ModelAt, Problem};
 use std::f64::consts::PI;
@@ -388,8 +388,7 @@ const STAGES: usize = 4;
 static PROFILE_ON: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 static STAGE_NANOS: [std::sync::atomic::AtomicU64; STAGES] =
     [const { std::sync::atomic::AtomicU64::new(0) }; STAGES];
-/// Solves, LU factorisations (Newton iterations other than chord steps) and residual
-/// evaluations.
+/// Solves, Newton iterations (LU factorisations) and residual evaluations.
 static COUNTS: [std::sync::atomic::AtomicU64; 3] =
     [const { std::sync::atomic::AtomicU64::new(0) }; 3];
 
@@ -406,7 +405,8 @@ pub fn stage_profile(on: bool) {
 }
 
 /// Seconds per [`Stage`] (in its order) since [`stage_profile`] switched the timers on,
-/// then the number of solves, LU factorisations and residual evaluations.
+/// then the number of solves, Newton iterations (LU factorisations) and residual
+/// evaluations.
 pub fn stage_seconds() -> [f64; STAGES + 3] {
     use std::sync::atomic::Ordering::Relaxed;
     let mut out = [0.0; STAGES + 3];
@@ -1078,38 +1078,7 @@ fn max_abs(v: &[f64]) -> f64 {
 
 /// Newton–IHB from the starting guess `guess` (its `coeffs`, `omega`, `winding`; resized
 /// to `opts.n_harm` if needed).
-///
-/// From `N > DIRECT_PROJECTION_MAX_HARM` on, the last steps may be chord steps: once two
-/// full Newton steps in a row show a quadratic rate `kappa` (`|dx_k| ~ kappa
-/// |dx_k-1|^2`) at which the LU factors at hand would contract by `theta = 2 kappa
-/// |dx_k| <= 1e-3` per step, the next steps reuse them instead of forming a new Jacobian
-/// and factoring it (at N = 8 these are three quarters of a Newton iteration's
-/// instructions; a chord step is one residual and one solve). Converged means what it
-/// means for Newton (residual and step below their tolerances) and, after a chord step,
-/// also that the error it leaves, about `theta` times the step, is below the round-off of
-/// the unknowns, so the result is Newton's to round-off. A run of chord steps that does
-/// not end the solve so is undone: Newton goes on from where it started, on the path it
-/// would have taken without it. N <= 3 iterates exactly as before (see
-/// [`DIRECT_PROJECTION_MAX_HARM`]); `iterations` counts chord steps too.
 pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptions) -> HbSolution {
-    let chord = CHORD_STEPS && opts.n_harm > DIRECT_PROJECTION_MAX_HARM;
-    solve_with(model, guess, opts, chord).0
-}
-
-/// Whether [`solve`] ends converging N > 3 solves with chord steps. Off: with them the
-/// zeta_b 0.05, N = 8 thesis scan found one solution more than before (Omega 1.2, eta
-/// 0.4, O-O: a continuation solve of 36 iterations converged, trivial-multiplier error
-/// 0.66, where the saved scan has none), not yet explained; on, a warm N = 8 solve
-/// takes 3.65 M instead of about 4.1 M instructions (N = 8 / N = 3 = 2.01).
-pub const CHORD_STEPS: bool = false;
-
-/// Newton with a final chord step allowed or not, and the number of LU factorisations.
-fn solve_with<D: Dynamics + ?Sized>(
-    model: &D,
-    guess: &HbSolution,
-    opts: &HbOptions,
-    chord: bool,
-) -> (HbSolution, usize) {
     let g = if guess.n_harm == opts.n_harm {
         guess.clone()
     } else {
@@ -1153,41 +1122,12 @@ fn solve_with<D: Dynamics + ?Sized>(
             f64::INFINITY,
             0,
         );
-        return (out, 0);
+        return out;
     }
     sys.assemble(&x, &mut r, Some(&mut jac));
     let mut rn = max_abs(&r);
     let scale0 = max_abs(&x).max(1.0);
-    // The factors of the last Jacobian; `stale` when the next step is a chord step with
-    // them (the Jacobian at the current point was not formed).
-    let mut lu: Option<LuFactor> = None;
-    let mut stale = false;
-    let mut factorizations = 0;
-    // The last Newton step (max-norm), NaN unless it was a full step.
-    let mut last = f64::NAN;
-    // While chord steps are taken: their contraction estimate, how many have been
-    // taken in a row and the size of the last one.
-    let (mut theta, mut chord_run, mut chord_last) = (f64::NAN, 0usize, f64::NAN);
-    // Where a run of chord steps started: the point, and the iteration count there.
-    let mut saved: (Vec<f64>, usize) = (vec![], 0);
-    let mut it = 0;
-    // A run of chord steps that did not end the solve is undone: back to the point it
-    // started from, and on as Newton goes on from there (the residual and Jacobian
-    // there recomputed, the same arithmetic; the same iteration count), so that chord
-    // steps change no Newton path, only how a converging one ends.
-    macro_rules! undo_chord_run {
-        () => {{
-            x.copy_from_slice(&saved.0);
-            it = saved.1;
-            stale = false;
-            last = f64::NAN;
-            sys.assemble(&x, &mut r, Some(&mut jac));
-            rn = max_abs(&r);
-            continue;
-        }};
-    }
-    while it < opts.max_iter {
-        it += 1;
+    for it in 1..=opts.max_iter {
         // A cancelled solve's result is discarded by whoever cancelled it (see `cancel`).
         if crate::cancel::cancelled() {
             finish(
@@ -1198,29 +1138,20 @@ fn solve_with<D: Dynamics + ?Sized>(
                 f64::INFINITY,
                 it - 1,
             );
-            return (out, factorizations);
+            return out;
         }
         if !rn.is_finite() {
             finish(&x, &mut out, Status::Diverged, rn, f64::INFINITY, it - 1);
-            return (out, factorizations);
+            return out;
         }
         let neg: Vec<f64> = r.iter().map(|v| -v).collect();
-        let was_chord = stale;
-        if !stale {
-            count(1);
-            factorizations += 1;
-            lu = timed(Stage::Lu, || lu_factor(&jac, n));
-        }
-        let Some(dx) = lu.as_ref().and_then(|f| timed(Stage::Lu, || f.solve(&neg))) else {
-            if was_chord {
-                undo_chord_run!();
-            }
+        count(1);
+        let Some(sol) = timed(Stage::Lu, || lu_solve(&jac, n, &neg)) else {
             finish(&x, &mut out, Status::Singular, rn, f64::INFINITY, it - 1);
-            return (out, factorizations);
+            return out;
         };
-        if let Some(f) = &lu {
-            out.pivot_ratio = f.pivot_ratio;
-        }
+        out.pivot_ratio = sol.pivot_ratio;
+        let dx = sol.x;
         // Backtracking on ||R||_2, for which the Newton direction is a descent direction
         // (the max-norm need not fall even when the step is good).
         let merit = l2(&r);
@@ -1249,77 +1180,30 @@ fn solve_with<D: Dynamics + ?Sized>(
             lam *= 0.5;
         }
         if !accepted {
-            if was_chord {
-                undo_chord_run!();
-            }
             finish(&x, &mut out, Status::Diverged, rn, max_abs(&dx), it);
-            return (out, factorizations);
+            return out;
         }
         let step = lam * max_abs(&dx);
         x.copy_from_slice(&xt);
         rn = rtn;
         if max_abs(&x) > 1e8 * scale0 {
-            if was_chord {
-                undo_chord_run!();
-            }
             finish(&x, &mut out, Status::Diverged, rn, step, it);
-            return (out, factorizations);
+            return out;
         }
-        let scale = max_abs(&x).max(1.0);
-        if was_chord {
-            // The contraction a chord step shows (after the first) counts as well.
-            if chord_run > 0 {
-                theta = theta.max(step / chord_last);
-            }
-            chord_run += 1;
-            chord_last = step;
-        }
-        let mut converged = rn <= opts.tol && step <= opts.step_tol * scale;
-        if converged && was_chord {
-            // What a chord step leaves is about the next one, `theta` times its own.
-            converged = lam == 1.0 && theta * step <= f64::EPSILON * scale;
-        }
-        if converged {
+        if rn <= opts.tol && step <= opts.step_tol * max_abs(&x).max(1.0) {
             finish(&x, &mut out, Status::Converged, rn, step, it);
-            return (out, factorizations);
+            return out;
         }
         // The accepted point is the last one the line search evaluated: its residual
         // is `rt` and its samples are still in `sys`, so only the Jacobian is new.
         r.copy_from_slice(&rt);
-        if was_chord {
-            // On with the same factors while they contract fast, a few steps at most
-            // (the first chord step stands for a Newton step: well below the last).
-            let contracting = if chord_run == 1 {
-                step <= 0.1 * last
-            } else {
-                theta <= 1e-2
-            };
-            if !(lam == 1.0 && contracting && chord_run < 4) {
-                undo_chord_run!();
-            }
-        } else {
-            let prev = last;
-            last = if lam == 1.0 { step } else { f64::NAN };
-            // Chord steps next when the quadratic rate the last two Newton steps show
-            // makes the factors at hand contract by 1e-3 or better (NaN compares false).
-            // The run (at most 4 steps) ends before max_iter.
-            theta = 2.0 * (last / (prev * prev)) * last;
-            stale = chord && last < prev && theta <= 1e-3 && it + 5 <= opts.max_iter;
-            (chord_run, chord_last) = (0, f64::NAN);
-            if stale {
-                saved.0.clone_from(&x);
-                saved.1 = it;
-            }
-        }
-        if !stale {
-            sys.jacobian_after_residual(&x, &mut jac);
-        }
+        sys.jacobian_after_residual(&x, &mut jac);
         rn = max_abs(&r);
         if it == opts.max_iter {
             finish(&x, &mut out, Status::MaxIterations, rn, step, it);
         }
     }
-    (out, factorizations)
+    out
 }
 
 /// Nanoseconds spent in certificate checks by this process (all threads): what
@@ -1758,118 +1642,6 @@ mod tests {
             }
         }
         println!("largest gap relative to the largest entry: {worst:.1e}");
-    }
-
-    /// Warm starts of the standard R-R orbit (Omega 1.2 from the orbit at 1.19, as a
-    /// scan's neighbour gives it) and a cold Van der Pol start, at N where a chord step
-    /// may end the solve.
-    fn chord_cases() -> Vec<(Box<dyn Dynamics>, HbSolution, usize)> {
-        use crate::model::Planar;
-        use crate::periodic::{periodic, PeriodicOptions};
-        let near = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.19, &[1.0, 1.0]).unwrap();
-        let seed = periodic(&near, &[true, true], None, &PeriodicOptions::default()).sol;
-        assert_eq!(seed.status, Status::Converged);
-        let mut out: Vec<(Box<dyn Dynamics>, HbSolution, usize)> = vec![];
-        for nh in [4, 6, 8, 12] {
-            let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
-            out.push((Box::new(p), seed.resized(nh), nh));
-            let mut coeffs = vec![0.0; 2 * nh + 1];
-            coeffs[1] = 1.8;
-            let vdp = HbSolution::start(0.95, coeffs, vec![0.0], nh, Status::Converged);
-            out.push((Box::new(Vdp(0.1)), vdp, nh));
-        }
-        out
-    }
-
-    #[test]
-    fn a_final_chord_step_ends_where_newton_ends() {
-        // The same solves with Newton steps only (a fresh Jacobian and LU at every
-        // iteration, the iteration before the chord step existed) are the reference:
-        // chord steps must save a factorisation on the warm N = 8 solve and leave the
-        // solution within round-off of Newton's, with the same status.
-        let mut chords = 0;
-        for (model, guess, nh) in chord_cases() {
-            let opts = HbOptions {
-                n_harm: nh,
-                ..Default::default()
-            };
-            let (c, fc) = solve_with(model.as_ref(), &guess, &opts, true);
-            let (nw, fnw) = solve_with(model.as_ref(), &guess, &opts, false);
-            assert_eq!(nw.status, Status::Converged, "N {nh}");
-            assert_eq!(c.status, nw.status, "N {nh}");
-            assert_eq!(fnw, nw.iterations, "Newton factors once per iteration");
-            assert!(fc <= fnw, "N {nh}: {fc} vs {fnw}");
-            // A Newton step's worth of chord steps: one or two.
-            assert!(
-                c.iterations - fc <= 2 * (fnw - fc),
-                "N {nh}: {} iterations",
-                c.iterations
-            );
-            chords += fnw - fc;
-            if model.ndof() == 4 && nh == 8 {
-                assert_eq!(fc + 1, fnw, "the warm N = 8 solve ends with chord steps");
-            }
-            let scale = nw.coeffs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-            let worst = c
-                .coeffs
-                .iter()
-                .zip(&nw.coeffs)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
-            assert!(
-                worst <= 8.0 * f64::EPSILON * scale,
-                "N {nh}: coefficients {worst:e}"
-            );
-            assert!(
-                (c.omega - nw.omega).abs() <= 8.0 * f64::EPSILON * nw.omega,
-                "N {nh}: omega {} vs {}",
-                c.omega,
-                nw.omega
-            );
-        }
-        assert!(chords >= 4, "chord steps taken: {chords}");
-    }
-
-    #[test]
-    fn n3_solves_take_no_chord_step() {
-        // N <= DIRECT_PROJECTION_MAX_HARM iterates as the saved scans did: one
-        // factorisation per iteration.
-        use crate::model::Planar;
-        use crate::periodic::{periodic, PeriodicOptions};
-        let near = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.19, &[1.0, 1.0]).unwrap();
-        let seed = periodic(&near, &[true, true], None, &PeriodicOptions::default()).sol;
-        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
-        let opts = HbOptions::default();
-        let (a, fa) = solve_with(&p, &seed, &opts, opts.n_harm > DIRECT_PROJECTION_MAX_HARM);
-        let b = solve(&p, &seed, &opts);
-        assert_eq!(a.status, Status::Converged);
-        assert_eq!(fa, a.iterations);
-        assert_eq!(a.omega.to_bits(), b.omega.to_bits());
-    }
-
-    /// Newton's steps and residuals per iteration on the chord test's cases (`--ignored
-    /// --nocapture`): the solve stopped after 1, 2, ... iterations.
-    #[test]
-    #[ignore]
-    fn newton_trace() {
-        for (model, guess, nh) in chord_cases() {
-            for chord in [false, true] {
-                let mut line = format!("d {} N {nh:>2} chord {chord:>5}:", model.ndof());
-                for k in 1..=8 {
-                    let opts = HbOptions {
-                        n_harm: nh,
-                        max_iter: k,
-                        ..Default::default()
-                    };
-                    let (s, f) = solve_with(model.as_ref(), &guess, &opts, chord);
-                    line += &format!(" [{k}: step {:.1e} res {:.1e} lu {f}]", s.step, s.residual);
-                    if s.status == Status::Converged {
-                        break;
-                    }
-                }
-                println!("{line}");
-            }
-        }
     }
 
     #[test]

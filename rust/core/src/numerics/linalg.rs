@@ -32,8 +32,8 @@ enum Factors {
     Blocked(crate::numerics::blocked_lu::BlockedLu),
 }
 
-/// A partial-pivoting LU factorisation (faer) of a row-major matrix, kept for solves
-/// with several right-hand sides (the chord steps of a Newton iteration).
+/// A partial-pivoting LU factorisation of a row-major matrix (faer's, or the blocked one
+/// for large systems), kept for solves with several right-hand sides.
 pub struct LuFactor {
     lu: Factors,
     n: usize,
