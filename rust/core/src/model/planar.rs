@@ -104,13 +104,26 @@ impl Planar {
 
     #[inline(always)]
     fn forces_impl<const ADD: bool>(&self, om: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        self.forces_trig::<ADD>(om, q, v, |i| q[2 + i].sin_cos(), out);
+    }
+
+    /// [`Self::forces_impl`] with each ball's `(sin, cos)` from `trig`.
+    #[inline(always)]
+    fn forces_trig<const ADD: bool>(
+        &self,
+        om: f64,
+        q: &[f64],
+        v: &[f64],
+        trig: impl Fn(usize) -> (f64, f64),
+        out: &mut [f64],
+    ) {
         let (z, dl) = (self.zeta, self.delta);
         let (x, y, vx, vy) = (q[0], q[1], v[0], v[1]);
         let k = 1.0 - om * om;
         let mut fx = 2.0 * z * vx - 2.0 * om * vy + k * x - 2.0 * z * om * y - self.mu * om * om;
         let mut fy = 2.0 * z * vy + 2.0 * om * vx + k * y + 2.0 * z * om * x;
         for i in 0..self.n_balls() {
-            let (s, c) = q[2 + i].sin_cos();
+            let (s, c) = trig(i);
             let mi = self.m(i);
             let w = om + v[2 + i];
             fx -= mi * w * w * c;
@@ -206,9 +219,15 @@ impl Planar {
     /// Adds the inertia terms `M(q) a` to `out`.
     #[inline(always)]
     pub fn add_inertia(&self, q: &[f64], a: &[f64], out: &mut [f64]) {
+        self.add_inertia_trig(a, |i| q[2 + i].sin_cos(), out);
+    }
+
+    /// [`Self::add_inertia`] with each ball's `(sin, cos)` from `trig`.
+    #[inline(always)]
+    fn add_inertia_trig(&self, a: &[f64], trig: impl Fn(usize) -> (f64, f64), out: &mut [f64]) {
         let (ax, ay) = (a[0], a[1]);
         for i in 0..self.n_balls() {
-            let (s, c) = q[2 + i].sin_cos();
+            let (s, c) = trig(i);
             let mi = self.m(i);
             let ab = a[2 + i];
             out[0] -= mi * s * ab;
@@ -315,6 +334,58 @@ impl Planar {
     }
 }
 
+impl Planar {
+    /// Every ball's `(sin, cos)` of its angle, on the stack up to 16 balls, for `f`:
+    /// the right-hand side and the residual need them in two places each, and the
+    /// trigonometry was a fifth of a scan's instructions when each place computed its own.
+    #[inline(always)]
+    fn with_trig<R>(&self, q: &[f64], f: impl FnOnce(&[(f64, f64)]) -> R) -> R {
+        let n = self.n_balls();
+        let mut buf = [(0.0f64, 0.0f64); 16];
+        let mut heap: Vec<(f64, f64)>;
+        let sc: &mut [(f64, f64)] = if n <= 16 {
+            &mut buf[..n]
+        } else {
+            heap = vec![(0.0, 0.0); n];
+            &mut heap
+        };
+        for (i, x) in sc.iter_mut().enumerate() {
+            *x = q[2 + i].sin_cos();
+        }
+        f(sc)
+    }
+
+    /// [`Dynamics::solve_mass`] with each ball's `(sin, cos)` given.
+    #[inline(always)]
+    fn solve_mass_trig(&self, trig: &[(f64, f64)], rhs: &mut [f64]) {
+        // The mass matrix is an arrow: eliminate the ball rows (Schur complement)
+        // and solve the remaining 2 x 2 system, O(n) instead of a dense LU.
+        let n = self.n_balls();
+        let dl = self.delta;
+        let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
+        let (mut r1, mut r2) = (rhs[0], rhs[1]);
+        for i in 0..n {
+            let (s, c) = trig[i];
+            let mi = self.m(i);
+            let rb = rhs[2 + i];
+            a11 -= mi * s * s / dl;
+            a12 += mi * s * c / dl;
+            a22 -= mi * c * c / dl;
+            r1 += mi * s * rb / dl;
+            r2 -= mi * c * rb / dl;
+        }
+        let det = a11 * a22 - a12 * a12;
+        let ax = (r1 * a22 - a12 * r2) / det;
+        let ay = (a11 * r2 - a12 * r1) / det;
+        rhs[0] = ax;
+        rhs[1] = ay;
+        for i in 0..n {
+            let (s, c) = trig[i];
+            rhs[2 + i] = (rhs[2 + i] + s * ax - c * ay) / dl;
+        }
+    }
+}
+
 /// `*x = v`, or `*x += v` when adding into a sum of components.
 #[inline(always)]
 fn put<const ADD: bool>(x: &mut f64, v: f64) {
@@ -331,8 +402,10 @@ impl Dynamics for Planar {
     }
 
     fn residual(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
-        self.forces(q, v, out);
-        self.add_inertia(q, a, out);
+        self.with_trig(q, |sc| {
+            self.forces_trig::<false>(self.omega_s, q, v, |i| sc[i], out);
+            self.add_inertia_trig(a, |i| sc[i], out);
+        });
     }
 
     fn jacobians(
@@ -353,31 +426,7 @@ impl Dynamics for Planar {
     }
 
     fn solve_mass(&self, _t: f64, q: &[f64], rhs: &mut [f64]) {
-        // The mass matrix is an arrow: eliminate the ball rows (Schur complement)
-        // and solve the remaining 2 x 2 system, O(n) instead of a dense LU.
-        let n = self.n_balls();
-        let dl = self.delta;
-        let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
-        let (mut r1, mut r2) = (rhs[0], rhs[1]);
-        for i in 0..n {
-            let (s, c) = q[2 + i].sin_cos();
-            let mi = self.m(i);
-            let rb = rhs[2 + i];
-            a11 -= mi * s * s / dl;
-            a12 += mi * s * c / dl;
-            a22 -= mi * c * c / dl;
-            r1 += mi * s * rb / dl;
-            r2 -= mi * c * rb / dl;
-        }
-        let det = a11 * a22 - a12 * a12;
-        let ax = (r1 * a22 - a12 * r2) / det;
-        let ay = (a11 * r2 - a12 * r1) / det;
-        rhs[0] = ax;
-        rhs[1] = ay;
-        for i in 0..n {
-            let (s, c) = q[2 + i].sin_cos();
-            rhs[2 + i] = (rhs[2 + i] + s * ax - c * ay) / dl;
-        }
+        self.with_trig(q, |trig| self.solve_mass_trig(trig, rhs));
     }
 
     fn solve_mass_columns(&self, _t: f64, q: &[f64], cols: &mut [f64]) {
@@ -423,10 +472,12 @@ impl Dynamics for Planar {
         }
     }
 
-    fn accel(&self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
-        self.forces(q, v, out);
-        out.iter_mut().for_each(|g| *g = -*g);
-        self.solve_mass(t, q, out);
+    fn accel(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
+        self.with_trig(q, |sc| {
+            self.forces_trig::<false>(self.omega_s, q, v, |i| sc[i], out);
+            out.iter_mut().for_each(|g| *g = -*g);
+            self.solve_mass_trig(sc, out);
+        });
     }
 }
 
