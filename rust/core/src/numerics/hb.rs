@@ -10,7 +10,7 @@
 //! `sin tau` coefficient of `x` is zero (spec section 4).
 
 use crate::continuation::Secant;
-use crate::linalg::lu_solve;
+use crate::linalg::LuWork;
 use crate::model::Dynamics;
 use crate::numerics::problem::{At, ModelAt, Problem};
 use std::f64::consts::PI;
@@ -282,12 +282,30 @@ impl HbSolution {
 
     /// `q, dq/dtau, d2q/dtau2` at phase `tau`.
     pub fn eval(&self, tau: f64, q: &mut [f64], qt: &mut [f64], qtt: &mut [f64]) {
-        let sc = tau.sin_cos();
-        for j in 0..self.ndof() {
-            let (a, b, c) = eval_series_sc(self.coord(j), self.winding[j], tau, sc);
-            q[j] = a;
-            qt[j] = b;
-            qtt[j] = c;
+        // `eval_series_sc` coordinate by coordinate, with the harmonics outermost so that
+        // the rotation recurrence (the same for every coordinate) runs once: the same
+        // operations on each coordinate's sums in the same order, so the same values.
+        let (s1, c1) = tau.sin_cos();
+        let (d, l) = (self.ndof(), 2 * self.n_harm + 1);
+        let (q, qt, qtt) = (&mut q[..d], &mut qt[..d], &mut qtt[..d]);
+        for j in 0..d {
+            let w = self.winding[j];
+            q[j] = self.coeffs[j * l] + w * tau;
+            qt[j] = w;
+            qtt[j] = 0.0;
+        }
+        let (mut sm, mut cm) = (0.0f64, 1.0f64);
+        for m in 1..=self.n_harm {
+            let (ns, nc) = (sm * c1 + cm * s1, cm * c1 - sm * s1);
+            sm = ns;
+            cm = nc;
+            let mf = m as f64;
+            for j in 0..d {
+                let (a, b) = (self.coeffs[j * l + 2 * m - 1], self.coeffs[j * l + 2 * m]);
+                q[j] += a * cm + b * sm;
+                qt[j] += mf * (-a * sm + b * cm);
+                qtt[j] -= mf * mf * (a * cm + b * sm);
+            }
         }
     }
 
@@ -670,13 +688,10 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         }
         // Galerkin projection.
         r.fill(0.0);
-        for i in 0..s {
-            let w = &self.basis.wgt[i * l..(i + 1) * l];
-            for j in 0..d {
-                let fj = self.f[i * d + j];
-                let row = &mut r[j * l..(j + 1) * l];
-                for p in 0..l {
-                    row[p] += w[p] * fj;
+        for (w, f) in self.basis.wgt.chunks_exact(l).zip(self.f.chunks_exact(d)) {
+            for (row, fj) in r[..d * l].chunks_exact_mut(l).zip(f) {
+                for (rp, wp) in row.iter_mut().zip(w) {
+                    *rp += wp * fj;
                 }
             }
         }
@@ -841,10 +856,14 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         // its constant at k = 0 and none above (sum_i cos k tau_i = 0 for 0 < k < S).
         let e3 = 3 * dd;
         let (mut varying, mut constant) = (Vec::with_capacity(e3), Vec::with_capacity(e3));
-        for e in 0..e3 {
+        // Entries that are zero at every sample: a block whose `K, C, M` entries all are
+        // is [`Self::zero_block`] (read here instead of scanning the samples again).
+        let mut zero = vec![false; e3];
+        for (e, is_zero) in zero.iter_mut().enumerate() {
             let first = self.kcm[e];
             if (1..s).all(|i| self.kcm[i * e3 + e] == first) {
                 constant.push((e, first));
+                *is_zero = first == 0.0;
             } else {
                 varying.push(e);
             }
@@ -882,24 +901,30 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         let mut work = vec![0.0; 8 * e];
         let (ext, rest) = work.split_at_mut(6 * e);
         let (ac, as_) = rest.split_at_mut(e);
+        let mut entries = vec![0.0; 4 * nh];
         for j in 0..d {
             for k in 0..d {
                 if crate::cancel::cancelled() {
                     return false;
                 }
-                if self.zero_block(j, k) {
+                let idx = j * d + k;
+                if zero[idx] && zero[dd + idx] && zero[2 * dd + idx] {
                     zero_block_of(jac, n, l, j, k);
                     continue;
                 }
-                let idx = j * d + k;
                 for x in 0..3 {
                     let c = &self.coef[(x * dd + idx) * 2 * w..(x * dd + idx + 1) * 2 * w];
+                    let (cos, sin) = c.split_at(w);
                     let (ce, se) = ext[2 * x * e..(2 * x + 2) * e].split_at_mut(e);
-                    for h in 0..w {
-                        ce[z + h] = c[h];
-                        ce[z - h] = c[h];
-                        se[z + h] = c[w + h];
-                        se[z - h] = -c[w + h];
+                    // h >= 0 at z + h, then h <= 0 at z - h (the sines negated), h = 0
+                    // written last by the second, as entry by entry before.
+                    ce[z..].copy_from_slice(cos);
+                    se[z..].copy_from_slice(sin);
+                    for (v, c) in ce[..=z].iter_mut().rev().zip(cos) {
+                        *v = *c;
+                    }
+                    for (v, c) in se[..=z].iter_mut().rev().zip(sin) {
+                        *v = -c;
                     }
                 }
                 let (kc, ks) = (&ext[0..e], &ext[e..2 * e]);
@@ -935,17 +960,33 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                     let (pc, ps) = (base + 2 * nn - 1, base + 2 * nn);
                     jac[pc] = inv * (ac[z + nn] - cn * cs[z + nn]);
                     jac[ps] = inv * (as_[z + nn] + cn * cc[z + nn]);
-                    for m in 1..=nh {
-                        // m - n and m + n as indices
-                        let (dm, sm) = (z + m - nn, z + m + nn);
-                        let (rc, rs) = ((2 * m - 1) * n, 2 * m * n);
-                        // cos m cos n = (cos(m-n) + cos(m+n))/2, cos m sin n =
-                        // (sin(m+n) - sin(m-n))/2, sin m cos n = (sin(m+n) + sin(m-n))/2,
-                        // sin m sin n = (cos(m-n) - cos(m+n))/2.
-                        jac[rc + pc] = inv * (ac[dm] + ac[sm] - cn * (cs[sm] - cs[dm]));
-                        jac[rc + ps] = inv * (as_[sm] - as_[dm] + cn * (cc[dm] + cc[sm]));
-                        jac[rs + pc] = inv * (as_[sm] + as_[dm] - cn * (cc[dm] - cc[sm]));
-                        jac[rs + ps] = inv * (ac[dm] - ac[sm] + cn * (cs[sm] + cs[dm]));
+                    // Rows m = 1..N read the harmonics m - n (`lo`) and m + n (`hi`): both
+                    // runs are contiguous, so the four entries are computed for all m
+                    // from slices (no per-entry index arithmetic or bounds checks; the
+                    // same expression per entry, so the same values) and then stored
+                    // down the block's two columns.
+                    // cos m cos n = (cos(m-n) + cos(m+n))/2, cos m sin n =
+                    // (sin(m+n) - sin(m-n))/2, sin m cos n = (sin(m+n) + sin(m-n))/2,
+                    // sin m sin n = (cos(m-n) - cos(m+n))/2.
+                    let (lo, hi) = (z + 1 - nn..z + nh + 1 - nn, z + 1 + nn..z + nh + 1 + nn);
+                    let (acd, acs) = (&ac[lo.clone()], &ac[hi.clone()]);
+                    let (asd, ass) = (&as_[lo.clone()], &as_[hi.clone()]);
+                    let (ccd, ccs) = (&cc[lo.clone()], &cc[hi.clone()]);
+                    let (csd, css) = (&cs[lo], &cs[hi]);
+                    let (t_cc, rest) = entries.split_at_mut(nh);
+                    let (t_cs, rest) = rest.split_at_mut(nh);
+                    let (t_sc, t_ss) = rest.split_at_mut(nh);
+                    for i in 0..nh {
+                        t_cc[i] = inv * (acd[i] + acs[i] - cn * (css[i] - csd[i]));
+                        t_cs[i] = inv * (ass[i] - asd[i] + cn * (ccd[i] + ccs[i]));
+                        t_sc[i] = inv * (ass[i] + asd[i] - cn * (ccd[i] - ccs[i]));
+                        t_ss[i] = inv * (acd[i] - acs[i] + cn * (css[i] + csd[i]));
+                    }
+                    for (i, rows) in jac[pc + n..].chunks_mut(2 * n).take(nh).enumerate() {
+                        rows[0] = t_cc[i];
+                        rows[1] = t_cs[i];
+                        rows[n] = t_sc[i];
+                        rows[n + 1] = t_ss[i];
                     }
                 }
             }
@@ -962,17 +1003,23 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
         // Summed in a contiguous column (sample by sample from zero, as the strided
         // column of `jac` was: the same sums).
         let mut col = vec![0.0; d * l];
+        // `2 omega M` is `(2 omega) M`: the product taken once gives the same values.
+        let om2 = 2.0 * om;
         for i in 0..s {
             let w = &self.basis.wgt[i * l..(i + 1) * l];
             let kcm = &self.kcm[i * 3 * dd..(i + 1) * 3 * dd];
+            let (cm, mm) = (&kcm[dd..2 * dd], &kcm[2 * dd..3 * dd]);
             let (qt, qtt) = (&self.qt[i * d..(i + 1) * d], &self.qtt[i * d..(i + 1) * d]);
-            for j in 0..d {
+            for ((crow, mrow), cj) in cm
+                .chunks_exact(d)
+                .zip(mm.chunks_exact(d))
+                .zip(col.chunks_exact_mut(l))
+            {
                 let mut dfo = 0.0;
-                for k in 0..d {
-                    let o = j * d + k;
-                    dfo += kcm[o + dd] * qt[k] + 2.0 * om * kcm[o + 2 * dd] * qtt[k];
+                for ((cv, mv), (qk, qkk)) in crow.iter().zip(mrow).zip(qt.iter().zip(qtt)) {
+                    dfo += cv * qk + om2 * mv * qkk;
                 }
-                for (c, wr) in col[j * l..(j + 1) * l].iter_mut().zip(w) {
+                for (c, wr) in cj.iter_mut().zip(w) {
                     *c += wr * dfo;
                 }
             }
@@ -1092,6 +1139,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
     let mut r = vec![0.0; n];
     let mut rt = vec![0.0; n];
     let mut jac = vec![0.0; n * n];
+    let mut lu = LuWork::new(n);
     let mut out = HbSolution {
         omega: g.omega,
         coeffs: g.coeffs.clone(),
@@ -1146,7 +1194,7 @@ pub fn solve<D: Dynamics + ?Sized>(model: &D, guess: &HbSolution, opts: &HbOptio
         }
         let neg: Vec<f64> = r.iter().map(|v| -v).collect();
         count(1);
-        let Some(sol) = timed(Stage::Lu, || lu_solve(&jac, n, &neg)) else {
+        let Some(sol) = timed(Stage::Lu, || lu.solve(&jac, &neg)) else {
             finish(&x, &mut out, Status::Singular, rn, f64::INFINITY, it - 1);
             return out;
         };
@@ -1642,6 +1690,41 @@ mod tests {
             }
         }
         println!("largest gap relative to the largest entry: {worst:.1e}");
+    }
+
+    #[test]
+    fn solution_evaluation_is_the_series_coordinate_by_coordinate() {
+        // `HbSolution::eval` shares one rotation recurrence between the coordinates; each
+        // coordinate must still be `eval_series` to the bit, and `eval_series` the
+        // closed form `w tau + a_0 + sum a_m cos m tau + b_m sin m tau` to round-off.
+        let (n_harm, d) = (8, 3);
+        let l = 2 * n_harm + 1;
+        let coeffs: Vec<f64> = (0..d * l)
+            .map(|k| ((k * 37 % 23) as f64 - 11.0) / 7.0)
+            .collect();
+        let sol = HbSolution::start(1.3, coeffs, vec![-1.0, 0.0, 2.0], n_harm, Status::Converged);
+        let (mut q, mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+        for k in 0..50 {
+            let tau = 0.37 * k as f64 - 3.0;
+            sol.eval(tau, &mut q, &mut qt, &mut qtt);
+            for j in 0..d {
+                let c = sol.coord(j);
+                let (a, b, e) = eval_series(c, sol.winding[j], tau);
+                assert_eq!(
+                    [q[j], qt[j], qtt[j]].map(f64::to_bits),
+                    [a, b, e].map(f64::to_bits)
+                );
+                let exact: f64 = sol.winding[j] * tau
+                    + c[0]
+                    + (1..=n_harm)
+                        .map(|m| {
+                            let mt = m as f64 * tau;
+                            c[2 * m - 1] * mt.cos() + c[2 * m] * mt.sin()
+                        })
+                        .sum::<f64>();
+                assert!((a - exact).abs() < 1e-12, "tau {tau}: {a} against {exact}");
+            }
+        }
     }
 
     #[test]

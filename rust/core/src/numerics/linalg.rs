@@ -110,6 +110,89 @@ pub fn lu_solve(a: &[f64], n: usize, b: &[f64]) -> Option<LuSolve> {
     })
 }
 
+/// Storage for repeated LU solves of systems of one size (Newton's iterations): the
+/// factorisation of [`lu_solve`] without its per-call allocations.
+///
+/// faer's `PartialPivLu` copies the matrix, factors it in place and then copies the
+/// factors apart into `L` and `U` (zeroing the other triangles) before a solve reads
+/// them; here the same `lu_in_place` factors the same column-major copy (a matrix of the
+/// same shape, so the same layout) and the triangular solves read the factors where they
+/// are: the unit-lower solve reads only the strict lower triangle and the upper one only
+/// the upper triangle and diagonal, so the values, and every rounding, are those of
+/// [`lu_solve`]. Systems of [`BLOCKED_MIN_ROWS`](crate::numerics::blocked_lu::BLOCKED_MIN_ROWS)
+/// rows or more go to [`lu_solve`] (its cancellable factorisation).
+pub struct LuWork {
+    n: usize,
+    lu: Mat<f64>,
+    fwd: Vec<usize>,
+    bwd: Vec<usize>,
+    scratch: faer::dyn_stack::MemBuffer,
+}
+
+impl LuWork {
+    pub fn new(n: usize) -> Self {
+        use faer::linalg::lu::partial_pivoting::factor::lu_in_place_scratch;
+        let small = n < crate::numerics::blocked_lu::BLOCKED_MIN_ROWS;
+        let m = if small { n } else { 0 };
+        LuWork {
+            n,
+            lu: Mat::zeros(m, m),
+            fwd: vec![0; m],
+            bwd: vec![0; m],
+            scratch: faer::dyn_stack::MemBuffer::new(lu_in_place_scratch::<usize, f64>(
+                m,
+                m,
+                faer::Par::Seq,
+                Default::default(),
+            )),
+        }
+    }
+
+    /// [`lu_solve`]`(a, n, b)`: the same solution and pivot ratio, or `None` in the same
+    /// cases.
+    pub fn solve(&mut self, a: &[f64], b: &[f64]) -> Option<LuSolve> {
+        use faer::linalg::lu::partial_pivoting::factor::lu_in_place;
+        use faer::linalg::triangular_solve::{
+            solve_unit_lower_triangular_in_place, solve_upper_triangular_in_place,
+        };
+        let n = self.n;
+        if n >= crate::numerics::blocked_lu::BLOCKED_MIN_ROWS {
+            return lu_solve(a, n, b);
+        }
+        self.lu
+            .copy_from(faer::MatRef::from_row_major_slice(&a[..n * n], n, n));
+        lu_in_place(
+            self.lu.as_mut(),
+            &mut self.fwd,
+            &mut self.bwd,
+            faer::Par::Seq,
+            faer::dyn_stack::MemStack::new(&mut self.scratch),
+            Default::default(),
+        );
+        let (mut umax, mut umin) = (0.0f64, f64::INFINITY);
+        for i in 0..n {
+            let v = self.lu[(i, i)].abs();
+            umax = umax.max(v);
+            umin = umin.min(v);
+        }
+        if !(umin > umax * 1e-15) || !umax.is_finite() {
+            return None;
+        }
+        // Row i of P b is row fwd[i] of b, as faer's permutation of the right-hand side.
+        let mut rhs = Mat::<f64>::from_fn(n, 1, |i, _| b[self.fwd[i]]);
+        solve_unit_lower_triangular_in_place(self.lu.as_ref(), rhs.as_mut(), faer::Par::Seq);
+        solve_upper_triangular_in_place(self.lu.as_ref(), rhs.as_mut(), faer::Par::Seq);
+        let x: Vec<f64> = (0..n).map(|i| rhs[(i, 0)]).collect();
+        if x.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        Some(LuSolve {
+            x,
+            pivot_ratio: umax / umin,
+        })
+    }
+}
+
 /// First-order state matrix `A = [[0, I], [-M^-1 K, -M^-1 C]]` (row-major, `2d x 2d`),
 /// using the model's own mass solve; `cols` is scratch of length `2 d^2`.
 pub fn state_matrix<D: Dynamics + ?Sized>(
@@ -185,5 +268,46 @@ mod tests {
                 assert_eq!(got.x[i].to_bits(), sol[(i, 0)].to_bits(), "n {n} x[{i}]");
             }
         }
+    }
+
+    #[test]
+    fn reused_lu_work_solves_as_faer_to_the_bit() {
+        // faer's own `PartialPivLu` solve (separate L and U) against the in-place
+        // factors, three matrices per workspace (its reuse), small diagonals so that
+        // rows are swapped; sizes around faer's block sizes and the HB sizes 29, 69.
+        for n in [1, 2, 5, 17, 29, 33, 69, 101] {
+            let mut work = LuWork::new(n);
+            for round in 0..3usize {
+                let a: Vec<f64> = (0..n * n)
+                    .map(|k| {
+                        let r = ((k * 7919 + round * 131) % 1009) as f64 / 1009.0 - 0.5;
+                        if k % (n + 1) == 0 {
+                            1e-3 * r
+                        } else {
+                            r
+                        }
+                    })
+                    .collect();
+                let b: Vec<f64> = (0..n)
+                    .map(|i| (i as f64 * 0.37 + round as f64).sin())
+                    .collect();
+                let lu = faer::MatRef::from_row_major_slice(&a, n, n).partial_piv_lu();
+                let sol = lu.solve(&Mat::<f64>::from_fn(n, 1, |i, _| b[i]));
+                let got = work.solve(&a, &b).unwrap();
+                let want = lu_solve(&a, n, &b).unwrap();
+                assert_eq!(
+                    got.pivot_ratio.to_bits(),
+                    want.pivot_ratio.to_bits(),
+                    "n {n}"
+                );
+                for i in 0..n {
+                    assert_eq!(got.x[i].to_bits(), sol[(i, 0)].to_bits(), "n {n} x[{i}]");
+                }
+            }
+        }
+        let mut work = LuWork::new(2);
+        assert!(work.solve(&[1.0, 2.0, 2.0, 4.0], &[1.0, 1.0]).is_none());
+        let s = work.solve(&[2.0, 1.0, 1.0, 3.0], &[3.0, 5.0]).unwrap();
+        assert!((s.x[0] - 0.8).abs() < 1e-14 && (s.x[1] - 1.4).abs() < 1e-14);
     }
 }
