@@ -3,7 +3,7 @@
 //! scan knows only the trait.
 
 use crate::equilibria::{
-    equilibria, perfect_balance_verdict, Equilibrium, EquilibriumKind, Verdict,
+    equal_balls, equilibria, perfect_balance_verdict, Equilibrium, EquilibriumKind, Verdict,
 };
 use crate::error::Result;
 use crate::model::ParamRef;
@@ -19,6 +19,13 @@ pub trait Family: Parametric {
     /// asks it at every point).
     fn balance_verdict(&self) -> Option<Verdict> {
         self.balance().map(|e| e.verdict)
+    }
+    /// Equilibria that attract their neighbourhood, as `(positions, rate)` with `rate`
+    /// minus the largest real part of their eigenvalues (none neutral), where the model
+    /// has them cheaply (closed forms); a scan's seeds stop on reaching one (see
+    /// [`crate::analysis::attractors::Capture`]). Empty: the seeds wait for rest.
+    fn attracting_rests(&self) -> Vec<(Vec<f64>, f64)> {
+        vec![]
     }
 }
 
@@ -39,6 +46,29 @@ impl Family for Planar {
     }
     fn balance_verdict(&self) -> Option<Verdict> {
         perfect_balance_verdict(self)
+    }
+    fn attracting_rests(&self) -> Vec<(Vec<f64>, f64)> {
+        let n = self.n_balls();
+        let closed =
+            (n == 2 && equal_balls(self) || n == 1 && self.omega_s > 0.0) && self.zeta > 0.0;
+        if !closed {
+            return vec![];
+        }
+        let mut out = vec![];
+        for e in equilibria(self) {
+            if e.verdict != Verdict::Stable || e.neutral > 0 {
+                continue;
+            }
+            let rate = -e.index;
+            if n == 2 {
+                // identical balls: the relabelled state is the same equilibrium
+                let mut s = e.q.clone();
+                s.swap(2, 3);
+                out.push((s, rate));
+            }
+            out.push((e.q, rate));
+        }
+        out
     }
 }
 

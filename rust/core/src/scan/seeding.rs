@@ -4,7 +4,7 @@
 use super::grid::Local;
 use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
 use super::{count, profile, work, Family, Found, Origin, ScanSpec};
-use crate::analysis::attractors::seed_guess;
+use crate::analysis::attractors::{seed_guess, Capture};
 use crate::continuation::Lattice;
 use crate::hb::{solve, HbSolution, Status};
 use crate::periodic::{finish, initial_states};
@@ -94,6 +94,20 @@ pub(super) fn run_seeds<D: Family>(
     let mut order: Vec<usize> = (0..tasks.len()).collect();
     order.sort_by_key(|&i| (pb[tasks[i].0].1, i));
     let t = Instant::now();
+    // Per seed point, the equilibria a start may stop at once it gets close.
+    let mut points: Vec<usize> = tasks.iter().map(|t| t.0).collect();
+    points.dedup();
+    let captures: Vec<Vec<Capture>> = points
+        .par_iter()
+        .map(|&p| {
+            let m = &params[p];
+            m.attracting_rests()
+                .iter()
+                .filter_map(|(q, rate)| Capture::new(m, q, *rate))
+                .collect()
+        })
+        .collect();
+    let captures_of = |p: usize| &captures[points.binary_search(&p).unwrap()];
     let (cands, times): (Vec<Option<(usize, Candidate)>>, Vec<profile::Task>) = order
         .par_iter()
         .with_max_len(1)
@@ -107,7 +121,7 @@ pub(super) fn run_seeds<D: Family>(
                 let model = &params[p];
                 // This point's own states: "at rest in the ground frame" depends on its spin.
                 let y0 = &initial_states(model)[starts[s]];
-                let g = seed_guess(model, y0, n_harm, &spec.opts.guess)?;
+                let g = seed_guess(model, y0, n_harm, &spec.opts.guess, captures_of(p))?;
                 let rot: Vec<bool> = g.winding[model.layout().balls()]
                     .iter()
                     .map(|w| *w != 0.0)
