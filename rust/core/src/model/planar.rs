@@ -435,41 +435,33 @@ impl Dynamics for Planar {
         let n = self.n_balls();
         let d = n + 2;
         let dl = self.delta;
-        let mut sc = [(0.0f64, 0.0f64); 16];
-        let mut sc_heap: Vec<(f64, f64)>;
-        let sc: &mut [(f64, f64)] = if n <= 16 {
-            &mut sc[..n]
-        } else {
-            sc_heap = vec![(0.0, 0.0); n];
-            &mut sc_heap
-        };
-        let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
-        for i in 0..n {
-            let (s, c) = q[2 + i].sin_cos();
-            sc[i] = (s, c);
-            let mi = self.m(i);
-            a11 -= mi * s * s / dl;
-            a12 += mi * s * c / dl;
-            a22 -= mi * c * c / dl;
-        }
-        let det = a11 * a22 - a12 * a12;
-        for col in cols.chunks_mut(d) {
-            let (mut r1, mut r2) = (col[0], col[1]);
-            for i in 0..n {
-                let (s, c) = sc[i];
-                let w = self.m(i) * col[2 + i] / dl;
-                r1 += s * w;
-                r2 -= c * w;
+        self.with_trig(q, |sc| {
+            let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
+            for (i, &(s, c)) in sc.iter().enumerate() {
+                let mi = self.m(i);
+                a11 -= mi * s * s / dl;
+                a12 += mi * s * c / dl;
+                a22 -= mi * c * c / dl;
             }
-            let ax = (r1 * a22 - a12 * r2) / det;
-            let ay = (a11 * r2 - a12 * r1) / det;
-            col[0] = ax;
-            col[1] = ay;
-            for i in 0..n {
-                let (s, c) = sc[i];
-                col[2 + i] = (col[2 + i] + s * ax - c * ay) / dl;
+            let det = a11 * a22 - a12 * a12;
+            for col in cols.chunks_mut(d) {
+                let (mut r1, mut r2) = (col[0], col[1]);
+                for i in 0..n {
+                    let (s, c) = sc[i];
+                    let w = self.m(i) * col[2 + i] / dl;
+                    r1 += s * w;
+                    r2 -= c * w;
+                }
+                let ax = (r1 * a22 - a12 * r2) / det;
+                let ay = (a11 * r2 - a12 * r1) / det;
+                col[0] = ax;
+                col[1] = ay;
+                for i in 0..n {
+                    let (s, c) = sc[i];
+                    col[2 + i] = (col[2 + i] + s * ax - c * ay) / dl;
+                }
             }
-        }
+        });
     }
 
     fn accel(&self, _t: f64, q: &[f64], v: &[f64], out: &mut [f64]) {
