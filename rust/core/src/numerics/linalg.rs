@@ -47,16 +47,11 @@ pub fn lu_factor(a: &[f64], n: usize) -> Option<LuFactor> {
         // `None` also when cancelled: the caller's result is discarded then.
         let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
         let lu = crate::numerics::blocked_lu::BlockedLu::factor(m)?;
-        let (umax, umin) = lu.pivots().fold((0.0f64, f64::INFINITY), |(hi, lo), v| {
-            (hi.max(v), lo.min(v))
-        });
-        if !(umin > umax * 1e-15) || !umax.is_finite() {
-            return None;
-        }
+        let pivot_ratio = pivot_ratio(lu.pivots())?;
         return Some(LuFactor {
             lu: Factors::Blocked(lu),
             n,
-            pivot_ratio: umax / umin,
+            pivot_ratio,
         });
     }
     // faer copies its argument into the matrix it factors; handing it the row-major
@@ -64,20 +59,24 @@ pub fn lu_factor(a: &[f64], n: usize) -> Option<LuFactor> {
     // column-major matrix, so the same factors to the bit).
     let lu = faer::MatRef::from_row_major_slice(&a[..n * n], n, n).partial_piv_lu();
     let u = lu.U();
-    let (mut umax, mut umin) = (0.0f64, f64::INFINITY);
-    for i in 0..n {
-        let v = u[(i, i)].abs();
-        umax = umax.max(v);
-        umin = umin.min(v);
-    }
-    if !(umin > umax * 1e-15) || !umax.is_finite() {
-        return None;
-    }
+    let pivot_ratio = pivot_ratio((0..n).map(|i| u[(i, i)].abs()))?;
     Some(LuFactor {
         lu: Factors::Faer(lu),
         n,
-        pivot_ratio: umax / umin,
+        pivot_ratio,
     })
+}
+
+/// `max |u_ii| / min |u_ii|` of the pivots' moduli, or `None` when the matrix is
+/// numerically singular (a pivot below 1e-15 of the largest, or one not finite).
+fn pivot_ratio(pivots: impl Iterator<Item = f64>) -> Option<f64> {
+    let (umax, umin) = pivots.fold((0.0f64, f64::INFINITY), |(hi, lo), v| {
+        (hi.max(v), lo.min(v))
+    });
+    if !(umin > umax * 1e-15) || !umax.is_finite() {
+        return None;
+    }
+    Some(umax / umin)
 }
 
 impl LuFactor {
@@ -169,15 +168,7 @@ impl LuWork {
             faer::dyn_stack::MemStack::new(&mut self.scratch),
             Default::default(),
         );
-        let (mut umax, mut umin) = (0.0f64, f64::INFINITY);
-        for i in 0..n {
-            let v = self.lu[(i, i)].abs();
-            umax = umax.max(v);
-            umin = umin.min(v);
-        }
-        if !(umin > umax * 1e-15) || !umax.is_finite() {
-            return None;
-        }
+        let pivot_ratio = pivot_ratio((0..n).map(|i| self.lu[(i, i)].abs()))?;
         // Row i of P b is row fwd[i] of b, as faer's permutation of the right-hand side.
         let mut rhs = Mat::<f64>::from_fn(n, 1, |i, _| b[self.fwd[i]]);
         solve_unit_lower_triangular_in_place(self.lu.as_ref(), rhs.as_mut(), faer::Par::Seq);
@@ -186,10 +177,7 @@ impl LuWork {
         if x.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        Some(LuSolve {
-            x,
-            pivot_ratio: umax / umin,
-        })
+        Some(LuSolve { x, pivot_ratio })
     }
 }
 
