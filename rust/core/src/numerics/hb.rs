@@ -105,9 +105,35 @@ pub fn eval_series(c: &[f64], w: f64, tau: f64) -> (f64, f64, f64) {
 
 /// As [`eval_series`] with `sin tau, cos tau` supplied, so that several coordinates at
 /// one phase share a single trigonometric call.
-pub fn eval_series_sc(c: &[f64], w: f64, tau: f64, (s1, c1): (f64, f64)) -> (f64, f64, f64) {
-    let n = (c.len() - 1) / 2;
-    let (mut q, mut qt, mut qtt) = (c[0] + w * tau, w, 0.0);
+pub fn eval_series_sc(c: &[f64], w: f64, tau: f64, sc: (f64, f64)) -> (f64, f64, f64) {
+    let (mut q, mut qt, mut qtt) = ([0.0], [0.0], [0.0]);
+    eval_series_rows(c, &[w], tau, sc, &mut q, &mut qt, &mut qtt);
+    (q[0], qt[0], qtt[0])
+}
+
+/// [`eval_series_sc`] for every coordinate of `coeffs` (one row of `2N + 1` per entry of
+/// `winding`) into `q, qt, qtt`, with the harmonics outermost so that the rotation
+/// recurrence (the same for every coordinate) runs once: the same operations on each
+/// coordinate's sums in the same order as one coordinate alone, so the same values.
+fn eval_series_rows(
+    coeffs: &[f64],
+    winding: &[f64],
+    tau: f64,
+    (s1, c1): (f64, f64),
+    q: &mut [f64],
+    qt: &mut [f64],
+    qtt: &mut [f64],
+) {
+    let d = winding.len();
+    let l = coeffs.len() / d;
+    let n = (l - 1) / 2;
+    let (q, qt, qtt) = (&mut q[..d], &mut qt[..d], &mut qtt[..d]);
+    for j in 0..d {
+        let w = winding[j];
+        q[j] = coeffs[j * l] + w * tau;
+        qt[j] = w;
+        qtt[j] = 0.0;
+    }
     let (mut sm, mut cm) = (0.0f64, 1.0f64);
     for m in 1..=n {
         // cos/sin of m tau by rotation recurrence: no trig call per harmonic.
@@ -115,12 +141,13 @@ pub fn eval_series_sc(c: &[f64], w: f64, tau: f64, (s1, c1): (f64, f64)) -> (f64
         sm = ns;
         cm = nc;
         let mf = m as f64;
-        let (a, b) = (c[2 * m - 1], c[2 * m]);
-        q += a * cm + b * sm;
-        qt += mf * (-a * sm + b * cm);
-        qtt -= mf * mf * (a * cm + b * sm);
+        for j in 0..d {
+            let (a, b) = (coeffs[j * l + 2 * m - 1], coeffs[j * l + 2 * m]);
+            q[j] += a * cm + b * sm;
+            qt[j] += mf * (-a * sm + b * cm);
+            qtt[j] -= mf * mf * (a * cm + b * sm);
+        }
     }
-    (q, qt, qtt)
 }
 
 /// Convergence status of a Newton–IHB solve.
@@ -282,31 +309,7 @@ impl HbSolution {
 
     /// `q, dq/dtau, d2q/dtau2` at phase `tau`.
     pub fn eval(&self, tau: f64, q: &mut [f64], qt: &mut [f64], qtt: &mut [f64]) {
-        // `eval_series_sc` coordinate by coordinate, with the harmonics outermost so that
-        // the rotation recurrence (the same for every coordinate) runs once: the same
-        // operations on each coordinate's sums in the same order, so the same values.
-        let (s1, c1) = tau.sin_cos();
-        let (d, l) = (self.ndof(), 2 * self.n_harm + 1);
-        let (q, qt, qtt) = (&mut q[..d], &mut qt[..d], &mut qtt[..d]);
-        for j in 0..d {
-            let w = self.winding[j];
-            q[j] = self.coeffs[j * l] + w * tau;
-            qt[j] = w;
-            qtt[j] = 0.0;
-        }
-        let (mut sm, mut cm) = (0.0f64, 1.0f64);
-        for m in 1..=self.n_harm {
-            let (ns, nc) = (sm * c1 + cm * s1, cm * c1 - sm * s1);
-            sm = ns;
-            cm = nc;
-            let mf = m as f64;
-            for j in 0..d {
-                let (a, b) = (self.coeffs[j * l + 2 * m - 1], self.coeffs[j * l + 2 * m]);
-                q[j] += a * cm + b * sm;
-                qt[j] += mf * (-a * sm + b * cm);
-                qtt[j] -= mf * mf * (a * cm + b * sm);
-            }
-        }
+        eval_series_rows(&self.coeffs, &self.winding, tau, tau.sin_cos(), q, qt, qtt);
     }
 
     /// First-order state `(q, q')` at time `t` (in units of 1/w_n).
