@@ -256,3 +256,24 @@ def test_auto_harmonics_from_a_non_orbit_certifies_after_refinement():
         else:
             assert s.stability == "undetermined" and s.target_met is not True
     assert outcomes == {True, False}
+
+
+def test_o_o_scan_reports_no_equilibrium_as_an_orbit():
+    """An equilibrium solves the harmonic-balance equations at any omega; O-O scans of
+    the thesis map at zeta 0.02, zeta_b 0.1 used to report eight such series (harmonics
+    at round-off, pivot ratios 1e8 to 3e10) as converged O-O solutions. Every converged
+    O-O row must now move: its highest harmonic is not at round-off and its omega is
+    determined (a well-conditioned Newton matrix)."""
+    b = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0)
+    df = ballbal.scan(b, patterns=["O-O"], N=3, Omega=(1.0, 2.0, 0.1), eta=(0.4, 1.5, 0.1))
+    conv = df.filter((df["status"] == "converged") & (df["type"] == "O-O"))
+    assert conv.height >= 10
+    assert (conv["tail"] > 1e-12).all()
+    assert (conv["pivot_ratio"] < 1e8).all()
+    # The perfect balance those series sat at, in closed form, is an equilibrium of the
+    # model: the solver's own equilibria find it where the thesis puts it.
+    one = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0, eta=(0.7, 0.7),
+                           Omega=1.3)
+    pb = [e for e in ballbal.equilibria(one) if e.kind == "perfect_balance"][0]
+    beta = math.acos(-1.0 / (2 * 0.7))
+    assert np.allclose(np.abs(pb.q), [0.0, 0.0, beta, beta], atol=1e-10)

@@ -444,6 +444,9 @@ def periodic(
       most 4.9, the series near a rotating branch's infinite-period end that are no
       orbits 23 and more) the status is ``not_closed``.
     * ``tail`` above ``max_tail``: status ``truncated`` (N does not resolve the orbit).
+    * A series without winding whose harmonics are at round-off (below 1e-9 of its
+      size) is an equilibrium, which solves the equations at any ``omega``: status
+      ``equilibrium`` (no orbit, no frequency).
     * ``trivial_error``: no stability verdict (``undetermined``) unless the trivial
       multiplier is within ``max_trivial`` of 1; the same for ``hill_stability``.
     * ``separation_error`` (merged balls, i.e. identical balls on the same motion, only):
@@ -451,8 +454,9 @@ def periodic(
       ``exp(-2 zeta_b T)`` (Liouville's formula on the separation mode); above
       ``max_trivial`` the verdict is ``undetermined`` too.
 
-    A ``not_closed`` or ``truncated`` result keeps ``omega`` and ``coeffs`` for
-    inspection but has no multipliers and no verdict. A solve that fails is returned with
+    A ``not_closed``, ``truncated`` or ``equilibrium`` result keeps ``coeffs`` (and,
+    but for an equilibrium, ``omega``) for inspection but has no multipliers and no
+    verdict. A solve that fails is returned with
     its ``status`` (``diverged``, ``singular``, ``max_iterations``, ``no_guess``) and
     ``omega = None``; it never raises for that. Tolerances and margins outside their
     ranges (``rtol`` and ``atol`` in (0, 1), ``margin`` in [0, 1), ``settle`` and

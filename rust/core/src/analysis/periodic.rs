@@ -234,8 +234,9 @@ fn defect_points(sol: &HbSolution) -> usize {
     2 * sol.samples.max(crate::hb::default_samples(sol.n_harm))
 }
 
-/// Certifies a converged series: its status becomes `Truncated` if the highest harmonic
-/// exceeds `max_tail`, `NotClosed` if the integrated defect exceeds `max_closure`.
+/// Certifies a converged series: its status becomes `Equilibrium` if it does not move
+/// ([`HbSolution::is_still`]), `Truncated` if the highest harmonic exceeds `max_tail`,
+/// `NotClosed` if the integrated defect exceeds `max_closure`.
 /// Returns the integrated defect (`None` for a series that did not converge).
 pub fn certify<D: Dynamics + ?Sized>(
     p: &D,
@@ -246,7 +247,9 @@ pub fn certify<D: Dynamics + ?Sized>(
         return None;
     }
     let closure = crate::hb::timed_certificate(|| defect_closure(p, sol, defect_points(sol)));
-    if !(sol.tail_ratio_on(p.layout().support()) <= opts.max_tail) {
+    if sol.is_still() {
+        sol.status = Status::Equilibrium;
+    } else if !(sol.tail_ratio_on(p.layout().support()) <= opts.max_tail) {
         sol.status = Status::Truncated;
     } else if !(closure <= opts.max_closure) {
         sol.status = Status::NotClosed;
@@ -257,7 +260,7 @@ pub fn certify<D: Dynamics + ?Sized>(
 #[derive(Debug, Clone)]
 pub struct Periodic {
     /// The series; its status says whether it converged *and* passed the certificates
-    /// (`NotClosed`, `Truncated` keep the series for inspection).
+    /// (`NotClosed`, `Truncated`, `Equilibrium` keep the series for inspection).
     pub sol: HbSolution,
     /// Integrated ODE defect of the series ([`defect_closure`]), for every series
     /// Newton converged on.
@@ -545,7 +548,7 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
                 Status::Converged if passed.is_some() => passed,
                 Status::Converged => certify(p, &mut sol, opts),
                 // Already certified (and refused) by `periodic`'s search: keep its measure.
-                Status::NotClosed | Status::Truncated => {
+                Status::NotClosed | Status::Truncated | Status::Equilibrium => {
                     Some(defect_closure(p, &sol, defect_points(&sol)))
                 }
                 _ => None,
@@ -822,6 +825,61 @@ mod tests {
 
     fn thesis(om: f64, eta: f64) -> Planar {
         Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap()
+    }
+
+    /// A series that does not move solves the harmonic-balance equations at every
+    /// `omega`: at the perfect balance of two equal balls (closed form: rotor on the
+    /// axis, balls at `+-arccos(-1 / (2 eta))`) the residual is at round-off for any
+    /// frequency, so Newton "converging" there (as O-O scans of the zeta 0.02 maps did,
+    /// with pivot ratios of 1e8 to 3e10) has found no orbit. The certificate says
+    /// `Equilibrium`; the same series with a harmonic of 1e-3 is an orbit candidate the
+    /// other certificates judge.
+    #[test]
+    fn a_series_at_an_equilibrium_is_refused_as_no_orbit() {
+        use crate::hb::HbSystem;
+        let p = Planar::new(0.2, 0.02, &[0.1], 50.0, 1.3, &[0.7, 0.7]).unwrap();
+        let b = (-1.0f64 / (2.0 * 0.7)).acos();
+        let n_harm = 3;
+        let l = 2 * n_harm + 1;
+        let mut coeffs = vec![0.0; 4 * l];
+        coeffs[2 * l] = b;
+        coeffs[3 * l] = -b;
+        let opts = PeriodicOptions::default();
+        for omega in [0.37, 0.9, 2.4] {
+            let mut s = HbSolution::start(
+                omega,
+                coeffs.clone(),
+                vec![0.0; 4],
+                n_harm,
+                Status::Converged,
+            );
+            let mut sys = HbSystem::new(&p, &s.winding, n_harm, crate::hb::default_samples(n_harm));
+            let mut x = s.coeffs.clone();
+            x.push(omega);
+            let mut r = vec![0.0; x.len()];
+            sys.assemble(&x, &mut r, None);
+            let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(worst < 1e-14, "omega {omega}: residual {worst}");
+            assert!(certify(&p, &mut s, &opts).is_some());
+            assert_eq!(s.status, Status::Equilibrium, "omega {omega}");
+        }
+        coeffs[2 * l + 1] = 1e-3;
+        let mut s = HbSolution::start(0.9, coeffs, vec![0.0; 4], n_harm, Status::Converged);
+        assert!(!s.is_still());
+        certify(&p, &mut s, &opts);
+        assert_ne!(s.status, Status::Equilibrium);
+        // A rotating ball's constant series is a uniform rotation, an orbit whose omega
+        // matters: never an equilibrium.
+        let mut rr = HbSolution::start(
+            0.9,
+            vec![0.0; 4 * l],
+            vec![0.0, 0.0, -1.0, -1.0],
+            n_harm,
+            Status::Converged,
+        );
+        assert!(!rr.is_still());
+        certify(&p, &mut rr, &opts);
+        assert_ne!(rr.status, Status::Equilibrium);
     }
 
     /// The thesis' heaviest single ball (eta 1.85) at Omega 1.6: its rotating motion is

@@ -45,7 +45,8 @@ pub const SOLUTION_FIELDS: [&str; 19] = [
 
 /// A solution's values in the order of [`SOLUTION_FIELDS`]. A series that converged
 /// but failed a certificate (`not_closed`, `truncated`) keeps its `omega` for
-/// inspection; its status says why it is not a result.
+/// inspection; its status says why it is not a result. An `equilibrium` has no `omega`
+/// (any value solves its equations).
 pub fn solution_cells(r: &Periodic) -> [Cell; 19] {
     let s = &r.sol;
     let fl = r.floquet.as_ref();

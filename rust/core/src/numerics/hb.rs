@@ -16,6 +16,13 @@ use crate::numerics::problem::{At, ModelAt, Problem};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+/// Relative size of the harmonics below which a series without winding is an
+/// equilibrium ([`Status::Equilibrium`]). On the nine thesis maps at N = 3 the series
+/// Newton converged on in O-O scans had harmonics either of 0.1 to 3 (orbits) or of
+/// 1e-16 to 1e-15 (equilibria, with pivot ratios of 1e8 to 3e10 because `omega` is
+/// free); 1e-9 sits between with six decades to spare on either side.
+pub const STILL: f64 = 1e-9;
+
 /// Coefficient layout per coordinate: `[a_0, a_1, b_1, ..., a_N, b_N]`.
 #[derive(Debug, Clone)]
 pub struct Basis {
@@ -168,6 +175,11 @@ pub enum Status {
     /// Newton converged, but the highest harmonic is too large relative to the motion
     /// ([`HbSolution::tail_ratio`]): `N` does not resolve the orbit.
     Truncated,
+    /// Newton converged on a series that does not move: every coordinate's harmonics
+    /// are at round-off ([`HbSolution::oscillation`]) and no ball winds, so the series
+    /// is an equilibrium, which solves the equations at any `omega` — no periodic orbit
+    /// and no frequency.
+    Equilibrium,
 }
 
 impl Status {
@@ -180,6 +192,7 @@ impl Status {
             Status::NoGuess => "no_guess",
             Status::NotClosed => "not_closed",
             Status::Truncated => "truncated",
+            Status::Equilibrium => "equilibrium",
         }
     }
 }
@@ -355,6 +368,23 @@ impl HbSolution {
             })
             .fold(1.0, f64::max);
         self.tail() / amp
+    }
+
+    /// Largest harmonic coefficient (`a_m, b_m`, `m >= 1`) over the coordinates: how far
+    /// the series moves apart from any winding.
+    pub fn oscillation(&self) -> f64 {
+        (0..self.ndof())
+            .flat_map(|j| self.coord(j)[1..].iter())
+            .fold(0.0, |m, v| m.max(v.abs()))
+    }
+
+    /// Whether the series is an equilibrium rather than an orbit: no coordinate winds
+    /// and the harmonics are below [`STILL`] of the coordinates' size (at least 1).
+    pub fn is_still(&self) -> bool {
+        let size = (0..self.ndof())
+            .map(|j| self.coord(j)[0].abs())
+            .fold(1.0, f64::max);
+        self.winding.iter().all(|w| *w == 0.0) && self.oscillation() <= STILL * size
     }
 
     /// The same solution with `n_harm` harmonics (truncated or zero-padded): a predictor.
