@@ -105,7 +105,7 @@ impl Basis {
 /// and what lies beyond `S - N` aliases onto the retained harmonics. Four samples per
 /// harmonic project products of three series exactly (`S > 4N`); the twenty more cover
 /// the tails of the trigonometric terms. Measured at N = 8 against 144 samples (where
-/// aliasing is at round-off), 2026-11-24: the nine thesis maps' 885 solutions with the
+/// aliasing is at round-off), 2026-11-24: the nine thesis maps' 933 solutions with the
 /// same verdicts, none lost or gained, omega within 6e-11 (`8 (N + 1) = 72` samples:
 /// 5e-15), multipliers within 6e-9 of the 72-sample ones; the period-106 orbit's
 /// coefficients within 3e-16. Up to N = 3 the count is unchanged (scans at N = 3 keep
