@@ -746,7 +746,21 @@ pub fn hill_verdict<D: Dynamics + ?Sized>(
     max_trivial: f64,
     n_max: usize,
 ) -> Result<(Hill, Judgement)> {
-    let r = hill_until(model, sol, hill_verdict_start(sol), n_max, |r| {
+    let r = hill_until(
+        model,
+        sol,
+        hill_verdict_start(sol),
+        n_max,
+        verdict_goal(margin, max_trivial),
+    )?;
+    let j = judge(&r.multipliers, margin.max(r.error), max_trivial);
+    Ok((r, j))
+}
+
+/// The error estimate at which [`hill_verdict`] takes an attempt's verdict as settled
+/// (see there).
+fn verdict_goal(margin: f64, max_trivial: f64) -> impl Fn(&Hill) -> f64 {
+    move |r| {
         let j = judge(&r.multipliers, margin, max_trivial);
         let dist = (j.max_modulus - 1.0).abs();
         let settled = if j.trivial_error <= max_trivial && dist > margin.max(j.trivial_error) {
@@ -755,9 +769,7 @@ pub fn hill_verdict<D: Dynamics + ?Sized>(
             0.0
         };
         HILL_VERDICT_TOL.max(j.trivial_error).max(settled)
-    })?;
-    let j = judge(&r.multipliers, margin.max(r.error), max_trivial);
-    Ok((r, j))
+    }
 }
 
 /// First truncation [`hill_verdict`] tries: `1.5 / sqrt(omega)` harmonics (at least 2),
@@ -1735,16 +1747,7 @@ mod tests {
             max_steps: 10_000_000,
             ..Default::default()
         };
-        let goal = |r: &Hill| {
-            let j = judge(&r.multipliers, margin, max_trivial);
-            let dist = (j.max_modulus - 1.0).abs();
-            let settled = if j.trivial_error <= max_trivial && dist > margin.max(j.trivial_error) {
-                dist / HILL_VERDICT_ROOM
-            } else {
-                0.0
-            };
-            HILL_VERDICT_TOL.max(j.trivial_error).max(settled)
-        };
+        let goal = verdict_goal(margin, max_trivial);
         struct Row {
             label: String,
             omega: f64,
@@ -1773,10 +1776,10 @@ mod tests {
                     [r.error, err, lead]
                 };
                 let h2 = hill_at(p, sol, 2).unwrap();
-                let r = hill_until(p, sol, 2, HILL_MAX, goal).unwrap();
+                let r = hill_until(p, sol, 2, HILL_MAX, &goal).unwrap();
                 let j = judge(&r.multipliers, margin.max(r.error), max_trivial);
                 // the verdict as started before at 3
-                let rn = hill_until(p, sol, start_at(1.5, 3, sol), HILL_MAX, goal).unwrap();
+                let rn = hill_until(p, sol, start_at(1.5, 3, sol), HILL_MAX, &goal).unwrap();
                 let jn = judge(&rn.multipliers, margin.max(rn.error), max_trivial);
                 Some(Row {
                     label: label.clone(),

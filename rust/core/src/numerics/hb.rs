@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 /// Relative size of the harmonics below which a series without winding is an
 /// equilibrium ([`Status::Equilibrium`]). On the nine thesis maps at N = 3 the series
-/// Newton converged on in O-O scans had harmonics either of 0.1 to 3 (orbits) or of
+/// Newton converged on in O-O scans had harmonics either between 0.1 and 10 (orbits) or of
 /// 1e-16 to 1e-15 (equilibria, with pivot ratios of 1e8 to 3e10 because `omega` is
 /// free); 1e-9 sits between with six decades to spare on either side.
 pub const STILL: f64 = 1e-9;
