@@ -360,28 +360,43 @@ impl Planar {
     fn solve_mass_trig(&self, trig: &[(f64, f64)], rhs: &mut [f64]) {
         // The mass matrix is an arrow: eliminate the ball rows (Schur complement)
         // and solve the remaining 2 x 2 system, O(n) instead of a dense LU.
-        let n = self.n_balls();
         let dl = self.delta;
-        let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
+        let schur = self.mass_schur(trig);
         let (mut r1, mut r2) = (rhs[0], rhs[1]);
-        for i in 0..n {
-            let (s, c) = trig[i];
+        for (i, &(s, c)) in trig.iter().enumerate() {
             let mi = self.m(i);
             let rb = rhs[2 + i];
-            a11 -= mi * s * s / dl;
-            a12 += mi * s * c / dl;
-            a22 -= mi * c * c / dl;
             r1 += mi * s * rb / dl;
             r2 -= mi * c * rb / dl;
         }
-        let det = a11 * a22 - a12 * a12;
+        Self::mass_back(trig, dl, schur, r1, r2, rhs);
+    }
+
+    /// The 2 x 2 Schur complement of the mass matrix's ball rows, `[a11, a12, a22, det]`.
+    #[inline(always)]
+    fn mass_schur(&self, trig: &[(f64, f64)]) -> [f64; 4] {
+        let dl = self.delta;
+        let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
+        for (i, &(s, c)) in trig.iter().enumerate() {
+            let mi = self.m(i);
+            a11 -= mi * s * s / dl;
+            a12 += mi * s * c / dl;
+            a22 -= mi * c * c / dl;
+        }
+        [a11, a12, a22, a11 * a22 - a12 * a12]
+    }
+
+    /// The rotor's accelerations from the reduced right-hand side `(r1, r2)`, then the
+    /// balls' by back substitution, into `v` (whose ball entries hold the right-hand side).
+    #[inline(always)]
+    fn mass_back(trig: &[(f64, f64)], dl: f64, schur: [f64; 4], r1: f64, r2: f64, v: &mut [f64]) {
+        let [a11, a12, a22, det] = schur;
         let ax = (r1 * a22 - a12 * r2) / det;
         let ay = (a11 * r2 - a12 * r1) / det;
-        rhs[0] = ax;
-        rhs[1] = ay;
-        for i in 0..n {
-            let (s, c) = trig[i];
-            rhs[2 + i] = (rhs[2 + i] + s * ax - c * ay) / dl;
+        v[0] = ax;
+        v[1] = ay;
+        for (i, &(s, c)) in trig.iter().enumerate() {
+            v[2 + i] = (v[2 + i] + s * ax - c * ay) / dl;
         }
     }
 }
@@ -436,30 +451,15 @@ impl Dynamics for Planar {
         let d = n + 2;
         let dl = self.delta;
         self.with_trig(q, |sc| {
-            let (mut a11, mut a12, mut a22) = (1.0, 0.0, 1.0);
-            for (i, &(s, c)) in sc.iter().enumerate() {
-                let mi = self.m(i);
-                a11 -= mi * s * s / dl;
-                a12 += mi * s * c / dl;
-                a22 -= mi * c * c / dl;
-            }
-            let det = a11 * a22 - a12 * a12;
+            let schur = self.mass_schur(sc);
             for col in cols.chunks_mut(d) {
                 let (mut r1, mut r2) = (col[0], col[1]);
-                for i in 0..n {
-                    let (s, c) = sc[i];
+                for (i, &(s, c)) in sc.iter().enumerate() {
                     let w = self.m(i) * col[2 + i] / dl;
                     r1 += s * w;
                     r2 -= c * w;
                 }
-                let ax = (r1 * a22 - a12 * r2) / det;
-                let ay = (a11 * r2 - a12 * r1) / det;
-                col[0] = ax;
-                col[1] = ay;
-                for i in 0..n {
-                    let (s, c) = sc[i];
-                    col[2 + i] = (col[2 + i] + s * ax - c * ay) / dl;
-                }
+                Self::mass_back(sc, dl, schur, r1, r2, col);
             }
         });
     }
