@@ -1298,6 +1298,16 @@ mod tests {
     use crate::periodic::{periodic, PeriodicOptions};
     use crate::Planar;
 
+    /// The monodromy the tests take as the reference: RK45 at rtol 1e-12.
+    fn tight() -> FloquetOptions {
+        FloquetOptions {
+            rtol: 1e-12,
+            atol: 1e-14,
+            max_steps: 10_000_000,
+            ..Default::default()
+        }
+    }
+
     #[test]
     fn hill_agrees_with_monodromy_on_the_standard_case() {
         hill_agrees(8);
@@ -1345,12 +1355,7 @@ mod tests {
             let p = Planar::new(0.2, 0.05, &[0.05], 50.0, om, &vec![eta; pat.len()]).unwrap();
             let sol = periodic(&p, pat, None, &PeriodicOptions::default()).sol;
             assert_eq!(sol.status, crate::hb::Status::Converged);
-            let tight = FloquetOptions {
-                rtol: 1e-12,
-                atol: 1e-14,
-                max_steps: 10_000_000,
-                ..Default::default()
-            };
+            let tight = tight();
             let reference = floquet(&p, &sol, &tight).unwrap().multipliers;
             for h in 3..=8 {
                 let r = hill_at(&p, &sol, h).unwrap();
@@ -1425,12 +1430,7 @@ mod tests {
             };
             let sol = periodic(&p, pat, None, &opts).sol;
             assert_eq!(sol.status, crate::hb::Status::Converged, "{om} {eta}");
-            let tight = FloquetOptions {
-                rtol: 1e-12,
-                atol: 1e-14,
-                max_steps: 10_000_000,
-                ..Default::default()
-            };
+            let tight = tight();
             let reference = floquet(&p, &sol, &tight).unwrap();
             assert_eq!(reference.stability, Stability::Stable);
             // hill_verdict_start would begin above n_max: the cap is what limits it
@@ -1466,12 +1466,7 @@ mod tests {
                 "{om} {eta}: omega {}",
                 sol.omega
             );
-            let tight = FloquetOptions {
-                rtol: 1e-12,
-                atol: 1e-14,
-                max_steps: 10_000_000,
-                ..Default::default()
-            };
+            let tight = tight();
             let reference = floquet(&p, &sol, &tight).unwrap();
             assert_ne!(reference.stability, Stability::Undetermined, "{om} {eta}");
             let (r, j) = hill_verdict(&p, &sol, 1e-6, MAX_TRIVIAL, HILL_MAX).unwrap();
@@ -1553,12 +1548,7 @@ mod tests {
                     continue;
                 }
                 let sol = r.sol;
-                let tight = FloquetOptions {
-                    rtol: 1e-12,
-                    atol: 1e-14,
-                    max_steps: 10_000_000,
-                    ..Default::default()
-                };
+                let tight = tight();
                 let reference = floquet(&p, &sol, &tight).unwrap();
                 f(name, n_harm, &p, &sol, &reference);
             }
@@ -1684,8 +1674,7 @@ mod tests {
     #[test]
     #[ignore]
     fn hill_h2_study() {
-        use crate::periodic::GuessOptions;
-        use crate::scan::{scan, scan_floquet_default, ScanSpec};
+        use crate::scan::{scan, ScanSpec};
         use rayon::prelude::*;
         let (margin, max_trivial) = (1e-6, MAX_TRIVIAL);
         let mut cases: Vec<(String, Planar, HbSolution)> = vec![];
@@ -1704,26 +1693,11 @@ mod tests {
                 (0..=n).map(|i| lo + step * i as f64).collect()
             };
             let spec = ScanSpec {
-                base: &base,
-                names: vec!["Omega".into(), "eta".into()],
-                values: vec![grid(1.0, 2.0), grid(0.4, 1.5)],
                 patterns: pats.iter().map(|x| x.1.clone()).collect(),
-                opts: PeriodicOptions {
-                    hb: HbOptions::default(),
-                    floquet: Some(scan_floquet_default()),
-                    guess: GuessOptions {
-                        rtol: 1e-6,
-                        atol: 1e-8,
-                        ..Default::default()
-                    },
-                    ..Default::default()
-                },
                 seeds: 4,
-                starts: 2,
                 block: 8,
                 chunk: 8,
-                threads: 2,
-                max_tail: 0.25,
+                ..crate::scan::tests::spec(&base, &grid(1.0, 2.0), &grid(0.4, 1.5), 2)
             };
             for row in scan(&spec).unwrap() {
                 let Some(res) = row.result else { continue };
@@ -1741,12 +1715,7 @@ mod tests {
             }
         }
         println!("{} solutions", cases.len());
-        let tight = FloquetOptions {
-            rtol: 1e-12,
-            atol: 1e-14,
-            max_steps: 10_000_000,
-            ..Default::default()
-        };
+        let tight = tight();
         let goal = verdict_goal(margin, max_trivial);
         struct Row {
             label: String,

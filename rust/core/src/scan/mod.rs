@@ -227,7 +227,7 @@ pub fn scan_floquet_default() -> FloquetOptions {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::waves::{orbit_key, same_orbit};
     use super::*;
     use crate::hb::HbOptions;
@@ -235,7 +235,8 @@ mod tests {
     use crate::periodic::{GuessOptions, PeriodicOptions};
     use crate::{Planar, Scene};
 
-    fn spec<'a, D: Family>(
+    /// A two-parameter (Omega, eta) R-R scan with the scan's defaults, small blocks.
+    pub(crate) fn spec<'a, D: Family>(
         base: &'a D,
         om: &[f64],
         eta: &[f64],
