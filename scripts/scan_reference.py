@@ -77,7 +77,7 @@ def _keyed(df: pl.DataFrame) -> pl.DataFrame:
     return df.with_columns(pl.col("Omega").round(9), pl.col("eta").round(9))
 
 
-def _still(df: pl.DataFrame) -> pl.Expr:
+def _still() -> pl.Expr:
     return ((pl.col("status") == "converged") & (pl.col("type") == "O-O")
             & (pl.col("tail") < STILL_TAIL))
 
@@ -90,9 +90,9 @@ def _renumbered(df: pl.DataFrame) -> pl.DataFrame:
 
 def compare_table(name: str, ref: pl.DataFrame, new: pl.DataFrame) -> tuple[bool, str]:
     ref, new = _keyed(ref), _keyed(new)
-    refused = ref.filter(_still(ref))
-    still_new = new.filter(_still(new))
-    ref = _renumbered(ref.filter(~_still(ref)))
+    refused = ref.filter(_still())
+    still_new = new.filter(_still())
+    ref = _renumbered(ref.filter(~_still()))
     rc = ref.filter(pl.col("status") == "converged")
     nc = new.filter(pl.col("status") == "converged")
     lost = rc.join(nc, on=KEY, how="anti")
