@@ -6,6 +6,12 @@ it cross-checks (RK45 at the scan's rtol 1e-6, and Magnus), at the thesis' stand
 
     python benchmarks/bench_hill.py            # wall clock, medians (a few seconds)
     python benchmarks/bench_hill.py --rust     # also the core's old-vs-new side by side
+    python benchmarks/bench_hill.py --scan     # also the fine-grid scan's Hill settings
+
+``--scan``: the fine grid (101 x 111, R-R, N = 3, zeta = zeta_b = 0.05), one thread,
+CPU time, with ``hill=False``, the default (Hill where the verdict is in doubt,
+``hill_band`` 0.2) and ``hill=True`` (beside every monodromy), twice in turn, with the
+solutions each cross-checks and the extra over ``hill=False``.
 
 The former Hill's method (complex Hill matrix, full eigen-decomposition, truncation
 clamp(N + 4, 8, 24)) is reachable only in the core (``hill_multipliers_dense``); its cost
@@ -21,8 +27,10 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import time
 from pathlib import Path
 
+import polars as pl
 from bench_periodic import match_error, median_time  # the script's own directory
 
 import ballbal
@@ -77,6 +85,29 @@ def case(name: str, b: ballbal.Balancer, seed: ballbal.PeriodicSolution, N: int)
           f"{err_v:.1e}, {hv.hill_stability}); Hill / Magnus {hvl / mg:4.1f}")
 
 
+def scan_settings() -> None:
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
+    grid = {"Omega": (1.0, 2.0, 0.01), "eta": (0.4, 1.5, 0.01)}
+    ballbal.scan(b, patterns=["R-R"], threads=1, Omega=[1.2], eta=[1.0])
+    settings = {"hill=False": {"hill": False}, "default (band)": {}, "hill=True": {"hill": True}}
+    cpu: dict[str, list[float]] = {k: [] for k in settings}
+    checked: dict[str, int] = {}
+    for _ in range(2):
+        for k, kw in settings.items():
+            t = time.process_time()
+            df = ballbal.scan(b, patterns=["R-R"], N=3, threads=1, **grid, **kw)
+            cpu[k].append(time.process_time() - t)
+            ok = df.filter(pl.col("status") == "converged")
+            checked[k] = int(ok["hill_stability"].is_not_null().sum())
+            checked["solutions"] = ok.height
+    base = min(cpu["hill=False"])
+    print(f"\nfine grid, R-R, N = 3, one thread, CPU s (best of 2), "
+          f"{checked['solutions']} solutions:")
+    for k in settings:
+        print(f"  {k:<15} {min(cpu[k]):6.2f} s  (+{100 * (min(cpu[k]) / base - 1):4.1f} %), "
+              f"Hill on {checked[k]} solutions")
+
+
 def main() -> None:
     base = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, eta=(1.0, 1.0))
     b = ballbal.Balancer(**base, Omega=1.2)
@@ -94,6 +125,8 @@ def main() -> None:
     print("\ncallgrind instructions, the scan's verdict target (see SCAN_CALLGRIND):")
     for k, v in SCAN_CALLGRIND.items():
         print(f"  {k}: {v / 1e6:4.1f} M")
+    if "--scan" in sys.argv:
+        scan_settings()
     if "--rust" in sys.argv:
         root = Path(__file__).resolve().parent.parent
         out = subprocess.run(

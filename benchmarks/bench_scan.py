@@ -12,7 +12,9 @@ Per-stage costs (one thread, from ``_native.scan_stage_seconds``): perfect-balan
 checks, seed simulations with their solves, continuation waves (harmonic balance and
 Floquet of every continued solution), row building, and table building (columns and
 Python per chunk); Floquet's share is the difference to a run with ``floquet=False``,
-Hill's the extra of ``hill=True``.
+of which Hill's cross-check of the doubtful verdicts (the default ``hill_band``) is the
+difference to ``hill=False``; beside it, what ``hill=True`` (Hill beside every monodromy)
+would add instead.
 
 ``--old PATH``: also run every row with an older build (a directory holding the
 ``ballbal`` package, put first on ``PYTHONPATH`` in a subprocess), printed beside.
@@ -84,6 +86,9 @@ if stages is not None and not light:
     t = time.perf_counter()
     ballbal.scan(b, patterns=pats, N=N, threads=1, hill=True, **grid)
     out["hill"] = time.perf_counter() - t
+    t = time.perf_counter()
+    ballbal.scan(b, patterns=pats, N=N, threads=1, hill=False, **grid)
+    out["no_hill"] = time.perf_counter() - t
 prof = getattr(_native, "scan_profile", None)
 if prof is not None:
     order = _native.scan_wave_order
@@ -235,8 +240,9 @@ def main() -> None:
                 f"{label:<24} N {N}: total {total:.3f} s = balance {pb:.3f} + seeds "
                 f"{seeds:.3f} + continuation {waves:.3f} + rows {rows_:.3f} + table "
                 f"{table:.3f} + rest {total - pb - seeds - waves - rows_ - table:.3f}; "
-                f"Floquet ~{total - new['no_floquet']:.3f}, Hill would add "
-                f"{new['hill'] - total:.3f}")
+                f"Floquet ~{total - new['no_floquet']:.3f}, of it Hill in the band "
+                f"~{total - new['no_hill']:.3f}; Hill beside every monodromy would add "
+                f"{new['hill'] - new['no_hill']:.3f} instead")
         if "profile" in new:
             eff_lines += efficiency(label, N, new["profile"])
         del t0

@@ -3,6 +3,7 @@ change must leave as it was.
 
     python scripts/reference_outputs.py save DIR      # with the build before the change
     python scripts/reference_outputs.py compare DIR   # with the build after it
+    python scripts/reference_outputs.py compare DIR --ignore hill_stability,verdicts_disagree
 
 Saved: thesis-grid scans (zeta_b 0.05 and 0.1; R-R, O-O, R-O; N = 3 and 8), scene scans
 (ball springs, a tilting disk), single periodic solutions with multipliers, equilibria,
@@ -140,8 +141,30 @@ def _norm(df: pl.DataFrame) -> pl.DataFrame:
     return df.rename({k: v for k, v in RENAME.items() if k in df.columns})
 
 
+def _filled(ref: pl.DataFrame, df: pl.DataFrame, cols: list[str]) -> str:
+    """How the ignored columns changed: values where the reference had null, nulls
+    where it had values, and values changed (rows in the same order)."""
+    if ref.height != df.height:
+        return "row counts differ"
+    parts = []
+    for c in cols:
+        if c not in ref.columns or c not in df.columns:
+            parts.append(f"{c} only on one side")
+            continue
+        a, b = ref[c], df[c]
+        filled = int((a.is_null() & b.is_not_null()).sum())
+        emptied = int((a.is_not_null() & b.is_null()).sum())
+        changed = int((a.is_not_null() & b.is_not_null() & (a != b)).sum())
+        parts.append(f"{c}: {filled} filled, {emptied} emptied, {changed} changed")
+    return "; ".join(parts)
+
+
 def main(argv: list[str]) -> int:
     mode, d = argv[1], Path(argv[2])
+    # --ignore A,B: a change meant to alter only these columns; compared without them
+    ignore = set(argv[argv.index("--ignore") + 1].split(",")) if "--ignore" in argv else set()
+    if ignore:
+        print("compared without the columns", ", ".join(sorted(ignore)))
     d.mkdir(parents=True, exist_ok=True)
     bad = 0
     for name, make in tables().items():
@@ -152,6 +175,11 @@ def main(argv: list[str]) -> int:
             print(f"saved {name}: {df.height} rows x {df.width} columns")
             continue
         ref = pl.read_parquet(f)
+        dropped = [c for c in ignore if c in df.columns or c in ref.columns]
+        if dropped:
+            print(f"   {name}: {_filled(ref, df, dropped)}")
+            ref = ref.drop([c for c in dropped if c in ref.columns])
+            df = df.drop([c for c in dropped if c in df.columns])
         same = ref.columns == df.columns and ref.equals(df)
         word = "same" if same else "DIFFERENT"
         if not same and name in ROUNDOFF:

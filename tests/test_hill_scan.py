@@ -57,20 +57,33 @@ def test_verdict_target_against_shooting_on_the_hard_case():
     _check_against_shooting(b, s)
 
 
-def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map():
-    """Every Hill verdict of a scan at its target is the verdict of RK45 at rtol 1e-10
-    on the same series, or undetermined; undetermined only where that leading modulus
-    is within 1e-3 of 1 or the tight verdict is undetermined itself."""
+KEY = ["Omega", "eta", "type", "solution"]
+
+
+@pytest.fixture(scope="module")
+def thesis_map() -> dict[str, pl.DataFrame]:
+    """The standard thesis map (all three types, N = 3) with Hill beside every
+    monodromy, with the scan's defaults (Hill where the verdict is in doubt), and with
+    RK45 at rtol 1e-10 and no Hill; converged rows only."""
     b = ballbal.Balancer(**THESIS)
     grid = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
     pats = ("R-R", "O-O", "R-O")
-    hill = ballbal.scan(b, patterns=pats, N=3, hill=True, **grid)
-    tight = ballbal.scan(b, patterns=pats, N=3, hill=False, floquet_method="rk45",
-                         rtol=1e-10, atol=1e-12, max_steps=1_000_000, **grid)
-    key = ["Omega", "eta", "type", "solution"]
-    both = (hill.filter(pl.col("status") == "converged")
-            .join(tight.filter(pl.col("status") == "converged"), on=key, suffix="_tight"))
-    assert both.height == hill.filter(pl.col("status") == "converged").height > 100
+    runs = {"all": dict(hill=True), "default": {},
+            "tight": dict(hill=False, floquet_method="rk45", rtol=1e-10, atol=1e-12,
+                          max_steps=1_000_000)}
+    return {k: ballbal.scan(b, patterns=pats, N=3, **grid, **kw)
+            .filter(pl.col("status") == "converged") for k, kw in runs.items()}
+
+
+def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map(
+        thesis_map: dict[str, pl.DataFrame]) -> None:
+    """Every Hill verdict of a scan at its target is the verdict of RK45 at rtol 1e-10
+    on the same series, or undetermined; undetermined only where that leading modulus
+    is within 1e-3 of 1 or the tight verdict is undetermined itself."""
+    hill, tight = thesis_map["all"], thesis_map["tight"]
+    assert hill["hill_stability"].is_not_null().all()
+    both = hill.join(tight, on=KEY, suffix="_tight")
+    assert both.height == hill.height > 100
     assert (both["omega"] == both["omega_tight"]).all()
     opposite = both.filter((pl.col("hill_stability") != pl.col("stability_tight"))
                            & (pl.col("hill_stability") != "undetermined"))
@@ -81,8 +94,60 @@ def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map():
     assert not both["verdicts_disagree"].any()
 
 
+def test_default_scan_cross_checks_the_doubtful_verdicts(
+        thesis_map: dict[str, pl.DataFrame]) -> None:
+    """The scan's default runs Hill where the monodromy's verdict is undetermined or its
+    leading modulus is within ``SCAN_HILL_BAND`` of 1, with the verdicts Hill gives
+    beside every monodromy, and nowhere else. What it skips it may skip: there, Hill's
+    verdict (computed beside every monodromy) and RK45's at rtol 1e-10 are the
+    monodromy's, without exception."""
+    band = ballbal.options.SCAN_HILL_BAND
+    assert ballbal.options.SCAN_DEFAULTS.floquet.hill
+    assert ballbal.options.SCAN_DEFAULTS.floquet.hill_band == band
+    dflt = thesis_map["default"].join(thesis_map["all"], on=KEY, suffix="_all")
+    dflt = dflt.join(thesis_map["tight"], on=KEY, suffix="_tight")
+    assert dflt.height == thesis_map["all"].height
+    doubt = ((pl.col("stability") == "undetermined")
+             | ((pl.col("max_modulus") - 1.0).abs() <= band))
+    checked = dflt.filter(pl.col("hill_stability").is_not_null())
+    skipped = dflt.filter(pl.col("hill_stability").is_null())
+    # every doubtful verdict checked, with the verdict a check of every row gives
+    assert dflt.filter(doubt)["hill_stability"].is_not_null().all()
+    assert (checked["hill_stability"] == checked["hill_stability_all"]).all()
+    assert (checked["verdicts_disagree"] == checked["verdicts_disagree_all"]).all()
+    # the rest lies beyond the band with a definite verdict (Hill off there)
+    assert skipped.height > 0.5 * dflt.height
+    assert ((skipped["max_modulus"] - 1.0).abs() > band).all()
+    assert skipped["verdicts_disagree"].is_null().all()
+    assert (skipped["stability"] == skipped["hill_stability_all"]).all()
+    assert (skipped["stability"] == skipped["stability_tight"]).all()
+
+
 def test_hill_target_option_is_checked():
     b = ballbal.Balancer()
     with pytest.raises(ParameterError) as e:
         ballbal.periodic(b, "R-R", N=3, hill_target="eigenvalues")
     assert e.value.parameter == "hill_target"
+
+
+def test_hill_band_option() -> None:
+    """``hill=True`` keeps its meaning (Hill beside every monodromy) unless a band is
+    given with it; a band must be a number of at least 0."""
+    from ballbal.options import SCAN_DEFAULTS, SCAN_KEYWORDS, Floquet, with_keywords
+
+    def band(**kw: object) -> object:
+        return with_keywords(SCAN_DEFAULTS, "scan", kw, SCAN_KEYWORDS).floquet.hill_band
+
+    assert band() == ballbal.options.SCAN_HILL_BAND
+    assert band(hill=True) is None
+    assert band(hill=np.True_) is None
+    assert band(hill=True, hill_band=0.05) == 0.05
+    assert band(hill_band=0.05) == 0.05
+    assert Floquet().hill_band is None  # periodic(): every solution
+    b = ballbal.Balancer()
+    with pytest.raises(ParameterError) as e:
+        ballbal.scan(b, patterns=["R-R"], Omega=[1.2], eta=[1.0], hill_band=-0.1)
+    assert e.value.parameter == "hill_band"
+    with pytest.raises(ballbal.exceptions.ParameterTypeError) as t:
+        Floquet(hill_band="wide")  # type: ignore[arg-type]
+    assert t.value.parameter == "hill_band"

@@ -89,11 +89,14 @@ def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
            "atol": 1e-9, "margin": 1e-6, "max_steps": 20_000, "settle": 1000.0,
            "window": 2000.0, "guess_rtol": 1e-5, "seeds": 4, "starts": 4, "max_tail": 0.25,
            "max_closure": 6.0, "max_trivial": 0.1}
-    # They were computed with RK45 monodromies: only that method resumes them.
-    rk45 = dataclasses.replace(ScanOptions().floquet, method="rk45")
+    # They were computed with RK45 monodromies and no Hill: only those options resume
+    # them.
+    rk45 = dataclasses.replace(ScanOptions().floquet, method="rk45", hill=False)
     got = _meta_options(ScanOptions(floquet=rk45))
     assert json.dumps(got) == json.dumps(old)
-    assert _meta_options(ScanOptions()) == {**old, "floquet_method": "magnus"}
+    assert _meta_options(ScanOptions()) == {
+        **old, "hill": True, "floquet_method": "magnus", "hill_target": "verdict",
+        "hill_band": ballbal.options.SCAN_HILL_BAND}
     hb = dataclasses.replace(ScanOptions().harmonic_balance, N="auto")
     auto = _meta_options(ScanOptions(harmonic_balance=hb))
     assert (auto["N"], auto["auto"]) == (3, 1e-4)  # the scan's default target
@@ -105,8 +108,9 @@ def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
 def test_scan_with_options_equals_scan_with_keywords(tmp_path):
     grid = {"Omega": [1.2, 1.25], "eta": [1.0]}
     flat = ballbal.scan(B, threads=1, seeds=2, starts=2, max_steps=10_000, **grid)
-    opts = ScanOptions(floquet=Floquet(rtol=1e-6, atol=1e-9, max_steps=10_000, hill=False,
-                                       method="magnus"),
+    opts = ScanOptions(floquet=Floquet(rtol=1e-6, atol=1e-9, max_steps=10_000, hill=True,
+                                       method="magnus", hill_target="verdict",
+                                       hill_band=ballbal.options.SCAN_HILL_BAND),
                        guess=GuessSearch(settle=1000.0, window=2000.0, rtol=1e-5,
                                          atol=1e-5 * 1e-3, seeds=2, starts=2))
     new = ballbal.scan(B, options=opts, execution=Execution(threads=1, out=tmp_path / "s"),
@@ -121,7 +125,8 @@ def test_periodic_and_scan_share_the_solution_schema():
     df = ballbal.scan(B, threads=1, hill=True, **grid)
     row = df.row(0, named=True)
     # The scan's options as periodic() options: the same orbit, the same numbers.
-    o = ScanOptions(floquet=dataclasses.replace(ScanOptions().floquet, hill=True))
+    o = ScanOptions(floquet=dataclasses.replace(ScanOptions().floquet, hill=True,
+                                                hill_band=None))
     s = ballbal.periodic(B, "R-R", options=PeriodicOptions(
         harmonic_balance=o.harmonic_balance, floquet=o.floquet, guess=o.guess))
     names = {"status", "omega", "stability", "max_modulus", "trivial_error", "residual",

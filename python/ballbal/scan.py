@@ -171,7 +171,8 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
     before it was an option hold RK45 multipliers; they resume with
     ``floquet_method="rk45"`` and are refused with any other method. Hill's target only
     where Hill runs and it is not ``"multipliers"`` (what every earlier Hill verdict
-    used), likewise."""
+    used), likewise; Hill's band only where Hill runs with one (earlier Hill verdicts
+    were given beside every monodromy)."""
     h, f, g = o.harmonic_balance, o.floquet, o.guess
     d: dict[str, Any] = {
         "N": h._start, "auto": h._auto_target, "N_max": h.N_max, "hill": f.hill,
@@ -185,6 +186,8 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
         d["floquet_method"] = f.method
     if f.hill and f.hill_target != "multipliers":
         d["hill_target"] = f.hill_target
+    if f.hill and f.hill_band is not None:
+        d["hill_band"] = f.hill_band
     if g.atol != g.rtol * 1e-3:
         d["guess_atol"] = g.atol
     return d
@@ -548,7 +551,7 @@ def scan(  # noqa: E302 - overloads above
     ``options``: a :class:`~ballbal.ScanOptions` (what is computed; default
     :data:`ballbal.options.SCAN_DEFAULTS`, whose tolerances and guess search differ from
     :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`). The flat keywords
-    of :func:`~ballbal.periodic` (``N, target, N_max, hill, samples, tol, step_tol,
+    of :func:`~ballbal.periodic` (``N, target, N_max, hill, hill_band, samples, tol, step_tol,
     max_iter, floquet, rtol, atol, margin, max_steps, settle, window, guess_rtol,
     guess_atol, max_tail, max_closure, max_trivial``) and ``seeds, starts, block`` are
     still accepted beside the axes and change those options. ``execution``: an
@@ -586,8 +589,12 @@ def scan(  # noqa: E302 - overloads above
     ``N="auto"``: continuation runs at N = 3 and each solution found is refined until
     its highest harmonic and trivial multiplier error are below ``target`` (at most
     ``N_max``): easy points stay cheap; ``N`` and ``target_met`` say what each row got.
-    ``hill=True`` adds Hill's-method verdicts (``hill_stability``) and flags rows where
-    they contradict the monodromy's (``verdicts_disagree``).
+    Hill's method cross-checks the verdicts where they are in doubt: a row whose
+    monodromy gives no verdict, or whose leading non-trivial multiplier lies within
+    ``hill_band`` (default 0.2) of the unit circle or within ten times the monodromy's
+    own error estimate, gets Hill's verdict (``hill_stability``) and a flag where the
+    two contradict each other (``verdicts_disagree``); elsewhere both are null.
+    ``hill=True`` cross-checks every solution (``hill_band=None``), ``hill=False`` none.
 
     ``out``: a directory; each finished chunk is written there as Parquet at once
     (atomically), and a later call with the same arguments and ``out`` skips the chunks

@@ -239,6 +239,7 @@ pub struct FloquetArgs {
     monodromy: bool,
     hill: bool,
     hill_target: String,
+    hill_band: Option<f64>,
 }
 
 /// `ballbal.options.GuessSearch`.
@@ -287,6 +288,7 @@ impl PeriodicArgs {
             hill: f.hill,
             hill_judging: Some((f.margin, f.max_trivial)),
             hill_target: HillTarget::parse(&f.hill_target).py()?,
+            hill_band: f.hill_band,
             hb: HbOptions {
                 n_harm: h.start,
                 samples: h.samples,

@@ -6,7 +6,7 @@
 use crate::error::check_range;
 use crate::floquet::{
     floquet, hill, hill_verdict, judge, Floquet, FloquetOptions, HillTarget, Stability, HILL_MAX,
-    HILL_TOL,
+    HILL_TOL, HILL_VERDICT_ROOM,
 };
 use crate::hb::{defect_closure, solve, HbOptions, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
@@ -180,6 +180,12 @@ pub struct PeriodicOptions {
     /// What Hill's truncation is enlarged for: the multipliers to [`HILL_TOL`], or (a
     /// scan's default) only as far as its verdict needs.
     pub hill_target: HillTarget,
+    /// `None`: Hill's cross-check (with `hill`) runs on every converged solution.
+    /// `Some(band)`: Hill cross-checks the monodromy only where it leaves the verdict in
+    /// some doubt (see [`hill_wanted`]): it failed or gave no verdict, or the leading
+    /// non-trivial modulus is within `band` of 1 or within [`HILL_VERDICT_ROOM`] of the
+    /// monodromy's own error estimates; without a monodromy (`floquet` `None`), not at all.
+    pub hill_band: Option<f64>,
     /// Largest integrated ODE defect ([`defect_closure`]) of a converged series; above
     /// it the result is `NotClosed`.
     pub max_closure: f64,
@@ -198,6 +204,7 @@ impl Default for PeriodicOptions {
             hill: false,
             hill_judging: None,
             hill_target: HillTarget::Multipliers,
+            hill_band: None,
             max_closure: MAX_CLOSURE,
             max_tail: MAX_TAIL,
         }
@@ -224,6 +231,9 @@ impl PeriodicOptions {
             true,
         )?;
         check_range("max_tail", self.max_tail, 0.0, true, f64::INFINITY, true)?;
+        if let Some(b) = self.hill_band {
+            check_range("hill_band", b, 0.0, false, f64::INFINITY, true)?;
+        }
         Ok(())
     }
 }
@@ -556,7 +566,10 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
             (fl, fl_err) = run_floquet(&sol);
         }
     }
-    let hill = if opts.hill && sol.status == Status::Converged {
+    let hill = if opts.hill
+        && sol.status == Status::Converged
+        && hill_wanted(opts.floquet.is_some(), fl.as_ref(), opts.hill_band)
+    {
         let defaults = FloquetOptions::default();
         let (margin, max_trivial) = match (&opts.floquet, opts.hill_judging) {
             (Some(f), _) => (f.margin, f.max_trivial),
@@ -587,6 +600,27 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
         hill,
         tail,
     }
+}
+
+/// Whether Hill's cross-check is wanted beside the monodromy result `fl` (`None` if the
+/// monodromy failed) with [`PeriodicOptions::hill_band`] `band`, when a monodromy was
+/// asked for (`monodromy`). Always without a band. With one, Hill cross-checks the
+/// monodromy: never without it (no monodromy asked for), and otherwise where it failed,
+/// its verdict is undetermined, or its leading non-trivial modulus is within `band` of 1
+/// or within [`HILL_VERDICT_ROOM`] times the larger of the trivial multiplier's error and
+/// Magnus' error estimate (the room Hill's own verdict demands of its estimate). Beyond
+/// that, an error large enough to move the modulus across 1 would be many times what the
+/// monodromy's certificates measured.
+pub fn hill_wanted(monodromy: bool, fl: Option<&Floquet>, band: Option<f64>) -> bool {
+    let Some(band) = band else {
+        return true;
+    };
+    let Some(f) = fl else {
+        return monodromy;
+    };
+    let err = f.trivial_error.max(f.method_error.unwrap_or(0.0));
+    f.stability == Stability::Undetermined
+        || !((f.max_modulus - 1.0).abs() > band.max(HILL_VERDICT_ROOM * err))
 }
 
 /// The solution re-solved with half as many harmonics again (at most `n_max`), started
@@ -702,6 +736,82 @@ pub fn closure_error<D: Dynamics + ?Sized>(
 mod tests {
     use super::*;
     use crate::Planar;
+
+    fn judged(lead: f64, trivial_error: f64, method_error: Option<f64>) -> Floquet {
+        let j = judge(
+            &[(1.0 + trivial_error, 0.0), (lead, 0.0)],
+            1e-6,
+            crate::floquet::MAX_TRIVIAL,
+        );
+        Floquet {
+            multipliers: vec![(1.0 + trivial_error, 0.0), (lead, 0.0)],
+            trivial: j.trivial,
+            trivial_error: j.trivial_error,
+            separation_error: None,
+            max_modulus: j.max_modulus,
+            stability: j.stability,
+            steps: 0,
+            rhs_evals: 0,
+            method_error,
+        }
+    }
+
+    #[test]
+    fn hill_band_selects_the_doubtful_verdicts() {
+        let band = Some(0.2);
+        // no band: always; no monodromy asked for: never; one that failed: always
+        assert!(hill_wanted(true, Some(&judged(0.1, 1e-7, None)), None));
+        assert!(!hill_wanted(false, None, band));
+        assert!(hill_wanted(true, None, band));
+        // clear verdicts beyond the band, on either side of 1
+        assert!(!hill_wanted(true, Some(&judged(0.79, 1e-7, None)), band));
+        assert!(!hill_wanted(true, Some(&judged(1.21, 1e-7, None)), band));
+        assert!(hill_wanted(true, Some(&judged(0.81, 1e-7, None)), band));
+        assert!(hill_wanted(true, Some(&judged(1.19, 1e-7, None)), band));
+        // ten times the trivial multiplier's error, or Magnus' estimate, widens it
+        assert!(hill_wanted(true, Some(&judged(0.5, 0.06, None)), band));
+        assert!(!hill_wanted(true, Some(&judged(0.5, 0.04, None)), band));
+        assert!(hill_wanted(
+            true,
+            Some(&judged(0.5, 1e-7, Some(0.06))),
+            band
+        ));
+        // an undetermined verdict (trivial error beyond max_trivial) far from 1
+        let f = judged(0.01, 0.5, None);
+        assert_eq!(f.stability, Stability::Undetermined);
+        assert!(hill_wanted(true, Some(&f), Some(0.0)));
+        // a non-finite modulus is doubtful
+        let mut f = judged(0.5, 1e-7, None);
+        f.max_modulus = f64::NAN;
+        assert!(hill_wanted(true, Some(&f), band));
+    }
+
+    /// The band at work on the standard case: Hill runs exactly when the monodromy's
+    /// leading modulus lies within the band, and then gives the same verdict.
+    #[test]
+    fn hill_band_on_the_standard_case() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let run = |band: Option<f64>| {
+            let opts = PeriodicOptions {
+                floquet: Some(FloquetOptions::default()),
+                hill: true,
+                hill_band: band,
+                ..Default::default()
+            };
+            periodic(&p, &[true, true], None, &opts)
+        };
+        let all = run(None);
+        let f = all.floquet.as_ref().unwrap();
+        let dist = (f.max_modulus - 1.0).abs();
+        assert!(f.stability != Stability::Undetermined && f.trivial_error < 1e-4);
+        let (_, verdict) = all.hill.clone().unwrap();
+        assert_eq!(verdict, f.stability);
+        let inside = run(Some(dist * 1.01));
+        assert_eq!(inside.hill.map(|h| h.1), Some(verdict));
+        let outside = run(Some(dist * 0.99));
+        assert!(outside.hill.is_none());
+        assert_eq!(outside.floquet.unwrap().max_modulus, f.max_modulus);
+    }
 
     /// Measurement, not a check: `cargo test --release -p ballbal-core measure_certificates
     /// -- --ignored --nocapture` prints the integrated defect against the simulated
