@@ -96,11 +96,11 @@ def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map(
 
 def test_default_scan_cross_checks_the_doubtful_verdicts(
         thesis_map: dict[str, pl.DataFrame]) -> None:
-    """The scan's default runs Hill where the monodromy's verdict is undetermined or its
-    leading modulus is within ``SCAN_HILL_BAND`` of 1, with the verdicts Hill gives
-    beside every monodromy, and nowhere else. What it skips it may skip: there, Hill's
-    verdict (computed beside every monodromy) and RK45's at rtol 1e-10 are the
-    monodromy's, without exception."""
+    """The scan's default runs Hill on every solution whose monodromy verdict is
+    undetermined or whose leading modulus is within ``SCAN_HILL_BAND`` of 1, with the
+    verdicts Hill gives beside every monodromy, and skips most of the others. What it
+    skips it may skip: there, Hill's verdict (computed beside every monodromy) and
+    RK45's at rtol 1e-10 are the monodromy's, without exception."""
     band = ballbal.options.SCAN_HILL_BAND
     assert ballbal.options.SCAN_DEFAULTS.floquet.hill
     assert ballbal.options.SCAN_DEFAULTS.floquet.hill_band == band

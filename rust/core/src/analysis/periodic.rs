@@ -183,8 +183,9 @@ pub struct PeriodicOptions {
     /// `None`: Hill's cross-check (with `hill`) runs on every converged solution.
     /// `Some(band)`: Hill cross-checks the monodromy only where it leaves the verdict in
     /// some doubt (see [`hill_wanted`]): it failed or gave no verdict, or the leading
-    /// non-trivial modulus is within `band` of 1 or within [`HILL_VERDICT_ROOM`] of the
-    /// monodromy's own error estimates; without a monodromy (`floquet` `None`), not at all.
+    /// non-trivial modulus is within `band` of 1 or within [`HILL_VERDICT_ROOM`] times the
+    /// monodromy's own error estimate of 1; without a monodromy (`floquet` `None`), not at
+    /// all.
     pub hill_band: Option<f64>,
     /// Largest integrated ODE defect ([`defect_closure`]) of a converged series; above
     /// it the result is `NotClosed`.
