@@ -5,6 +5,10 @@ RK45 at tight tolerances across a thesis map."""
 
 from __future__ import annotations
 
+import re
+import subprocess
+import sys
+
 import numpy as np
 import polars as pl
 import pytest
@@ -151,3 +155,16 @@ def test_hill_band_option() -> None:
     with pytest.raises(ballbal.exceptions.ParameterTypeError) as t:
         Floquet(hill_band="wide")  # type: ignore[arg-type]
     assert t.value.parameter == "hill_band"
+
+
+def test_main_job_reports_the_cross_check() -> None:
+    """``ballbal run`` says how many of its map's verdicts Hill cross-checked, and that
+    none was contradicted."""
+    r = subprocess.run([sys.executable, "-m", "ballbal.cli", "run"], capture_output=True,
+                       text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    m = re.search(r"cross-checked (\d+) of the (\d+) verdicts .*: (\d+) the same, "
+                  r"(\d+) contradicted", r.stdout)
+    assert m, r.stdout
+    checked, total, same, contradicted = map(int, m.groups())
+    assert 0 < checked < total and same == checked and contradicted == 0

@@ -20,6 +20,7 @@ import numpy as np
 from .analysis import equilibria, periodic
 from .exceptions import BallbalError, ParameterError, ScanInterrupted, ScanStoreError
 from .model import Balancer
+from .options import SCAN_HILL_BAND
 from .scan import SCANNABLE, read_scan, scan, scan_meta
 from .scene import MAX_BALLS, Scene, load_scene
 
@@ -154,6 +155,13 @@ def _print_map(b: Balancer) -> None:
                  "+" if here["pb_stable"][0] else ".")
             line.append(f"{c:>4}")
         print(f"  {eta:3.1f}  " + "".join(line))
+    ok = df.filter(df["status"] == "converged")
+    checked = ok.filter(ok["hill_stability"].is_not_null())
+    same = int((checked["hill_stability"] == checked["stability"]).sum())
+    print(f"  Hill's method cross-checked {checked.height} of the {ok.height} verdicts (those in "
+          f"doubt: undetermined, or the leading multiplier within {SCAN_HILL_BAND} of the "
+          f"unit circle): {same} the same, {int(checked['verdicts_disagree'].sum())} "
+          "contradicted")
 
 
 def _scan(a: argparse.Namespace) -> int:
