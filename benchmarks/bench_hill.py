@@ -52,7 +52,8 @@ CALLGRIND = {(3, 2): (146.9e6, 14.1e6), (8, 2): (347.7e6, 14.2e6),
 # N = 3, 11 261 solutions; one thread, CPU time on a loaded machine): 10.0-12.0 s
 # without Hill, 20.6 s with it, +70 to 100 %: a continuation-bound scan spends about
 # as much per solution on everything else (warm solve, certificate, Magnus) as faer's
-# real Schur of the 42-row Hill block costs, which is why scans keep Hill off.
+# real Schur of the 42-row Hill block costs, which is why scans run Hill only where the
+# verdict is in doubt (hill_band; --scan prints the three settings).
 # 2026-11-24: the verdict starts at H = 2 where 1.5 / sqrt(omega) allows it (omega >=
 # 0.5625; hill_verdict_profile: about 2.3 M per Hill matrix at H = 2 against 4.2 M at
 # H = 3): on a 26 x 28 R-R grid (840 solutions, callgrind) hill_verdict 5.49 M -> 4.80 M

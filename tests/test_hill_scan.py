@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import polars as pl
@@ -168,3 +169,24 @@ def test_main_job_reports_the_cross_check() -> None:
     assert m, r.stdout
     checked, total, same, contradicted = map(int, m.groups())
     assert 0 < checked < total and same == checked and contradicted == 0
+
+
+def test_scans_written_without_hill_resume_with_hill_off(tmp_path: Path) -> None:
+    """A directory written with Hill off (the default before 2026-11-24) is refused by
+    the new defaults with a message saying how to resume it, and resumes with
+    ``hill=False`` (from Python and with ``ballbal scan --hill off``) to the same
+    table."""
+    b = ballbal.Balancer(**THESIS)
+    grid = {"Omega": [1.2, 1.3], "eta": [1.0]}
+    first = ballbal.scan(b, patterns=["R-R"], threads=1, hill=False, out=tmp_path / "s",
+                         **grid)
+    with pytest.raises(ballbal.exceptions.ScanStoreError, match="hill=False resumes"):
+        ballbal.scan(b, patterns=["R-R"], threads=1, out=tmp_path / "s", **grid)
+    again = ballbal.scan(b, patterns=["R-R"], threads=1, hill=False, out=tmp_path / "s",
+                         **grid)
+    assert again.drop("seconds").equals(first.drop("seconds"))
+    r = subprocess.run([sys.executable, "-m", "ballbal.cli", "scan", "--Omega", "1.2:1.31:0.1",
+                        "--eta", "1.0:1.01:0.1", "--hill", "off", "--no-progress",
+                        "-o", str(tmp_path / "s")], capture_output=True, text=True,
+                       timeout=300, cwd=tmp_path)
+    assert r.returncode == 0, r.stderr

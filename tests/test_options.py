@@ -97,6 +97,9 @@ def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
     assert _meta_options(ScanOptions()) == {
         **old, "hill": True, "floquet_method": "magnus", "hill_target": "verdict",
         "hill_band": ballbal.options.SCAN_HILL_BAND}
+    # A band without a monodromy runs no Hill: recorded as floquet=False scans were.
+    off = dataclasses.replace(ScanOptions().floquet, monodromy=False, method="rk45")
+    assert _meta_options(ScanOptions(floquet=off)) == {**old, "floquet": False}
     hb = dataclasses.replace(ScanOptions().harmonic_balance, N="auto")
     auto = _meta_options(ScanOptions(harmonic_balance=hb))
     assert (auto["N"], auto["auto"]) == (3, 1e-4)  # the scan's default target

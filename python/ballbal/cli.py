@@ -13,7 +13,7 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -160,8 +160,8 @@ def _print_map(b: Balancer) -> None:
     same = int((checked["hill_stability"] == checked["stability"]).sum())
     print(f"  Hill's method cross-checked {checked.height} of the {ok.height} verdicts (those in "
           f"doubt: undetermined, or the leading multiplier within {SCAN_HILL_BAND} of the "
-          f"unit circle): {same} the same, {int(checked['verdicts_disagree'].sum())} "
-          "contradicted")
+          f"unit circle or within ten times the monodromy's error of it): {same} the same, "
+          f"{int(checked['verdicts_disagree'].sum())} contradicted")
 
 
 def _scan(a: argparse.Namespace) -> int:
@@ -176,8 +176,10 @@ def _scan(a: argparse.Namespace) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ScanInterrupted)
+            hill: dict[str, Any] = {"doubt": {}, "all": {"hill": True},
+                                    "off": {"hill": False}}[a.hill]
             df = scan(b, grid=grid, patterns=a.types, N=a.N, threads=a.threads,
-                      chunk=a.chunk, out=a.out, progress=not a.no_progress)
+                      chunk=a.chunk, out=a.out, progress=not a.no_progress, **hill)
     except ScanStoreError as e:  # another scan's directory, or one in use
         print(f"ballbal: error: {e}", file=sys.stderr)
         return 2
@@ -271,6 +273,9 @@ def main(argv: list[str] | None = None) -> int:
     ps.add_argument("--threads", type=int, default=None)
     ps.add_argument("--chunk", type=int, default=None)
     ps.add_argument("-o", "--out", required=True, help="output directory (Parquet chunks)")
+    ps.add_argument("--hill", choices=["doubt", "all", "off"], default="doubt",
+                    help="Hill's cross-check of the verdicts in doubt (default), of all, or "
+                         "none ('off' resumes directories written before 2026-11-24)")
     ps.add_argument("--no-progress", action="store_true")
     pl_ = sub.add_parser("plot", help="plot a scan written by 'ballbal scan'")
     pl_.add_argument("scan_dir")

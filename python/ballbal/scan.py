@@ -172,10 +172,13 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
     ``floquet_method="rk45"`` and are refused with any other method. Hill's target only
     where Hill runs and it is not ``"multipliers"`` (what every earlier Hill verdict
     used), likewise; Hill's band only where Hill runs with one (earlier Hill verdicts
-    were given beside every monodromy)."""
+    were given beside every monodromy). A band without a monodromy runs no Hill and is
+    recorded as Hill off, as ``floquet=False`` scans were."""
     h, f, g = o.harmonic_balance, o.floquet, o.guess
+    # A band without a monodromy runs no Hill: the same table as Hill off.
+    hill = f.hill and (f.monodromy or f.hill_band is None)
     d: dict[str, Any] = {
-        "N": h._start, "auto": h._auto_target, "N_max": h.N_max, "hill": f.hill,
+        "N": h._start, "auto": h._auto_target, "N_max": h.N_max, "hill": hill,
         "samples": h.samples, "tol": h.tol, "step_tol": h.step_tol, "max_iter": h.max_iter,
         "floquet": f.monodromy, "rtol": f.rtol, "atol": f.atol, "margin": f.margin,
         "max_steps": f.max_steps, "settle": g.settle, "window": g.window,
@@ -184,9 +187,9 @@ def _meta_options(o: ScanOptions) -> dict[str, Any]:
     }
     if f.method != "rk45":
         d["floquet_method"] = f.method
-    if f.hill and f.hill_target != "multipliers":
+    if hill and f.hill_target != "multipliers":
         d["hill_target"] = f.hill_target
-    if f.hill and f.hill_band is not None:
+    if hill and f.hill_band is not None:
         d["hill_band"] = f.hill_band
     if g.atol != g.rtol * 1e-3:
         d["guess_atol"] = g.atol
@@ -425,9 +428,13 @@ class _Store:
                 meta["chunk"] = stored
             if old != meta:
                 diff = _differences(old, meta)
+                hint = ""
+                if old.get("options", {}).get("hill") is False and "options.hill" in diff:
+                    hint = (" (scans written before 2026-11-24 ran without Hill's "
+                            "cross-check by default: hill=False resumes them)")
                 raise ScanStoreError(
                     f"out: {self.dir} holds a different scan (it differs in "
-                    f"{', '.join(diff)}); choose another directory or delete it")
+                    f"{', '.join(diff)}){hint}; choose another directory or delete it")
             if list(old["grid"]) != list(meta["grid"]):
                 # Same axes, other order: the chunks would be cut along another axis.
                 raise ScanStoreError(

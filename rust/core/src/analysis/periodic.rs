@@ -184,7 +184,7 @@ pub struct PeriodicOptions {
     /// `Some(band)`: Hill cross-checks the monodromy only where it leaves the verdict in
     /// some doubt (see [`hill_wanted`]): it failed or gave no verdict, or the leading
     /// non-trivial modulus is within `band` of 1 or within [`HILL_VERDICT_ROOM`] times the
-    /// monodromy's own error estimate of 1; without a monodromy (`floquet` `None`), not at
+    /// monodromy's own error measures of 1; without a monodromy (`floquet` `None`), not at
     /// all.
     pub hill_band: Option<f64>,
     /// Largest integrated ODE defect ([`defect_closure`]) of a converged series; above
@@ -608,8 +608,9 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
 /// asked for (`monodromy`). Always without a band. With one, Hill cross-checks the
 /// monodromy: never without it (no monodromy asked for), and otherwise where it failed,
 /// its verdict is undetermined, or its leading non-trivial modulus is within `band` of 1
-/// or within [`HILL_VERDICT_ROOM`] times the larger of the trivial multiplier's error and
-/// Magnus' error estimate (the room Hill's own verdict demands of its estimate). Beyond
+/// or within [`HILL_VERDICT_ROOM`] times the largest of the monodromy's error measures:
+/// the trivial multiplier's error, Magnus' estimate and merged balls' separation error
+/// (the room Hill's own verdict demands of its estimate; a NaN one is doubt). Beyond
 /// that, an error large enough to move the modulus across 1 would be many times what the
 /// monodromy's certificates measured.
 pub fn hill_wanted(monodromy: bool, fl: Option<&Floquet>, band: Option<f64>) -> bool {
@@ -619,7 +620,16 @@ pub fn hill_wanted(monodromy: bool, fl: Option<&Floquet>, band: Option<f64>) -> 
     let Some(f) = fl else {
         return monodromy;
     };
-    let err = f.trivial_error.max(f.method_error.unwrap_or(0.0));
+    // f64::max would drop a NaN estimate: a NaN anywhere is doubt.
+    let errs = [
+        f.trivial_error,
+        f.method_error.unwrap_or(0.0),
+        f.separation_error.unwrap_or(0.0),
+    ];
+    if errs.iter().any(|e| e.is_nan()) {
+        return true;
+    }
+    let err = errs.into_iter().fold(0.0, f64::max);
     f.stability == Stability::Undetermined
         || !((f.max_modulus - 1.0).abs() > band.max(HILL_VERDICT_ROOM * err))
 }
@@ -777,14 +787,25 @@ mod tests {
             Some(&judged(0.5, 1e-7, Some(0.06))),
             band
         ));
-        // an undetermined verdict (trivial error beyond max_trivial) far from 1
-        let f = judged(0.01, 0.5, None);
-        assert_eq!(f.stability, Stability::Undetermined);
+        // an undetermined verdict far from 1 with small errors (the undetermined rule
+        // alone asks for Hill)
+        let mut f = judged(0.5, 1e-7, None);
+        assert!(!hill_wanted(true, Some(&f), Some(0.0)));
+        f.stability = Stability::Undetermined;
         assert!(hill_wanted(true, Some(&f), Some(0.0)));
-        // a non-finite modulus is doubtful
+        // merged balls' separation error widens it too
+        let mut f = judged(0.5, 1e-7, None);
+        f.separation_error = Some(0.06);
+        assert!(hill_wanted(true, Some(&f), band));
+        // a non-finite modulus or error estimate is doubtful
         let mut f = judged(0.5, 1e-7, None);
         f.max_modulus = f64::NAN;
         assert!(hill_wanted(true, Some(&f), band));
+        assert!(hill_wanted(
+            true,
+            Some(&judged(0.5, 1e-7, Some(f64::NAN))),
+            band
+        ));
     }
 
     /// The band at work on the standard case: Hill runs exactly when the monodromy's
