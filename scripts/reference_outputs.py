@@ -175,7 +175,7 @@ def main(argv: list[str]) -> int:
             print(f"saved {name}: {df.height} rows x {df.width} columns")
             continue
         ref = pl.read_parquet(f)
-        dropped = [c for c in ignore if c in df.columns or c in ref.columns]
+        dropped = [c for c in sorted(ignore) if c in df.columns or c in ref.columns]
         if dropped:
             print(f"   {name}: {_filled(ref, df, dropped)}")
             ref = ref.drop([c for c in dropped if c in ref.columns])
