@@ -10,13 +10,13 @@ from functools import cache
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
-from scipy.optimize import fsolve
 
 import ballbal
 from ballbal.continuation import Continuation, Curve, periodic_branch, periodic_curve
 from ballbal.exceptions import ParameterError
 
 from reference import rhs
+from shooting import newton
 
 STD = dict(mu=0.2, zeta=0.05, delta=50.0)
 N = 8
@@ -75,9 +75,7 @@ def shoot_merged(b: ballbal.Balancer, y_guess: np.ndarray, T_guess: float,
         y0 = state(z)
         return (_flow(b, y0, z[-1]) - y0 - shift)[rows]
 
-    z, _, ok, msg = fsolve(F, np.append(y_guess[free], T_guess), full_output=True,
-                           xtol=1e-12)
-    assert ok == 1, msg
+    z = newton(F, np.append(y_guess[free], T_guess))
     return float(z[-1]), np.linalg.eigvals(_monodromy(b, state(z), z[-1]))
 
 
