@@ -35,15 +35,20 @@ def parameter_range(v: Any) -> tuple[float, float]:
 
 
 def model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:
-    """``model`` with ``parameter`` set to ``value`` (``"eta[2]"``: one ball's)."""
+    """``model`` with ``parameter`` set to ``value``. A ball-indexed name counts balls
+    from 0, as Python indexes ``Balancer.eta`` and as the core and the scans do:
+    ``"eta[0]"`` is the first ball's ``eta``."""
     m = _INDEXED.match(parameter)
     if m is None:
         return model.replace(**{parameter: value})
     name, i = m.group(1), int(m.group(2))
     bal = model.balancer if isinstance(model, Scene) else model
+    if i >= bal.n_balls:
+        raise ParameterError(parameter, f"ball index {i} of {bal.n_balls} balls (counted from 0)",
+                             allowed=f"{name}[0] to {name}[{bal.n_balls - 1}]")
     old = getattr(bal, name)
     vals = list(old) if isinstance(old, (tuple, list)) else [old] * bal.n_balls
-    vals[i - 1] = value
+    vals[i] = value
     return model.replace(**{name: tuple(vals)})
 
 

@@ -132,7 +132,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
     ``model``, or a kind name: the first equilibrium of that kind) continued in
     ``parameter`` (any name ``with_param`` takes: ``"Omega"``, ``"eta"`` (all balls),
-    ``"eta[1]"``, ``"zeta"``, ``"zeta_b"``, ``"mu"``, ``"delta"``, scene parameters) by
+    ``"eta[1]"`` (the second ball: balls count from 0), ``"zeta"``, ``"zeta_b"``, ``"mu"``, ``"delta"``, scene parameters) by
     pseudo-arclength over ``range``, through folds.
 
     ``model`` may also be a :class:`~ballbal.model.Seed003`: then ``parameter`` is one of
