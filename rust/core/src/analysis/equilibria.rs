@@ -307,9 +307,9 @@ fn spectrum<D: Dynamics + ?Sized>(
 /// kind, then `x`), analysed alike.
 pub fn perfect_balance_verdict(p: &Planar) -> Option<Verdict> {
     let n = p.n_balls();
-    let found = if n == 2 && equal_balls(p) && p.zeta > 0.0 {
+    let found = if n == 2 && equal_balls(p) {
         closed_form_two_equal(p)
-    } else if n == 1 && p.zeta > 0.0 && p.omega_s > 0.0 {
+    } else if n == 1 && p.omega_s > 0.0 {
         closed_form_one(p)
     } else {
         return equilibria(p)
@@ -369,7 +369,30 @@ pub fn residual_imbalance(eta: &[f64], balls: &[f64]) -> f64 {
     re.hypot(im)
 }
 
-/// Closed-form equilibria of one ball (`zeta > 0`, `Omega > 0`). At rest the disk centre
+/// The unbalanced equilibria without disk damping (`zeta = 0`) of balls that act on the
+/// disk as one mass `eta_sum` (one ball, or two equal balls together). At rest the disk
+/// centre is on the balls' line, `x + i y = r exp(i b)`, and `(1 - Omega^2 + 2 i zeta
+/// Omega) r = mu Omega^2 (exp(-i b) + eta_sum)` with `r` real; at `zeta = 0` the
+/// imaginary part leaves `(1 - Omega^2) sin b = 0`, so `b = 0` or `pi` (the damped
+/// forms' limit: their `A = (1 - Omega^2) / (2 zeta)` is infinite there), and `r = mu
+/// Omega^2 (cos b + eta_sum) / (1 - Omega^2)`. Returns `(x, b)` with `y = 0`. At the
+/// undamped resonance `Omega = 1` the disk equation asks `exp(-i b) + eta_sum = 0`, which
+/// only a perfect balance meets: none is returned.
+fn undamped_on_axis(p: &Planar, eta_sum: f64) -> Vec<(f64, f64)> {
+    let (om, mu) = (p.omega_s, p.mu);
+    if om == 0.0 || om == 1.0 {
+        return vec![];
+    }
+    [0.0, PI]
+        .into_iter()
+        .map(|b: f64| {
+            let r = mu * om * om * (b.cos() + eta_sum) / (1.0 - om * om);
+            (r * b.cos(), b)
+        })
+        .collect()
+}
+
+/// Closed-form equilibria of one ball (`Omega > 0`; `zeta = 0`: [`undamped_on_axis`]). At rest the disk centre
 /// sits on the ball's line, `x + i y = r exp(i b)`, and `(1 - Omega^2 + 2 i zeta Omega)
 /// r = mu Omega^2 (exp(-i b) + eta)`: `r = -mu Omega sin b / (2 zeta)` and
 /// `A sin b + Omega cos b = -eta Omega`, `A = (1 - Omega^2) / (2 zeta)` (the two-ball
@@ -378,6 +401,17 @@ pub fn residual_imbalance(eta: &[f64], balls: &[f64]) -> f64 {
 /// `eta = 1` one root is `b = pi` exactly with the disk on the axis: a perfect balance.
 fn closed_form_one(p: &Planar) -> Vec<(Vec<f64>, EquilibriumKind)> {
     let (eta, om, z, mu) = (p.eta[0], p.omega_s, p.zeta, p.mu);
+    if z == 0.0 {
+        return undamped_on_axis(p, eta)
+            .into_iter()
+            .map(|(x, b)| {
+                if eta == 1.0 && b == PI {
+                    return (vec![0.0, 0.0, PI], EquilibriumKind::PerfectBalance);
+                }
+                (vec![x, 0.0, b], one_ball_kind(b))
+            })
+            .collect();
+    }
     let a = (1.0 - om * om) / (2.0 * z);
     let amp = a.hypot(om);
     let phi = om.atan2(a);
@@ -423,6 +457,17 @@ fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, EquilibriumKind)> {
         };
         (r * b.cos(), r * b.sin())
     };
+    if z == 0.0 {
+        for (x, b) in undamped_on_axis(p, 2.0 * eta) {
+            out.push((vec![x, 0.0, b, b], EquilibriumKind::Together));
+        }
+        // Opposite balls cancel each other: the disk alone, `x = mu Omega^2 / (1 -
+        // Omega^2)`, balls on its line (b and b + pi are the same configuration).
+        if om != 1.0 {
+            let x = mu * om * om / (1.0 - om * om);
+            out.push((vec![x, 0.0, 0.0, PI], EquilibriumKind::Opposite));
+        }
+    }
     if z > 0.0 {
         let a = (1.0 - om * om) / (2.0 * z);
         let amp = a.hypot(om);
@@ -519,10 +564,10 @@ fn same_equilibrium(equal: bool, o: usize, a: &[f64], b: &[f64]) -> bool {
 /// balls; otherwise Newton from a deterministic set of starts.
 pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
     let n = p.n_balls();
-    if n == 2 && equal_balls(p) && p.zeta > 0.0 {
+    if n == 2 && equal_balls(p) {
         return sorted_analysed(p, closed_form_two_equal(p), true);
     }
-    if n == 1 && p.zeta > 0.0 && p.omega_s > 0.0 {
+    if n == 1 && p.omega_s > 0.0 {
         return sorted_analysed(p, closed_form_one(p), true);
     }
     equilibria_of(p, equal_balls(p), true)
@@ -941,6 +986,49 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Without disk damping the equilibria are the damped closed forms' limit: at
+    /// `zeta = 0` the list had only the perfect balance (the search's Newton stalls
+    /// there), at `zeta = 1e-9` all four. Each undamped one is an equilibrium (its
+    /// residual), the same states as at `zeta = 1e-10` (to that `zeta`'s effect), of the
+    /// same kinds, for one ball and two equal balls, below and above the resonance.
+    #[test]
+    fn undamped_equilibria_are_the_damped_ones_limit() {
+        for om in [0.6, 1.2, 2.5] {
+            for (etas, kinds) in [(vec![0.8, 0.8], 4), (vec![0.54], 2), (vec![1.0], 2)] {
+                let at = |z: f64| Planar::new(0.2, z, &[0.05], 50.0, om, &etas).unwrap();
+                let (undamped, damped) = (equilibria(&at(0.0)), equilibria(&at(1e-10)));
+                assert_eq!(undamped.len(), kinds, "{om} {etas:?}");
+                assert_eq!(damped.len(), kinds, "{om} {etas:?}");
+                for e in &undamped {
+                    assert!(e.residual < 1e-13, "{} residual {}", e.kind, e.residual);
+                    // The same disk position and the same set of ball positions on
+                    // the track (equal balls: in any order, angles modulo 2 pi).
+                    let same = |d: &&Equilibrium| {
+                        d.kind == e.kind
+                            && (d.q[0] - e.q[0]).abs() < 1e-6
+                            && (d.q[1] - e.q[1]).abs() < 1e-6
+                            && e.q[2..]
+                                .iter()
+                                .all(|a| d.q[2..].iter().any(|b| wrap(a - b).abs() < 1e-6))
+                    };
+                    assert!(
+                        damped.iter().any(|d| same(&d)),
+                        "{om} {etas:?}: {} {:?} not in {:?}",
+                        e.kind,
+                        e.q,
+                        damped.iter().map(|d| &d.q).collect::<Vec<_>>()
+                    );
+                }
+            }
+        }
+        // At the undamped resonance only a perfect balance can rest.
+        let p = Planar::new(0.2, 0.0, &[0.05], 50.0, 1.0, &[0.8, 0.8]).unwrap();
+        let eqs = equilibria(&p);
+        assert!(eqs
+            .iter()
+            .all(|e| e.kind == EquilibriumKind::PerfectBalance));
     }
 
     #[test]
