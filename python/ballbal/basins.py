@@ -20,6 +20,7 @@ nothing about its neighbourhood.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import math
 import os
@@ -171,7 +172,8 @@ class _BasinStore:
     out``), with the scan store's guarantees (:class:`ballbal.scan._Store`, whose
     locking, atomic writes and setting aside of damaged files it reuses): a later call
     with the same arguments skips the chunks on disk; a chunk file that is unreadable,
-    of another grid or short is set aside as ``<name>.damaged`` with a
+    changed since it was written (its checksum), of another grid or another chunk's
+    position, or short is set aside as ``<name>.damaged`` with a
     :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed."""
 
     def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any]) -> None:
@@ -203,20 +205,27 @@ class _BasinStore:
         self.store = Store(path, None, False)  # type: ignore[arg-type]
 
     def done(self, sizes: dict[int, int]) -> set[int]:
-        from .scan import _FINGERPRINT, _chunk_index
+        """The chunks on disk that can be trusted (this grid's, at their position, with
+        their checksum and every start); the others are set aside."""
+        from .scan import _chunk_index, _sealed_problem
 
         st = self.store
         ok = set()
         for f in sorted(st.dir.glob("chunk-*.parquet")):
             c = _chunk_index(f)
-            why = None
-            try:
-                if pl.read_parquet_metadata(f).get(_FINGERPRINT) != st.fingerprint:
-                    why = "it was not written by this grid"
-                elif c not in sizes or pl.read_parquet(f).height != sizes[c]:
-                    why = "it misses starts of its chunk"
-            except Exception as e:  # noqa: BLE001 - any failure to read: damaged
-                why = f"unreadable: {type(e).__name__}"
+            why: str | None
+            if c is None:
+                why = "not a chunk file name"
+            elif c not in sizes:
+                why = f"chunk {c} is outside the grid"
+            else:
+                why, data = _sealed_problem(f, st.fingerprint, c, "grid")
+                if why is None:
+                    try:
+                        if pl.read_parquet(io.BytesIO(data)).height != sizes[c]:
+                            why = "it misses starts of its chunk"
+                    except Exception as e:  # noqa: BLE001 - any failure to read: damaged
+                        why = f"unreadable: {type(e).__name__}"
             if why is None and c is not None:
                 ok.add(c)
             else:

@@ -11,6 +11,7 @@ partly after an interruption or a crash (``out=``).
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import math
 import os
@@ -28,6 +29,7 @@ import polars as pl
 
 from . import _check, _native
 from .exceptions import (
+    InternalError,
     ParameterError,
     ParameterTypeError,
     ScanInterrupted,
@@ -244,10 +246,98 @@ def run_chunk(job: _Job, c: int, threads: int = 1) -> pl.DataFrame:
 #: itself was damaged and had to be rewritten).
 _FINGERPRINT = "ballbal_scan"
 _CHUNK_FILE = re.compile(r"chunk-(\d{5,})\.parquet")
+#: Parquet key-value entry holding the chunk's number, so that a chunk copied or renamed
+#: to another position of the same grid is not taken for that position's: the basin
+#: store's rows are checked only by their count, and a checksum travels with its file.
+_CHUNK_KEY = "ballbal_chunk"
+#: Parquet key-value entry holding a SHA-256 of the chunk file's own bytes.
+#:
+#: Why the file's bytes and not the decoded table: a flip in the footer can leave the
+#: rows as they were and still change what is read, e.g. a column's min/max statistics,
+#: which polars' lazy scans use to skip row groups (``lazy=True`` tables), so a hash
+#: of the content would pass a file that filters wrong. Hashing the bytes needs no
+#: canonical serialisation, costs one pass of SHA-256 over what was just written, and
+#: is checked before polars parses anything (a damaged file never reaches its decoder).
+#:
+#: Why inside the file and not in a sidecar or a manifest: a chunk stays one file
+#: written by one atomic rename, so no crash can leave a chunk and its checksum out of
+#: step (a sidecar needs an order of two renames, and a manifest a rewrite per chunk),
+#: and a chunk copied elsewhere carries its own checksum.
+#:
+#: A checksum cannot cover itself: the file is written with ``_UNSEALED`` as the value,
+#: hashed, and the value is overwritten with the digest (the same length, so no offset
+#: in the file moves); the check puts ``_UNSEALED`` back and hashes again. Any changed
+#: byte elsewhere changes the hash, and a changed digest no longer matches it.
+_CHECKSUM = "ballbal_sha256"
+_UNSEALED = b"0" * 64
+#: The key's bytes as the footer holds them (Thrift compact protocol, as every Parquet
+#: footer): the key, the value's field header and length (1 byte each for a 64-byte
+#: string), then the value.
+_CHECKSUM_KEY = _CHECKSUM.encode()
+_CHECKSUM_AT = len(_CHECKSUM_KEY) + 2
+_HEX = re.compile(rb"[0-9a-f]{64}")
 
 
 def _fingerprint(meta: Mapping[str, Any]) -> str:
     return hashlib.sha256(json.dumps(meta).encode()).hexdigest()
+
+
+def _sealed(df: pl.DataFrame, metadata: Mapping[str, str]) -> bytes:
+    """``df`` as the bytes of a Parquet file with ``metadata`` and its checksum (see
+    ``_CHECKSUM``)."""
+    buf = io.BytesIO()
+    df.write_parquet(buf, metadata={**metadata, _CHECKSUM: _UNSEALED.decode()})
+    data = bytearray(buf.getvalue())
+    at = data.find(_CHECKSUM_KEY)
+    if (at < 0 or data.find(_CHECKSUM_KEY, at + 1) >= 0
+            or data[at + _CHECKSUM_AT:at + _CHECKSUM_AT + 64] != _UNSEALED):
+        # The writer laid out its footer otherwise: no chunk is written that the check
+        # would refuse.
+        raise InternalError("the Parquet writer did not store the chunk checksum where "
+                            "expected")
+    data[at + _CHECKSUM_AT:at + _CHECKSUM_AT + 64] = \
+        hashlib.sha256(data).hexdigest().encode()
+    return bytes(data)
+
+
+def _checksum_problem(data: bytes) -> str | None:
+    """Why the bytes of a chunk file are not the ones written (see ``_CHECKSUM``), or
+    ``None``."""
+    at = data.rfind(_CHECKSUM_KEY)
+    if at < 0:
+        return "it carries no checksum (written before chunks had one, or its footer is damaged)"
+    digest = data[at + _CHECKSUM_AT:at + _CHECKSUM_AT + 64]
+    if data.find(_CHECKSUM_KEY) != at or not _HEX.fullmatch(digest):
+        return "its checksum is damaged"
+    h = hashlib.sha256(data[:at + _CHECKSUM_AT])
+    h.update(_UNSEALED)
+    h.update(data[at + _CHECKSUM_AT + 64:])
+    if h.hexdigest().encode() != digest:
+        return "its bytes do not match its checksum"
+    return None
+
+
+def _sealed_problem(f: Path, fingerprint: str, c: int,
+                    what: str = "scan") -> tuple[str | None, bytes]:
+    """Why chunk file ``f`` is not chunk ``c`` as this ``fingerprint``'s store wrote it,
+    or ``None``; and the file's bytes."""
+    try:
+        data = f.read_bytes()
+    except OSError as e:
+        return f"unreadable: {type(e).__name__}: {e}", b""
+    why = _checksum_problem(data)
+    if why is not None:
+        return why, data
+    try:
+        # Past the checksum the bytes are the ones written: polars reads its own file.
+        kv = pl.read_parquet_metadata(io.BytesIO(data))
+    except Exception as e:  # noqa: BLE001 - any failure to read means a damaged file
+        return f"unreadable: {type(e).__name__}", data
+    if kv.get(_FINGERPRINT) != fingerprint:
+        return f"it was not written by this {what}", data
+    if kv.get(_CHUNK_KEY) != str(c):
+        return f"it holds chunk {kv.get(_CHUNK_KEY)} of this {what}, not chunk {c}", data
+    return None, data
 
 
 def _chunk_index(f: Path) -> int | None:
@@ -304,12 +394,11 @@ def _chunk_problem(f: Path, meta: Mapping[str, Any], c: int | None) -> str | Non
     lo, hi = c * chunk, min(len(values[-1]), (c + 1) * chunk)
     if lo >= hi:
         return f"chunk {c} is outside the grid"
+    why, data = _sealed_problem(f, _fingerprint(meta), c)
+    if why is not None:
+        return why
     try:
-        # Directories of ballbal 0.1 (no blocks yet) have no fingerprints to check.
-        if ("block" in meta
-                and pl.read_parquet_metadata(f).get(_FINGERPRINT) != _fingerprint(meta)):
-            return "it was not written by this scan"
-        df = pl.read_parquet(f)
+        df = pl.read_parquet(io.BytesIO(data))
     except Exception as e:  # noqa: BLE001 - any failure to read means a damaged file
         return f"unreadable: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
     if df.schema != _empty(names).schema:
@@ -355,9 +444,11 @@ class _Store:
 
     The directory is locked (``fcntl.flock`` on ``.lock``) while a scan uses it; the
     kernel drops the lock when the process ends, even when killed. Every file is
-    written atomically; on opening, a file that cannot be trusted (unreadable, truncated,
-    of another scan, missing points) is set aside as ``<name>.damaged`` with a
-    :class:`ScanStoreWarning` and recomputed.
+    written atomically, and every chunk carries the scan's fingerprint, its chunk number
+    and a checksum of its bytes (``_CHECKSUM``); on opening, a file that cannot be
+    trusted (unreadable, truncated, changed, of another scan or position, missing
+    points) is set aside as ``<name>.damaged`` with a :class:`ScanStoreWarning` and
+    recomputed.
     """
 
     def __init__(self, path: str | os.PathLike[str], job: _Job, chunk_given: bool) -> None:
@@ -464,8 +555,8 @@ class _Store:
         return ok
 
     def write(self, c: int, df: pl.DataFrame) -> None:
-        _write_atomic(self.file(c),
-                      lambda fh: df.write_parquet(fh, metadata={_FINGERPRINT: self.fingerprint}))
+        _write_atomic(self.file(c), lambda fh: fh.write(
+            _sealed(df, {_FINGERPRINT: self.fingerprint, _CHUNK_KEY: str(c)})))
 
     def files(self, chunks: Iterable[int]) -> list[Path]:
         return [self.file(c) for c in sorted(chunks)]
@@ -607,11 +698,13 @@ def scan(  # noqa: E302 - overloads above
     (atomically), and a later call with the same arguments and ``out`` skips the chunks
     on disk (resume; the axes must be given in the same order). Only one scan at a time
     may use a directory (another gets :class:`~ballbal.exceptions.ScanStoreError`). A
-    damaged file found on resuming (truncated, unreadable, not this scan's) is set aside
-    as ``<name>.damaged`` with a :class:`~ballbal.exceptions.ScanStoreWarning` naming it,
-    and recomputed. With ``out``, only one chunk per thread is held in memory while the
-    scan runs; ``lazy=True`` returns a ``polars.LazyFrame`` over the files instead of
-    reading them back, for grids whose table does not fit in memory.
+    damaged file found on resuming (truncated, unreadable, changed since it was written
+    -- every chunk carries a SHA-256 of its bytes --, another scan's or another chunk's)
+    is set aside as ``<name>.damaged`` with a
+    :class:`~ballbal.exceptions.ScanStoreWarning` naming it, and recomputed. With
+    ``out``, only one chunk per thread is held in memory while the scan runs;
+    ``lazy=True`` returns a ``polars.LazyFrame`` over the files instead of reading them
+    back, for grids whose table does not fit in memory.
     ``executor``: a ``concurrent.futures`` executor or Dask ``Client``; the chunks run
     as its tasks (``threads`` per task, default 1) and the table is the same as here.
     ``progress``: ``True`` for a progress bar (tqdm if installed), or a callable
@@ -758,11 +851,12 @@ def read_scan(  # noqa: E302 - overloads above
     """The table of a scan written with ``out=path`` (the finished chunks, in order).
 
     Every chunk file is checked against the scan's ``meta.json`` before its rows are
-    used; a damaged one (truncated, unreadable, another scan's, missing points) raises
+    used; a damaged one (truncated, unreadable, changed since it was written, another
+    scan's or another chunk's, missing points) raises
     :class:`~ballbal.exceptions.ScanStoreError` naming it; running the same scan with
     ``out=path`` again sets it aside and recomputes it. ``lazy=True`` returns a
-    ``polars.LazyFrame`` over the files (checked by their footers only: row data is read
-    when the frame is collected).
+    ``polars.LazyFrame`` over the files (checked by their checksums and footers, one
+    file in memory at a time; the rows are decoded when the frame is collected).
     """
     d = Path(_check.path("path", path))
     # In chunk order, also past chunk 99999 (where names stop sorting as numbers).
@@ -778,13 +872,18 @@ def read_scan(  # noqa: E302 - overloads above
     for f in files:
         c = _chunk_index(f)
         if lazy:
-            try:
-                ok = ("block" not in meta
-                      or pl.read_parquet_metadata(f).get(_FINGERPRINT) == _fingerprint(meta))
-                ok = ok and pl.read_parquet_schema(f) == dict(_empty(list(meta["grid"])).schema)
-            except Exception:  # noqa: BLE001 - any failure to read means a damaged file
-                ok = False
-            why = None if ok and c is not None else "unreadable or not this scan's"
+            why: str | None
+            if c is None:
+                why, data = "not a chunk file name", b""
+            else:
+                why, data = _sealed_problem(f, _fingerprint(meta), c)
+            if why is None:
+                try:
+                    ok = (pl.read_parquet_schema(io.BytesIO(data))
+                          == dict(_empty(list(meta["grid"])).schema))
+                except Exception:  # noqa: BLE001 - any failure to read: a damaged file
+                    ok = False
+                why = None if ok else "its columns are not a scan table's"
         else:
             why = _chunk_problem(f, meta, c)
         if why is not None:
