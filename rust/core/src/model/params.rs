@@ -293,7 +293,7 @@ impl From<ParamId> for ParamRef {
 }
 
 impl ParamRef {
-    /// Looks a `with_param` name up: `"mu"`, `"a"`, `"eta"` (every ball), `"eta[2]"`.
+    /// Looks a `with_param` name up: `"mu"`, `"a"`, `"eta"` (every ball), `"eta[2]"` (the third ball: balls count from 0, as everywhere in ballbal).
     pub fn parse(name: &str) -> Option<ParamRef> {
         for s in REGISTRY {
             let Some(key) = s.key else { continue };

@@ -140,7 +140,7 @@ impl Planar {
     }
 
     /// Returns a copy with one named parameter changed (used by scans and continuation):
-    /// a registry name (`"mu"`, `"eta"` for every ball, `"eta[1]"`), revalidated.
+    /// a registry name (`"mu"`, `"eta"` for every ball, `"eta[1]"`, the second ball: balls count from 0), revalidated.
     pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
         let p = ParamRef::parse(name)
             .filter(|p| PLANAR_OWNERS.contains(&p.id.spec().owner))
