@@ -192,10 +192,14 @@ def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
     equilibrium carries its ``residual_imbalance``.
     Scenes with a ramp, gravity or an impulse have none (an error naming the effect).
 
-    From three balls on the perfect balances form a family (``neutral > 0``), reported
-    once by one of its points. Up to four balls every start of a lattice is tried; from
-    five on the search tries ``max(600, 25 n)`` starts (balls together, then a
-    low-discrepancy sequence) and says so with ``exhaustive=False``."""
+    Of the planar balancer, every state off the axis is listed in closed form, for any
+    damping (``zeta = 0`` included) and up to ten balls: at rest each ball needs the disk
+    centre on its line, so every ball sits at ``b`` or ``b + pi`` and the balls act as
+    one mass ``sum s_i eta_i`` (``s_i = +-1``), which leaves at most two ``b`` per sign
+    pattern. From three balls on the perfect balances form a family (``neutral > 0``),
+    reported once by one of its points. Up to four balls every start of a lattice is
+    tried; from five on the search tries ``max(600, 25 n)`` starts (balls together, then
+    a low-discrepancy sequence) and says so with ``exhaustive=False``."""
     _check.model("model", model)
     eta = capacities(model)
     return [_equilibrium(d, eta) for d in _native.equilibria(model)]
