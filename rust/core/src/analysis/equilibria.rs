@@ -312,7 +312,9 @@ pub fn perfect_balance_verdict(p: &Planar) -> Option<Verdict> {
     } else if n == 1 && p.omega_s > 0.0 {
         closed_form_one(p)
     } else {
-        return equilibria(p)
+        // The search alone: the states off the axis that `equilibria` adds in closed
+        // form are never perfect balances, and a scan asks this at every point.
+        return equilibria_of(p, equal_balls(p), true)
             .into_iter()
             .find(|e| e.kind == EquilibriumKind::PerfectBalance)
             .map(|e| e.verdict);

@@ -3,7 +3,8 @@
 //! scan knows only the trait.
 
 use crate::equilibria::{
-    equal_balls, equilibria, perfect_balance_verdict, Equilibrium, EquilibriumKind, Verdict,
+    equal_balls, equilibria, equilibria_of, perfect_balance_verdict, Equilibrium, EquilibriumKind,
+    Verdict,
 };
 use crate::error::Result;
 use crate::model::ParamRef;
@@ -40,8 +41,16 @@ impl Parametric for Planar {
 
 impl Family for Planar {
     fn balance(&self) -> Option<Equilibrium> {
-        equilibria(self)
-            .into_iter()
+        // Where there are no closed forms, the search alone finds the perfect balances
+        // (`equilibria` adds only states off the axis to it), without analysing the rest.
+        let n = self.n_balls();
+        let closed = n == 2 && equal_balls(self) || n == 1 && self.omega_s > 0.0;
+        let all = if closed {
+            equilibria(self)
+        } else {
+            equilibria_of(self, equal_balls(self), true)
+        };
+        all.into_iter()
             .find(|e| e.kind == EquilibriumKind::PerfectBalance)
     }
     fn balance_verdict(&self) -> Option<Verdict> {
