@@ -1,0 +1,42 @@
+"""Bounded sizes and the right errors in the analyses (issue 30): every size has a stated
+bound checked before any work, and bad input raises a ``ballbal.exceptions`` class that
+names the argument the caller wrote. Each test here failed before its fix: the call ran
+(for hours, or returned rows), or raised numpy's or Python's own error, or named another
+parameter."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import ballbal
+from ballbal import Balancer, _check
+from ballbal.continuation import Seed003, from_seed003
+from ballbal.exceptions import ParameterError
+
+
+def refused(call, parameter: str, kind: type[ParameterError] = ParameterError) -> str:
+    """Runs ``call``; it must raise ``kind`` naming ``parameter``. Returns the message."""
+    with pytest.raises(kind) as e:
+        call()
+    assert e.value.parameter == parameter, (e.value.parameter, str(e.value))
+    return str(e.value)
+
+
+# --- balls ------------------------------------------------------------------------
+
+def test_one_bound_on_balls_everywhere():
+    """1000 balls were accepted by Python (equilibria() then ran for hours) while scene
+    files and the command line stopped at 64: the one constant now bounds them all."""
+    assert ballbal.scene.MAX_BALLS == _check.MAX_BALLS == 64
+    msg = refused(lambda: Balancer(eta=(0.01,) * 1000), "eta")
+    assert "64" in msg
+    refused(lambda: Balancer(eta=np.full(65, 0.1)), "eta")
+    refused(lambda: Balancer(eta=(0.5, 0.5), zeta_b=(0.1,) * 65), "zeta_b")
+    refused(lambda: Balancer().replace(eta=(0.1,) * 65), "eta")
+    refused(lambda: from_seed003(0.5, 0.1, 2.0, n=65), "n")
+    refused(lambda: Seed003(0.5, 0.1, 2.0, n=65), "n")
+    refused(lambda: Balancer.from_lab(
+        disk_mass=1.0, eccentricity=1e-3, ball_masses=[1e-3] * 65, track_radius=0.05,
+        stiffness=1e4, damping=1.0, track_damping=1e-3, spin=100.0), "ball_masses")
+    assert Balancer(eta=(1 / 32,) * 64).n_balls == 64
