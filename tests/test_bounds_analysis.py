@@ -40,3 +40,26 @@ def test_one_bound_on_balls_everywhere():
         disk_mass=1.0, eccentricity=1e-3, ball_masses=[1e-3] * 65, track_radius=0.05,
         stiffness=1e4, damping=1.0, track_damping=1e-3, spin=100.0), "ball_masses")
     assert Balancer(eta=(1 / 32,) * 64).n_balls == 64
+
+
+# --- periodic's simulated start search ----------------------------------------------
+
+def test_periodic_bounds_the_parameters_of_its_start_search():
+    """``zeta=100`` took 85 s and ``Omega=1e3`` many minutes in the search by
+    simulation for a start that finds nothing; now refused before it, naming the
+    parameter and the bound."""
+    for kw, name in ((dict(zeta=100.0), "zeta"), (dict(Omega=1e3), "Omega"),
+                     (dict(zeta_b=(0.1, 31.0)), "zeta_b")):
+        msg = refused(lambda kw=kw: ballbal.periodic(Balancer(**kw), "R-R"), name)
+        assert "30" in msg and "guess" in msg
+    scene = ballbal.Scene(balancer=Balancer(Omega=31.0), springs=0.1)
+    refused(lambda: ballbal.periodic(scene, "R-R"), "Omega")
+    # accuracy_cost finds its start with periodic()
+    refused(lambda: ballbal.accuracy_cost(Balancer(Omega=40.0), N=[], samples=[], tol=[],
+                                          rtol=[], magnus_rtol=[], base_N=3,
+                                          reference_N=4), "Omega")
+    # with a guess there is no search, and no bound: Newton runs (whatever it finds)
+    opts = dict(N=3, hill=False, floquet=False, max_iter=5)
+    s = ballbal.periodic(Balancer(), "R-R", **opts)
+    r = ballbal.periodic(Balancer(Omega=31.0), "R-R", guess=s, **opts)
+    assert isinstance(r, ballbal.PeriodicSolution) and r.info["guess_source"] == "guess"
