@@ -6,6 +6,8 @@ parameter."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -63,3 +65,26 @@ def test_periodic_bounds_the_parameters_of_its_start_search():
     s = ballbal.periodic(Balancer(), "R-R", **opts)
     r = ballbal.periodic(Balancer(Omega=31.0), "R-R", guess=s, **opts)
     assert isinstance(r, ballbal.PeriodicSolution) and r.info["guess_source"] == "guess"
+
+
+# --- balance_map -------------------------------------------------------------------
+
+def test_balance_map_refuses_values_outside_the_parameters_ranges():
+    """``Omega=[-1.0], zeta_b=[-1.0]`` gave a row with status "ok" and a verdict: the
+    core set the values on each point without checking them."""
+    b = Balancer()
+    refused(lambda: ballbal.balance_map(b, Omega=[-1.0], zeta_b=[-1.0]), "Omega")
+    refused(lambda: ballbal.balance_map(b, zeta_b=[0.1, -1.0]), "zeta_b")
+    refused(lambda: ballbal.balance_map(b, Omega=[1.2], eta=[0.5, 0.0]), "eta")
+    refused(lambda: ballbal.balance_map(b, mu=[0.5, 1.0]), "mu")
+    refused(lambda: ballbal.balance_map(ballbal.Scene(balancer=b, springs=0.1),
+                                        delta=[-3.0]), "delta")
+
+
+def test_balance_map_refuses_nested_axes_and_a_grid_too_large():
+    b = Balancer()
+    refused(lambda: ballbal.balance_map(b, Omega=[[1.1, 1.2], [1.3, 1.4]]), "Omega")
+    refused(lambda: ballbal.balance_map(b, Omega=[1.2, math.nan]), "Omega")
+    # two axes of 400 values: 160 000 points, more than MAX_MAP_POINTS, before any is built
+    big = np.linspace(1.1, 2.0, 400)
+    refused(lambda: ballbal.balance_map(b, Omega=big, eta=big), "Omega")
