@@ -88,3 +88,32 @@ def test_balance_map_refuses_nested_axes_and_a_grid_too_large():
     # two axes of 400 values: 160 000 points, more than MAX_MAP_POINTS, before any is built
     big = np.linspace(1.1, 2.0, 400)
     refused(lambda: ballbal.balance_map(b, Omega=big, eta=big), "Omega")
+
+
+# --- accuracy_cost ----------------------------------------------------------------
+
+def test_accuracy_cost_needs_a_reference_finer_than_the_baseline():
+    """A reference with fewer harmonics than the baseline (or than an N tried) was
+    accepted: the "errors" were then the reference's own."""
+    b = Balancer()
+    no_knobs = dict(N=[], samples=[], tol=[], rtol=[], magnus_rtol=[], repeats=1)
+    refused(lambda: ballbal.accuracy_cost(b, base_N=3, reference_N=2, **no_knobs),
+            "reference_N")
+    refused(lambda: ballbal.accuracy_cost(b, base_N=3, reference_N=3, **no_knobs),
+            "reference_N")
+    refused(lambda: ballbal.accuracy_cost(b, base_N=3, reference_N=8,
+                                          **{**no_knobs, "N": [2, 12]}), "reference_N")
+
+
+def test_accuracy_cost_checks_every_knob_before_solving():
+    b = Balancer()
+    kw = dict(N=[2], samples=[4], tol=[1e-6], rtol=[1e-5], magnus_rtol=[], base_N=3,
+              reference_N=4, repeats=1)
+    refused(lambda: ballbal.accuracy_cost(b, **{**kw, "tol": [0.0]}), "tol")
+    refused(lambda: ballbal.accuracy_cost(b, **{**kw, "rtol": [1.5]}), "rtol")
+    refused(lambda: ballbal.accuracy_cost(b, **{**kw, "magnus_rtol": [-1e-6]}),
+            "magnus_rtol")
+    # 3 harmonics x 30000 = 90000 samples per period, over the core's 65536
+    refused(lambda: ballbal.accuracy_cost(b, **{**kw, "samples": [30000]}), "samples")
+    refused(lambda: ballbal.accuracy_cost(b, **{**kw, "N": [1] * 1001}), "N")
+    refused(lambda: ballbal.accuracy_cost(b, **{**kw, "neighbour": 2.0}), "neighbour")
