@@ -14,7 +14,8 @@ import pytest
 import ballbal
 from ballbal import Balancer, _check
 from ballbal.continuation import Seed003, from_seed003
-from ballbal.exceptions import ParameterError
+from ballbal.exceptions import ParameterError, ParameterTypeError
+from ballbal.sweep import speed_sweep
 
 
 def refused(call, parameter: str, kind: type[ParameterError] = ParameterError) -> str:
@@ -117,3 +118,37 @@ def test_accuracy_cost_checks_every_knob_before_solving():
     refused(lambda: ballbal.accuracy_cost(b, **{**kw, "samples": [30000]}), "samples")
     refused(lambda: ballbal.accuracy_cost(b, **{**kw, "N": [1] * 1001}), "N")
     refused(lambda: ballbal.accuracy_cost(b, **{**kw, "neighbour": 2.0}), "neighbour")
+
+
+# --- speed_sweep -----------------------------------------------------------------
+
+SPEEDS = [1.2, 1.3]
+
+
+def test_speed_sweep_errors_name_its_own_arguments():
+    """``dwell`` was reported as ``t_end``, ``kick=nan`` as ``y0``, ``record=0`` as
+    ``t``; ``record < 0`` raised numpy's ValueError and ``options=3`` an
+    AttributeError."""
+    b = Balancer(eta=(0.7, 0.7))
+    for dwell in (-1.0, 0.0, math.inf, 2e6):
+        refused(lambda dwell=dwell: speed_sweep(b, SPEEDS, dwell=dwell), "dwell")
+    refused(lambda: speed_sweep(b, SPEEDS, dwell=10.0, kick=math.nan), "kick")
+    refused(lambda: speed_sweep(b, SPEEDS, dwell=10.0, record=0.0), "record")
+    refused(lambda: speed_sweep(b, SPEEDS, dwell=10.0, record=-5.0), "record")
+    refused(lambda: speed_sweep(b, SPEEDS, dwell=10.0, options=3), "options",
+            ParameterTypeError)
+    refused(lambda: speed_sweep(b, [1.2, math.nan], dwell=10.0), "speeds")
+    refused(lambda: speed_sweep(b, [[1.2, 1.3]], dwell=10.0), "speeds")
+    refused(lambda: speed_sweep(b, [-1.0, 1.2], dwell=10.0), "speeds")
+    refused(lambda: speed_sweep(b, SPEEDS, dwell=10.0, direction=np.array([1, 2])),
+            "direction")
+
+
+def test_speed_sweep_sizes_are_bounded():
+    b = Balancer(eta=(0.7, 0.7))
+    # 6000 speeds up and down are 11999 steps
+    many = np.linspace(1.0, 2.0, 6000)
+    refused(lambda: speed_sweep(b, many, dwell=10.0), "speeds")
+    # 100 steps recording 1e4 time units: 2e7 samples kept
+    refused(lambda: speed_sweep(b, np.linspace(1.0, 2.0, 100), dwell=10.0,
+                                direction="up", record=1e4), "record")
