@@ -13,6 +13,7 @@ import pytest
 
 import ballbal
 from ballbal import Balancer, _check
+from ballbal.basins import BasinOptions, basins, default_grid
 from ballbal.continuation import Seed003, from_seed003
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.sweep import speed_sweep
@@ -152,3 +153,41 @@ def test_speed_sweep_sizes_are_bounded():
     # 100 steps recording 1e4 time units: 2e7 samples kept
     refused(lambda: speed_sweep(b, np.linspace(1.0, 2.0, 100), dwell=10.0,
                                 direction="up", record=1e4), "record")
+
+
+# --- basins ----------------------------------------------------------------------
+
+def m2() -> Balancer:
+    return Balancer(eta=(0.7, 0.7), Omega=1.35)
+
+
+def test_basins_errors_name_its_own_arguments():
+    """A bad ``seed`` raised numpy's errors, NaN angles were reported as ``starts``
+    (the core's name), and 2-D axes were flattened without a word."""
+    o = BasinOptions(window=5.0)
+    for seed in (-1, "x", 1.5, 2**70):
+        refused(lambda seed=seed: basins(m2(), samples=4, seed=seed, t_end=10.0,
+                                         options=o), "seed")
+    refused(lambda: basins(m2(), b1=[0.1, math.nan], b2=[1.0], t_end=10.0, options=o),
+            "b1")
+    refused(lambda: basins(m2(), b1=[0.1], b2=[[1.0, 2.0], [3.0, 4.0]], t_end=10.0,
+                           options=o), "b2")
+    refused(lambda: basins(m2(), n=2, seed=3, t_end=10.0, options=o), "seed")
+
+
+def test_basins_sizes_are_bounded():
+    o = BasinOptions(window=5.0)
+    refused(lambda: basins(m2(), n=1001, t_end=10.0, options=o), "n")
+    refused(lambda: basins(m2(), samples=10**6 + 1, t_end=10.0, options=o), "samples")
+    axis = np.linspace(0.0, 6.0, 1001)
+    refused(lambda: basins(m2(), b1=axis, b2=axis, t_end=10.0, options=o), "b1")
+    refused(lambda: default_grid(10**9), "n")
+
+
+def test_basins_checks_its_options_before_writing_out(tmp_path):
+    """A t_end out of range was refused only after the directory and its meta.json
+    were written."""
+    out = tmp_path / "b"
+    refused(lambda: basins(m2(), n=2, t_end=2e6,
+                           execution=ballbal.Execution(out=out)), "t_end")
+    assert not out.exists()
