@@ -14,7 +14,7 @@ import pytest
 import ballbal
 from ballbal import Balancer, _check
 from ballbal.basins import BasinOptions, basins, default_grid
-from ballbal.continuation import Seed003, from_seed003
+from ballbal.continuation import Continuation, Seed003, from_seed003
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.sweep import speed_sweep
 
@@ -191,3 +191,11 @@ def test_basins_checks_its_options_before_writing_out(tmp_path):
     refused(lambda: basins(m2(), n=2, t_end=2e6,
                            execution=ballbal.Execution(out=out)), "t_end")
     assert not out.exists()
+
+
+# --- continuation ----------------------------------------------------------------
+
+def test_continuation_sizes_are_bounded():
+    refused(lambda: Continuation(max_points=10**9), "max_points")
+    refused(lambda: Continuation(max_newton=10**6), "max_newton")
+    assert Continuation(max_points=_check.MAX_BRANCH_POINTS).max_points == 10**5
