@@ -55,6 +55,15 @@ NAMES = {
     "repeats",
     # command line
     "scan_dir", "type", "cmd",
+    # basins, speed sweeps and their helpers
+    "b1", "b2", "n", "seed", "settle_check", "rest_tol", "merge_tol", "settle_factor",
+    "early_stop", "speeds", "dwell", "direction", "kick", "record", "angles", "t",
+    "magnus_rtol", "result", "title", "y", "d", "n_balls", "omega_from", "omega_to",
+    # continuation
+    "range", "range1", "parameter", "parameter2", "event_index", "event", "kind",
+    "amplitude", "solution", "branch", "min_omega", "event_tol", "periodic_options",
+    "locate_tol", "ds", "ds_min", "ds_max", "max_points", "max_newton", "grow", "min_cos",
+    "forward", "omega0", "m0", "e", "C0", "D0",
 }
 
 

@@ -58,11 +58,12 @@ class Continuation:
 
     ``ds`` is the first step, between ``ds_min`` and ``ds_max``, measured in the unknowns
     and the parameter together (the harmonic coefficients, omega, the parameter);
-    ``max_points`` bounds the branch; Newton's corrector converges when the residual is
-    at most ``tol`` within ``max_newton`` iterations; the step grows by ``grow`` after an
-    easy correction and halves after a failed one or a turn sharper than
-    ``acos(min_cos)`` between successive tangents. ``forward`` starts towards increasing
-    parameter.
+    ``max_points`` bounds the branch (at most :data:`~ballbal._check.MAX_BRANCH_POINTS`);
+    Newton's corrector converges when the residual is at most ``tol`` within
+    ``max_newton`` iterations (at most :data:`~ballbal._check.MAX_NEWTON`); the step
+    grows by ``grow`` after an easy correction and halves after a failed one or a turn
+    sharper than ``acos(min_cos)`` between successive tangents. ``forward`` starts
+    towards increasing parameter.
     """
 
     ds: float = 0.01
@@ -78,8 +79,9 @@ class Continuation:
     def __post_init__(self) -> None:
         for name in ("ds", "ds_min", "ds_max", "tol", "grow", "min_cos"):
             object.__setattr__(self, name, _check.real(name, getattr(self, name)))
-        for name in ("max_points", "max_newton"):
-            object.__setattr__(self, name, _check.integer(name, getattr(self, name), 1))
+        for name, most in (("max_points", _check.MAX_BRANCH_POINTS),
+                           ("max_newton", _check.MAX_NEWTON)):
+            object.__setattr__(self, name, _check.integer(name, getattr(self, name), 1, most))
         object.__setattr__(self, "forward", _check.boolean("forward", self.forward))
 
 

@@ -262,3 +262,95 @@ def renamed_model(old: str) -> Callable[[Callable[_P, _R]], Callable[_P, _R]]:
             return f(*args, **kwargs)
         return call
     return wrap
+
+
+# --- Sizes of the analyses: sweeps, basins, balance maps, accuracy_cost, continuation
+# and the models (kept in one block; other bounds are above). ---
+
+#: Most balls a model may have (a balancer's ``eta``, a scene file's ``balls``, the
+#: command line's ``--balls``): one bound everywhere. The equilibrium search tries
+#: ``max(600, 25 n)`` starts of an ``n + 2`` unknown Newton solve, so its work grows
+#: about as ``n^4``: at 64 balls it takes 9 s (23 s with ball springs; 0.8 s at 32) on a
+#: loaded 2-core machine, at 1000 it would take days.
+MAX_BALLS = 64
+#: Most starts of one basin map (grid points ``len(b1) * len(b2)`` or ``n^2``, or
+#: ``samples``). Each start is a simulation of ``t_end`` time units (milliseconds to a
+#: second), and the starts and their table are held in memory: a million is a
+#: thousand-by-thousand map, hours of work at the default ``t_end``.
+MAX_BASIN_STARTS = 10**6
+#: Most speed steps of one sweep (``"up-down"`` makes ``2 len(speeds) - 1`` of them).
+#: Each step is a simulation of ``dwell`` time units, run one after the other since
+#: every step starts from the state the last one left; ten thousand steps at the
+#: default dwell are hours.
+MAX_SWEEP_STEPS = 10**4
+#: Most points of a balance map (the product of its axes). The core holds one scene and
+#: one equilibrium with its eigenvalues per point, all at once: measured 3.7 kB a point
+#: with 2 balls, 12 kB with 64, so 0.4 to 1.2 GB at this bound (and 20 s of work with 2
+#: balls, over an hour with 64).
+MAX_MAP_POINTS = 10**5
+#: Most points of one continuation (``Continuation.max_points``). Every point keeps
+#: its solution (up to ``(n + 2)(2 N + 1)`` coefficients, multipliers, a Python
+#: solution object): at a hundred thousand points a branch is already hundreds of MB.
+MAX_BRANCH_POINTS = 10**5
+#: Most Newton iterations per continuation step (``Continuation.max_newton``): a
+#: corrector that has not converged in a hundred iterations halves the step instead.
+MAX_NEWTON = 100
+#: Largest ``Omega`` for which :func:`ballbal.periodic` searches its start by
+#: simulation (without ``guess``). The balls turn ``Omega`` radians per time unit, so the
+#: integrator's steps per time unit grow with it (about 20 at the thesis' 1.2, 2000 at
+#: 100); a pattern that no start reaches is simulated some 100 times for ``settle +
+#: window`` time units: 4 s at 1.2, 12 s at 10, 22 s at 30, 106 s at 100, many minutes at
+#: 1e3 (one loaded 2-core machine). Balancers run at a few times the support's natural
+#: frequency (the thesis below 3): 30 leaves a wide margin.
+MAX_SEARCH_OMEGA = 30.0
+#: Largest damping ratio ``zeta`` and ``zeta_b`` for the same search: past a few times
+#: critical damping the explicit integrator's step is held by stability, and the search
+#: that finds nothing takes 15 s at 30 but 85 to 92 s at 100. No rig's support or track
+#: is damped more than a few times critically.
+MAX_SEARCH_DAMPING = 30.0
+#: Most values of one knob of :func:`ballbal.accuracy_cost` (``N``, ``samples``,
+#: ``tol``, ``rtol``, ``magnus_rtol``) and of a :func:`ballbal.track_damping_study`:
+#: each value is a full solve (``repeats`` times) or simulation.
+MAX_STUDY_VALUES = 1000
+
+
+def vector(name: str, v: Any, max_size: int, *, empty: bool = False) -> np.ndarray:
+    """One number or a one-dimensional list of them (a numpy array, a polars or pandas
+    series) as a float64 array of finite numbers, at most ``max_size`` of them, refused
+    before it is converted when longer. Unlike :func:`array`, a nested list or 2-D array
+    is refused (flattening it would hide the mistake), and so are NaN and inf; an empty
+    one too unless ``empty``."""
+    if is_real(v) or (isinstance(v, np.ndarray) and v.ndim == 0):
+        v = np.reshape(v, 1)
+    if isinstance(v, (str, bytes)) or not (isinstance(v, (Sequence, np.ndarray))
+                                           or hasattr(v, "__array__")):
+        raise ParameterTypeError(name, f"must be a list of numbers, got "
+                                 f"{type(v).__name__} {v!r:.60}", value=v)
+    size = len(v)
+    if size > max_size:
+        raise ParameterError(name, f"{size} values, at most {max_size}",
+                             allowed=f"at most {max_size} values", value=size)
+    try:
+        shape = np.shape(v)
+    except ValueError:  # ragged: nested lists of different lengths
+        shape = (size, -1)
+    if len(shape) != 1:
+        got = f"an array of shape {shape}" if min(shape) >= 0 else "nested lists"
+        raise ParameterError(name, f"must be a flat list of numbers, got {got}", value=v)
+    a = array(name, v)
+    if a.size == 0 and not empty:
+        raise ParameterError(name, "must hold at least one value", value=v)
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise ParameterError(name, f"value {bad[0]} is {a[bad[0]]}: every value must be "
+                             "finite", allowed="finite numbers", value=v)
+    return a
+
+
+def at_most(name: str, size: int, limit: int, what: str) -> int:
+    """``size`` (a count the arguments imply: grid points, steps), refused above
+    ``limit`` with an error naming ``name``, the argument to cut."""
+    if size > limit:
+        raise ParameterError(name, f"gives {size:.3g} {what}, at most {limit:.3g}",
+                             allowed=f"at most {limit:.3g} {what}", value=size)
+    return size

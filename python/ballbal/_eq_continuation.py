@@ -160,9 +160,10 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     parameter = _check.string("parameter", parameter)
     rng = parameter_range(range)
     options = _options(options)
-    if direction not in (None, "forward", "backward", "both"):
+    if direction is not None and (not isinstance(direction, str)
+                                  or direction not in ("forward", "backward", "both")):
         raise ParameterError("direction", f"must be 'forward', 'backward' or 'both', got "
-                             f"{direction!r}", allowed="forward, backward, both")
+                             f"{direction!r:.60}", allowed="forward, backward, both")
     if direction in ("forward", "backward"):
         options = replace(options, forward=direction == "forward")
     if isinstance(start, str):

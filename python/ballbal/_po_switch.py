@@ -69,11 +69,13 @@ def switch(
             raise ParameterError("event", "the branch has no located events")
         if kind is None:
             kind = str(solution.events["type"][i])  # type: ignore[assignment]
-        parameter = parameter or solution.parameter
+        parameter = solution.parameter if parameter is None else parameter
         solution = solution.event_solutions[i]
     if parameter is None:
         raise ParameterError("parameter", "name the parameter the branch is continued in")
     _check.string("parameter", parameter)
+    if kind is not None:
+        _check.string("kind", kind)
     amp = _check.real("amplitude", amplitude, 0.0, 10.0, lo_open=True)
     options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
                             "ballbal.PeriodicOptions")

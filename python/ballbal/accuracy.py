@@ -3,6 +3,7 @@ seconds at one parameter point."""
 
 from __future__ import annotations
 
+import math
 import statistics
 import time
 from collections.abc import Sequence
@@ -36,6 +37,14 @@ def _coeff_error(c: np.ndarray, ref: np.ndarray) -> float:
     pad[:, : c.shape[1]] = c
     padr[:, : ref.shape[1]] = ref
     return float(np.max(np.abs(pad - padr)) / max(1.0, float(np.max(np.abs(ref)))))
+
+
+def _knob(name: str, v: Any) -> list[Any]:
+    """The values of one knob: a list (empty skips the knob), at most
+    :data:`~ballbal._check.MAX_STUDY_VALUES` (each is ``repeats`` solves)."""
+    items = _check.sequence(name, v, empty=True)
+    _check.at_most(name, len(items), _check.MAX_STUDY_VALUES, "values")
+    return items
 
 
 @_check.renamed_model("balancer")
@@ -76,19 +85,34 @@ def accuracy_cost(
     series fails one (``status`` ``not_closed`` or ``truncated``) has no errors, and
     ``verdict_ok`` is null where either verdict is ``undetermined`` (no verdict is not a
     wrong verdict); ``closure``, ``separation_error`` and ``stability`` are columns.
+
+    Checked before any solve, each error naming its argument: ``reference_N`` above
+    ``base_N`` and at least every ``N`` (at most 256), at most
+    :data:`~ballbal._check.MAX_STUDY_VALUES` values per knob, ``samples`` multiples
+    giving at most 65536 samples, ``tol > 0``, ``rtol`` and ``magnus_rtol`` in (0, 1),
+    ``neighbour <= Omega``.
     """
     _check.model("model", model)
     _check.string("pattern", pattern)
-    N = [_check.integer("N", n, 1, 256) for n in _check.sequence("N", N, empty=True)]
-    multiples = [_check.real("samples", m, 0.0, 1 << 16, lo_open=True)
-                 for m in _check.sequence("samples", samples, empty=True)]
-    tol = [_check.real("tol", t) for t in _check.sequence("tol", tol, empty=True)]
-    rtol = [_check.real("rtol", r) for r in _check.sequence("rtol", rtol, empty=True)]
-    magnus_rtol = [_check.real("magnus_rtol", r)
-                   for r in _check.sequence("magnus_rtol", magnus_rtol, empty=True)]
-    base_N = _check.integer("base_N", base_N, 1, 256)
-    reference_N = _check.integer("reference_N", reference_N, 1, 256)
-    neighbour = _check.real("neighbour", neighbour, finite=True)
+    N = [_check.integer("N", n, 1, 256) for n in _knob("N", N)]
+    base_N = _check.integer("base_N", base_N, 1, 255)
+    # The core's largest sample count: a multiple of base_N above it is refused here,
+    # before the reference solves, rather than at its setting's solve.
+    multiples = [_check.real("samples", m, 0.0, (1 << 16) / base_N, lo_open=True)
+                 for m in _knob("samples", samples)]
+    # The core's ranges, checked before the reference solves: Newton's tolerance is
+    # positive, an integration's relative tolerance in (0, 1).
+    tol = [_check.real("tol", t, 0.0, lo_open=True, finite=True) for t in _knob("tol", tol)]
+    rtol = [_check.real("rtol", r, 0.0, 1.0, lo_open=True, hi_open=True)
+            for r in _knob("rtol", rtol)]
+    magnus_rtol = [_check.real("magnus_rtol", r, 0.0, 1.0, lo_open=True, hi_open=True)
+                   for r in _knob("magnus_rtol", magnus_rtol)]
+    # The errors are measured against the reference: it must resolve more harmonics
+    # than the baseline and at least as many as every N tried.
+    top = max([base_N + 1, *N])
+    reference_N = _check.integer("reference_N", reference_N, top, 256)
+    # the warm start's point, Omega - neighbour, is a speed: not below 0
+    neighbour = _check.real("neighbour", neighbour, -math.inf, model.Omega, finite=True)
     repeats = _check.integer("repeats", repeats, 1, 1000)
     if guess is not None and not isinstance(guess, PeriodicSolution):
         raise ParameterTypeError("guess", "must be a PeriodicSolution or None, got "

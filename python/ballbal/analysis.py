@@ -21,6 +21,10 @@ if TYPE_CHECKING:
 
 Stability = Literal["stable", "unstable", "undetermined"]
 
+#: Times per block of :meth:`PeriodicSolution.time_history` (its cos and sin tables are
+#: this by N: 2 x 130 MB at N = 256).
+_HISTORY_BLOCK = 1 << 16
+
 
 def _atol(atol: float | Sequence[float]) -> list[float]:
     return _check.reals("atol", atol)
@@ -214,9 +218,13 @@ def capacities(model: Balancer | Scene) -> np.ndarray:
 def residual_imbalance(eta: Sequence[float] | np.ndarray,
                        angles: Sequence[float] | np.ndarray) -> float:
     """``|1 + sum eta_i exp(i b_i)|``: the disk's and balls' imbalance together, in units
-    of the disk's ``m_d e``, for balls at angles ``b_i`` from the disk's mass centre."""
-    e = np.asarray(eta, dtype=float)
-    b = np.asarray(angles, dtype=float)
+    of the disk's ``m_d e``, for balls at angles ``b_i`` from the disk's mass centre
+    (one finite value each, at most :data:`~ballbal._check.MAX_BALLS`)."""
+    e = _check.vector("eta", eta, _check.MAX_BALLS)
+    b = _check.vector("angles", angles, _check.MAX_BALLS)
+    if b.size != e.size:
+        raise ParameterError("angles", f"needs one angle per ball ({e.size}), got {b.size}",
+                             allowed=f"{e.size} values", value=b.size)
     return float(abs(1.0 + np.sum(e * np.exp(1j * b))))
 
 
@@ -299,19 +307,29 @@ class PeriodicSolution:
         return amp
 
     def time_history(self, t: Sequence[float] | np.ndarray | None = None) -> pl.DataFrame:
-        """The orbit sampled at times ``t`` (default: 201 points over one period)."""
+        """The orbit sampled at times ``t`` (default: 201 points over one period; at
+        most :data:`~ballbal._check.MAX_SAMPLES` finite times)."""
         if self.omega is None:
             raise ValueError(f"no orbit: the solve did not converge (status {self.status})")
-        tt = np.linspace(0, self.period, 201) if t is None else np.asarray(t, dtype=float)
+        tt = (np.linspace(0, self.period, 201) if t is None
+              else _check.vector("t", t, _check.MAX_SAMPLES))
         tau = self.omega * tt
         m = np.arange(1, self.N + 1)
-        cos, sin = np.cos(np.outer(tau, m)), np.sin(np.outer(tau, m))
         cols: dict[str, Any] = {"t": tt}
         names = _state_names(self.balancer)
         d = len(self.winding)
         a, b = self.coeffs[:, 1::2], self.coeffs[:, 2::2]
-        q = self.coeffs[:, 0] + cos @ a.T + sin @ b.T + np.outer(tau, self.winding)
-        dq = self.omega * (-(sin * m) @ a.T + (cos * m) @ b.T + self.winding)
+        q = np.empty((tt.size, d))
+        dq = np.empty((tt.size, d))
+        # In blocks of times: the cos and sin tables are (times x N), which for 1e7
+        # times and N = 256 would be 40 GB at once.
+        for lo in range(0, tt.size, _HISTORY_BLOCK):
+            tb = tau[lo:lo + _HISTORY_BLOCK]
+            cos, sin = np.cos(np.outer(tb, m)), np.sin(np.outer(tb, m))
+            q[lo:lo + tb.size] = (self.coeffs[:, 0] + cos @ a.T + sin @ b.T
+                                  + np.outer(tb, self.winding))
+            dq[lo:lo + tb.size] = self.omega * (-(sin * m) @ a.T + (cos * m) @ b.T
+                                                + self.winding)
         for j in range(d):
             cols[names[j]] = q[:, j]
         for j in range(d):
@@ -337,7 +355,7 @@ class PeriodicSolution:
 
     def state(self, t: float = 0.0) -> np.ndarray:
         """First-order state ``(q, q')`` on the orbit at time ``t``."""
-        row = self.time_history([t]).drop("t").row(0)
+        row = self.time_history([_check.real("t", t, finite=True)]).drop("t").row(0)
         return np.asarray(row)
 
     def verify(self, rtol: float = 1e-10, atol: float = 1e-12) -> float:
@@ -349,6 +367,24 @@ class PeriodicSolution:
             self.balancer, self.omega, np.ascontiguousarray(self.coeffs.ravel()),
             [float(w) for w in self.winding], _check.real("rtol", rtol),
             _check.real("atol", atol))
+
+
+def _search_range(model: Balancer | Scene) -> None:
+    """Refuses a model whose start search by simulation would run for minutes: ``Omega``
+    above :data:`~ballbal._check.MAX_SEARCH_OMEGA`, ``zeta`` or ``zeta_b`` above
+    :data:`~ballbal._check.MAX_SEARCH_DAMPING` (see there for the measured cost)."""
+    bal = model.balancer if isinstance(model, Scene) else model
+    zb = bal.zeta_b if isinstance(bal.zeta_b, tuple) else (bal.zeta_b,)
+    for name, value, most in (("Omega", bal.Omega, _check.MAX_SEARCH_OMEGA),
+                              ("zeta", bal.zeta, _check.MAX_SEARCH_DAMPING),
+                              ("zeta_b", max(zb), _check.MAX_SEARCH_DAMPING)):
+        if value > most:
+            raise ParameterError(
+                name, f"{value:g} is above {most:g}, the largest for which periodic() "
+                "searches its start by simulation (the search's cost grows with it: "
+                f"minutes at 100); pass guess= (e.g. a solution continued from {most:g} "
+                "or below) to solve here", allowed=f"[0, {most:g}] without guess",
+                value=value)
 
 
 def _windings(windings: Any) -> list[int]:
@@ -466,7 +502,10 @@ def periodic(
     ``omega = None``; it never raises for that. Tolerances and margins outside their
     ranges (``rtol`` and ``atol`` in (0, 1), ``margin`` in [0, 1), ``settle`` and
     ``window`` up to 1e5, ...) raise :class:`~ballbal.exceptions.ParameterError` naming
-    them.
+    them. Without ``guess`` the model's ``Omega`` is at most
+    :data:`~ballbal._check.MAX_SEARCH_OMEGA` and its ``zeta`` and ``zeta_b`` at most
+    :data:`~ballbal._check.MAX_SEARCH_DAMPING` (30): beyond, the simulated search for a
+    start takes minutes; a ``guess`` (a solution continued there) lifts the bound.
     """
     _check.model("model", model)
     _check.string("pattern", pattern)
@@ -492,6 +531,8 @@ def periodic(
             raise ParameterTypeError("guess", "must be a PeriodicSolution or (omega, coeffs), "
                                      f"got {type(guess).__name__}", value=guess)
         gc = np.ascontiguousarray(gc, dtype=np.float64).ravel()
+    if go is None:
+        _search_range(model)
     # (starts, before the constructed starts): by default the nearby points come last.
     starts: tuple[list[tuple[str, float]], bool] | None = None
     if homotopy is None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -42,7 +43,11 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     balancer's perfect balance failed, e.g. springs near the critical speed), ``stability``,
     ``index`` (largest real part of the eigenvalues, seed 001's relative-stability
     index), ``whirl`` (residual ``hypot(x, y)``), ``tilt`` (residual ``hypot(A, B)``,
-    0 for a planar disk), ``residual`` (of the equilibrium equations)."""
+    0 for a planar disk), ``residual`` (of the equilibrium equations).
+
+    Each axis is a flat list of finite values inside the parameter's range (a value
+    outside it raises :class:`~ballbal.exceptions.ParameterError` naming the axis); the
+    grid has at most :data:`~ballbal._check.MAX_MAP_POINTS` points."""
     _check.model("model", model)
     if not axes:
         raise ParameterError("axes", "give at least one parameter to vary, e.g. Omega=[...]")
@@ -56,11 +61,12 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
             raise ParameterError(name, "not a parameter balance_map can vary (allowed: "
                                  f"{', '.join(sorted(allowed))})",
                                  allowed=", ".join(sorted(allowed)))
-        v = _check.array(name, axes[name])
-        if v.size == 0 or not np.all(np.isfinite(v)):
-            raise ParameterError(name, "needs a non-empty list of finite numbers")
+        v = _check.vector(name, axes[name], _check.MAX_MAP_POINTS)
+        _planar_range(scene.balancer, name, v)
         values.append([float(x) for x in v])
-    _check.grid_points([len(v) for v in values], names, streamed=False)
+    k = max(range(len(values)), key=lambda i: len(values[i]))  # the longest: the one to cut
+    _check.at_most(names[k], math.prod(len(v) for v in values), _check.MAX_MAP_POINTS,
+                   "points (the product of the axes)")
     grid = list(itertools.product(*values))
     # The points are built and solved in the core (parameters set by name there), so a
     # map costs the solves and not one Python scene per point.
@@ -89,6 +95,24 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
 
 
 _MAP_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta", "springs"}
+#: The planar balancer's axes: the core sets them on each point's scene without checking
+#: them (issue 30: ``Omega=[-1.0]`` gave rows with verdicts), so they are checked here.
+_PLANAR_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta"}
+
+
+def _planar_range(balancer: Balancer, name: str, values: np.ndarray) -> None:
+    """Refuses an axis of a balancer parameter with a value outside its range (the
+    core's, through :meth:`Balancer.validate`). The ranges are intervals, so the
+    smallest and the largest value decide; the error names the axis (``eta``, not the
+    ball ``eta[1]`` the core names)."""
+    if name not in _PLANAR_AXES:
+        return
+    for x in (float(values.min()), float(values.max())):
+        try:
+            balancer.replace(**{name: x}).validate()
+        except ParameterError as e:
+            raise ParameterError(name, f"{x:g} is outside its range: {e.message}",
+                                 allowed=e.allowed, value=x) from None
 _TILT_AXES = {"a", "b", "j_t", "j_z", "zeta_r"}
 #: On a bearing support: ``rho = e / c``, and the grooves' depth ratio and angle (degrees).
 _BEARING_AXES = {"rho", "depth_ratio", "groove_angle"}

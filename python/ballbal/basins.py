@@ -33,7 +33,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from .exceptions import ParameterError, ScanInterrupted, ScanStoreError
+from .exceptions import ParameterError, ParameterTypeError, ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .options import Execution
 from .scene import Scene
@@ -123,9 +123,11 @@ class Basins:
         regular period (merged R-R, R-O, O-O, ...) to ``periodic()`` of its pattern,
         solved from the series fitted to its first start's own simulated attractor.
         Columns ``label, count, mean_rate`` (the class's mean ball rate), ``kind``,
-        ``omega``, ``stability``, ``status`` (null where nothing is linked)."""
+        ``omega``, ``stability``, ``status`` (null where nothing is linked). ``N``:
+        the harmonics of the fitted series and of the solves, in ``[1, 256]``."""
         from .analysis import equilibria, periodic
 
+        N = _check.integer("N", N, 1, 256)  # noqa: N806 - the harmonics' symbol
         rows = []
         for label in self.table["label"].unique(maintain_order=True).to_list():
             cls = self.table.filter(pl.col("label") == label)
@@ -252,15 +254,22 @@ def _run_chunk(model: Balancer | Scene, starts: list[list[float]], options: Basi
 
 
 def _axis(name: str, v: Any) -> np.ndarray:
-    a = _check.array(name, v)
-    if a.size == 0:
-        raise ParameterError(name, "give at least one angle")
-    return a
+    """A grid axis: a flat, non-empty list of finite angles (a 2-D array is refused, not
+    flattened; NaN is named here rather than as the core's ``starts``)."""
+    return _check.vector(name, v, _check.MAX_BASIN_STARTS)
+
+
+def _seed(v: Any) -> int | None:
+    """``seed``: None (fresh entropy) or a non-negative integer, as numpy's
+    ``default_rng`` takes it, checked here so that its errors name ``seed``."""
+    return _check.optional_integer("seed", v, 0, 2**64 - 1)
 
 
 def default_grid(n: int) -> tuple[np.ndarray, np.ndarray]:
     """``n`` values per axis over ``[0, 2 pi)``: ``b1`` at ``(i + 1/4) h``, ``b2`` at
-    ``(j + 3/4) h`` (``h = 2 pi / n``), so that no start lies on the diagonal."""
+    ``(j + 3/4) h`` (``h = 2 pi / n``), so that no start lies on the diagonal. ``n`` is
+    at most ``sqrt(MAX_BASIN_STARTS)`` (1000)."""
+    n = _check.integer("n", n, 1, math.isqrt(_check.MAX_BASIN_STARTS))
     h = 2 * np.pi / n
     return (np.arange(n) + 0.25) * h, (np.arange(n) + 0.75) * h
 
@@ -296,6 +305,11 @@ def basins(
     ``executor``: a ``concurrent.futures`` executor or Dask ``Client`` running the
     chunks as tasks (``threads`` per task, default 1). None of it changes the
     table.
+
+    At most :data:`~ballbal._check.MAX_BASIN_STARTS` starts (``n <= 1000``); ``b1`` and
+    ``b2`` are flat lists of finite angles; ``seed`` (a non-negative integer) goes with
+    ``samples`` only. Bad arguments raise a
+    :class:`~ballbal.exceptions.ParameterError` naming them before any start is made.
     """
     _check.model("model", model)
     if model.n_balls != 2:
@@ -312,31 +326,40 @@ def basins(
     options = BasinOptions(t_end, window, options.rtol, options.atol, options.rest_tol,
                            options.merge_tol, factor if settle_check else None,
                            options.early_stop)
+    chunk = 256 if execution.chunk is None else execution.chunk
+    if chunk < 1:
+        raise ParameterError("chunk", f"must be >= 1, got {chunk}", allowed=">= 1",
+                             value=chunk)
+    # The core's checks of the model and the options, on no starts: before the starts
+    # are made and before ``out`` is written to.
+    _native.basins(model, [], options, 1, 1, [], lambda _c, _cols: None)
     random = samples is not None
     if random:
         if b1 is not None or b2 is not None or n is not None:
             raise ParameterError("samples", "give either samples (with seed) or a grid")
-        k = _check.integer("samples", samples, 1)
-        rng = np.random.default_rng(seed)
+        k = _check.integer("samples", samples, 1, _check.MAX_BASIN_STARTS)
+        rng = np.random.default_rng(_seed(seed))
         pts = rng.uniform(0.0, 2 * np.pi, size=(k, 2))
         s1, s2 = pts[:, 0], pts[:, 1]
     else:
+        if seed is not None:
+            raise ParameterError("seed", "draws random starts: give it with samples, not "
+                                 "with a grid", value=seed)
         if (b1 is None) != (b2 is None):
             raise ParameterError("b1" if b1 is None else "b2", "give both axes, or n")
         if b1 is not None and b2 is not None:
             if n is not None:
                 raise ParameterError("n", "give either n or the axes b1, b2")
             a1, a2 = _axis("b1", b1), _axis("b2", b2)
+            # the longer axis is the one to cut
+            _check.at_most("b1" if a1.size >= a2.size else "b2", a1.size * a2.size,
+                           _check.MAX_BASIN_STARTS, "starts (len(b1) * len(b2))")
         else:
-            a1, a2 = default_grid(_check.integer("n", 20 if n is None else n, 1))
+            a1, a2 = default_grid(20 if n is None else n)
         g1, g2 = np.meshgrid(a1, a2, indexing="xy")
         s1, s2 = g1.ravel(), g2.ravel()
     starts = [[float(x), float(y)] for x, y in zip(s1, s2, strict=True)]
     threads = (os.cpu_count() or 1) if execution.threads is None else execution.threads
-    chunk = 256 if execution.chunk is None else execution.chunk
-    if chunk < 1:
-        raise ParameterError("chunk", f"must be >= 1, got {chunk}", allowed=">= 1",
-                             value=chunk)
     n_chunks = -(-len(starts) // chunk)
     sizes = {c: min(len(starts), (c + 1) * chunk) - c * chunk for c in range(n_chunks)}
     parts: dict[int, pl.DataFrame] = {}
@@ -433,6 +456,11 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
+    if not isinstance(result, Basins):
+        raise ParameterTypeError("result", "must be a Basins (from ballbal.basins.basins), "
+                                 f"got {type(result).__name__}", value=result)
+    if title is not None:
+        _check.string("title", title)
     if ax is None:
         _, ax = plt.subplots(figsize=(5, 5))
     colours = {"perfect_balance": "white", "other_equilibrium": "tab:green",

@@ -13,18 +13,24 @@ from .exceptions import ParameterError, ParameterTypeError
 
 
 def _tuple(name: str, v: float | Sequence[float]) -> tuple[float, ...]:
+    """One value per ball (or one for all), at most :data:`~ballbal._check.MAX_BALLS`."""
     if _is_number(v):
         return (_check.real(name, v),)
     bad = ParameterTypeError(name, f"must be a number or a sequence of numbers, got {v!r:.60}",
                              value=v)
     if isinstance(v, (str, bytes)):
         raise bad
+    size = len(v) if isinstance(v, Sequence) else getattr(v, "size", None)  # numpy's
+    if isinstance(size, int):
+        # before the values are converted: 1000 balls made equilibria() run for hours
+        _check.at_most(name, size, _check.MAX_BALLS, "balls")
     try:
         items = list(v)  # type: ignore[arg-type]
     except TypeError as e:
         raise bad from e
     if not all(_is_number(x) for x in items):
         raise bad
+    _check.at_most(name, len(items), _check.MAX_BALLS, "balls")  # an iterable without len
     return tuple(_check.real(f"{name}[{i}]", x) for i, x in enumerate(items))
 
 
@@ -112,6 +118,7 @@ class Balancer:
                 ("damping", damping), ("track_damping", track_damping), ("spin", spin),
                 ("other_mass", other_mass)))
         mb = _check.reals("ball_masses", ball_masses)
+        _check.at_most("ball_masses", len(mb), _check.MAX_BALLS, "balls")
         if not mb or any(not (math.isfinite(m) and m > 0) for m in mb):
             raise ParameterError("ball_masses", "need at least one ball, every mass finite "
                                  "and > 0", allowed="(0, inf)", value=ball_masses)
@@ -173,7 +180,7 @@ def from_seed003(
                       (("omega0", omega0), ("C0", C0), ("D0", D0)))
     m0 = _check.real("m0", m0, 0.0, lo_open=True)
     e = _check.real("e", e, 0.0, lo_open=True)
-    n = _check.integer("n", n, 1, 1024)
+    n = _check.integer("n", n, 1, _check.MAX_BALLS)
     s = math.sqrt(1.0 + n * m0)
     return Balancer(
         mu=1.0 / (1.0 + n * m0),
@@ -217,7 +224,7 @@ class Seed003:
                                ("C0", 0.0, False), ("D0", 0.0, False)):
             object.__setattr__(self, k, _check.real(k, getattr(self, k), lo, lo_open=is_open,
                                                     finite=True))
-        object.__setattr__(self, "n", _check.integer("n", self.n, 1, 1024))
+        object.__setattr__(self, "n", _check.integer("n", self.n, 1, _check.MAX_BALLS))
 
     @property
     def balancer(self) -> Balancer:

@@ -423,8 +423,8 @@ _BALANCER_FIELDS = {f.name for f in fields(Balancer)}
 _TILT_FIELDS = {f.name for f in fields(Tilt)}
 
 
-#: Most balls a scene file may ask for with ``balls``.
-MAX_BALLS = 64
+#: Most balls a scene file may ask for with ``balls`` (every model's bound).
+MAX_BALLS = _check.MAX_BALLS
 
 
 def balancer_from_dict(d: dict[str, Any], where: str = "scene") -> Balancer:

@@ -23,7 +23,7 @@ The symmetry-breaking kick
 Merged balls (``b1 = b2``) stay merged for ever in a simulation of identical balls (the
 diagonal is invariant), which no rig does. ``kick`` (default 1e-3 rad) moves ball 1 by
 ``+kick`` and ball 2 by ``-kick`` at the start of every step, as a tap on the rig
-would; ``kick=0`` switches it off.
+would (two balls or more; one ball is not kicked); ``kick=0`` switches it off.
 """
 
 from __future__ import annotations
@@ -37,15 +37,27 @@ import polars as pl
 
 from . import _check, _native
 from .basins import REST, ROTATING, BasinOptions
-from .exceptions import ParameterError
+from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
+
+#: Longest ``dwell`` (and ``record``): the basins' classifier's longest ``t_end``
+#: (``BasinOptions``, checked in the core), which a step's dwell is.
+MAX_DWELL = 1e6
 
 
 def carry_over(y: np.ndarray, omega_from: float, omega_to: float, n_balls: int,
                d: int) -> np.ndarray:
     """The rotating-frame state after a speed step from ``omega_from`` to ``omega_to``
-    with the ground-frame state continuous (see the module's description)."""
-    y = np.array(y, dtype=float)
+    with the ground-frame state continuous (see the module's description); ``y`` has
+    ``2 d`` values (``d`` coordinates, the last ``n_balls`` of them the balls')."""
+    d = _check.integer("d", d, 3, _check.MAX_BALLS + 4)
+    n_balls = _check.integer("n_balls", n_balls, 1, d - 2)
+    y = _check.vector("y", y, 2 * d).copy()
+    if y.size != 2 * d:
+        raise ParameterError("y", f"needs 2 d = {2 * d} values, got {y.size}",
+                             allowed=f"{2 * d} values", value=y.size)
+    omega_from = _check.real("omega_from", omega_from, finite=True)
+    omega_to = _check.real("omega_to", omega_to, finite=True)
     dd = omega_from - omega_to
     x, yy = y[0], y[1]
     y[d] -= dd * yy
@@ -114,22 +126,37 @@ def speed_sweep(
     description. ``record``: simulate that long more after each step's dwell, without
     changing the state carried on, for the vibration indicator
     (:func:`ballbal.spectrum.vibration`); ``None`` skips it.
+
+    Bounds (a :class:`~ballbal.exceptions.ParameterError` naming the argument, before
+    any step runs): at most :data:`~ballbal._check.MAX_SWEEP_STEPS` steps, ``dwell``
+    and ``record`` in ``(0, 1e6]``, ``|kick| <= pi``, and at most
+    :data:`~ballbal._check.MAX_SAMPLES` recorded samples over the sweep.
     """
     from .analysis import simulate
     from .spectrum import ground_signal, signal_spectrum, vibration
 
     _check.model("model", model)
     if not isinstance(model, Balancer):
-        raise ParameterError("model", "speed sweeps take a Balancer")
-    sp = _check.array("speeds", speeds)
-    if sp.size < 1 or np.any(np.diff(sp) <= 0):
-        raise ParameterError("speeds", "give ascending speeds")
-    if direction not in ("up-down", "up", "down"):
+        raise ParameterTypeError("model", "speed sweeps take a Balancer", value=model)
+    if not isinstance(direction, str) or direction not in ("up-down", "up", "down"):
         raise ParameterError("direction", f"must be 'up-down', 'up' or 'down', got "
-                             f"{direction!r}", allowed="up-down, up, down")
-    dwell = _check.real("dwell", dwell)
-    kick = _check.real("kick", kick)
-    o = BasinOptions() if options is None else options
+                             f"{direction!r:.60}", allowed="up-down, up, down")
+    sp = _check.vector("speeds", speeds, _check.MAX_SWEEP_STEPS)
+    if np.any(sp < 0) or np.any(np.diff(sp) <= 0):
+        raise ParameterError("speeds", "give ascending speeds >= 0 (values of Omega)",
+                             allowed="ascending values in [0, inf)", value=speeds)
+    steps = 2 * sp.size - 1 if direction == "up-down" else sp.size
+    _check.at_most("speeds", steps, _check.MAX_SWEEP_STEPS, f"steps going {direction}")
+    # The dwell is the classifier's t_end: its range, named as the caller wrote it.
+    dwell = _check.real("dwell", dwell, 0.0, MAX_DWELL, lo_open=True)
+    kick = _check.real("kick", kick, -np.pi, np.pi)
+    if record is not None:
+        record = _check.real("record", record, 0.0, MAX_DWELL, lo_open=True)
+        # every step keeps the spectrum of its 20 samples per time unit
+        _check.at_most("record", steps * (int(record * 20) + 1), _check.MAX_SAMPLES,
+                       "recorded samples over the sweep (20 per time unit and step)")
+    o = _check.option("options", options, BasinOptions, BasinOptions(),
+                      "ballbal.basins.BasinOptions")
     o = replace(o, t_end=dwell, window=min(o.window, dwell), settle_factor=None)
     if direction == "up":
         path = [(float(s), "up") for s in sp]
@@ -144,15 +171,17 @@ def speed_sweep(
         y[d - n:d] = 0.3
         y[2 * d - n:] = -path[0][0]
     else:
-        y = _check.array("y0", y0).copy()
+        y = _check.vector("y0", y0, 2 * d).copy()
         if y.size != 2 * d:
-            raise ParameterError("y0", f"needs {2 * d} values")
+            raise ParameterError("y0", f"needs {2 * d} values ({', '.join(model.coordinates)} "
+                                 f"and their rates), got {y.size}",
+                                 allowed=f"{2 * d} values", value=y.size)
     prev = path[0][0]
     rows: list[dict[str, Any]] = []
     spectra: list[pl.DataFrame] = []
     for k, (om, dirn) in enumerate(path):
         y = carry_over(y, prev, om, n, d)
-        if kick:
+        if kick and n >= 2:
             y[d - n] += kick
             y[d - n + 1] -= kick
         m = model.replace(Omega=om)

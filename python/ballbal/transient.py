@@ -107,10 +107,12 @@ def track_damping_study(
     """Peak amplitude and settling time after the disturbance for each track damping,
     and seed 001's combined index ``peak * s + settle_time`` with the scale ``s`` = mean
     settling time / mean peak (so both terms count alike); ``optimal`` marks its
-    minimum."""
+    minimum. At most :data:`~ballbal._check.MAX_STUDY_VALUES` dampings (each a
+    simulation of ``t_end``)."""
     rows = []
     _check.model("model", model)
-    for zb in _check.reals("zeta_b", zeta_b):
+    values = [zeta_b] if _check.is_real(zeta_b) else zeta_b
+    for zb in _check.vector("zeta_b", values, _check.MAX_STUDY_VALUES):
         res = disturbance_response(model.replace(zeta_b=zb), to, **kw)
         rows.append({"zeta_b": float(zb), "peak": res.peak, "settle_time": res.settle_time,
                      "final_r": res.final_r})
