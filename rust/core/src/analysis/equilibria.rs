@@ -610,10 +610,10 @@ pub const LINE_STATES_MAX_BALLS: usize = 10;
 /// ball's equation asks the disk centre to lie on the ball's line (`Im(w e^(-i b_i)) =
 /// 0`, `w = x + i y`), so with `w != 0` every ball sits at `b` or `b + pi`: a sign
 /// pattern `s_i = +-1` (`s_1 = +1`; `(b, s)` and `(b + pi, -s)` are one state) makes the
-/// balls act as one mass `eta_s = sum s_i eta_i`, and the disk's equation `(1 - Omega^2
-/// + 2 i zeta Omega) r = mu Omega^2 (exp(-i b) + eta_s)` with `r` real gives `(1 -
-/// Omega^2) sin b + 2 zeta Omega cos b = -2 zeta Omega eta_s`: up to two `b` per pattern,
-/// `r` from the real part. States with `w = 0` (perfect balances) are the search's.
+/// balls act as one mass `eta_s = sum s_i eta_i`, and the disk's equation
+/// `(1 - Omega^2 + 2 i zeta Omega) r = mu Omega^2 (exp(-i b) + eta_s)` with `r` real
+/// gives `(1 - Omega^2) sin b + 2 zeta Omega cos b = -2 zeta Omega eta_s`: up to two `b`
+/// per pattern, `r` from the real part. States with `w = 0` (perfect balances) are the search's.
 /// Empty above [`LINE_STATES_MAX_BALLS`] balls and where the disk equation is singular
 /// (`Omega = 0`; `zeta = 0` at `Omega = 1`).
 fn on_one_line(p: &Planar) -> Vec<(Vec<f64>, EquilibriumKind)> {
