@@ -132,8 +132,9 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
     ``model``, or a kind name: the first equilibrium of that kind) continued in
     ``parameter`` (any name ``with_param`` takes: ``"Omega"``, ``"eta"`` (all balls),
-    ``"eta[1]"`` (the second ball: balls count from 0), ``"zeta"``, ``"zeta_b"``, ``"mu"``, ``"delta"``, scene parameters) by
-    pseudo-arclength over ``range``, through folds.
+    ``"eta[1]"`` (the second ball: balls count from 0), ``"zeta"``, ``"zeta_b"``,
+    ``"mu"``, ``"delta"``, scene parameters) by pseudo-arclength over ``range``, through
+    folds.
 
     ``model`` may also be a :class:`~ballbal.model.Seed003`: then ``parameter`` is one of
     seed 003's (``"omega0"``, ``"m0"``, ``"e"``, ``"C0"``, ``"D0"``), ``start`` an

@@ -69,7 +69,8 @@ def periodic_branch(
 ) -> Branch:
     """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
     in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
-    ``"eta[1]"`` (the second ball: balls count from 0), a scene's ``"springs"``, ...) over ``range = (lo, hi)`` by
+    ``"eta[1]"`` (the second ball: balls count from 0), a scene's ``"springs"``, ...)
+    over ``range = (lo, hi)`` by
     pseudo-arclength continuation of the harmonic-balance equations (through folds),
     with ``N`` harmonics (default: the start's).
 
