@@ -86,6 +86,18 @@ def test_bottomless_grooves_are_refused_before_the_solve() -> None:
            depth_ratio=[1.0, 1e300])
 
 
+def test_what_is_not_dimensions_or_a_film_force_is_named() -> None:
+    """These reached an attribute of the wrong object: AttributeError."""
+    b = br.Bearing(model="short", length_ratio=0.5)
+    raises(ParameterTypeError, "dimensions", br.coefficients, b, (0.1, 0.0), dimensions=3,
+           speed=500.0)
+    dims = br.Dimensions(radius=0.02, length=0.02, clearance=5e-5, viscosity=0.02)
+    for method in (dims.force, dims.pressure):
+        raises(ParameterTypeError, "f", method, (0.1, 0.2), 500.0)
+    raises(ParameterTypeError, "trajectories", br.plot_trajectory, {"run": 3})
+    raises(ParameterTypeError, "df", br.plot_groove_study, [1, 2])
+
+
 # --- groove study -----------------------------------------------------------------
 
 def test_groove_study_threads_are_capped_like_a_scans() -> None:
