@@ -128,3 +128,23 @@ def test_dynamics_invariant_under_mu_delta_scaling() -> None:
     for c in ("b1", "b2", "db1", "db2"):
         assert np.allclose(tb[c].to_numpy(), ta[c].to_numpy(), atol=1e-7), c
     assert np.ptp(ta["b1"].to_numpy()) > 1.0  # the balls move: not a trivial check
+
+
+def test_speed_conversions_refuse_what_numpy_would_convert() -> None:
+    """rpm_to_ratio(None) returned NaN (numpy reads None as NaN) and True counted as
+    1 rpm; both are refused, naming the argument. Arrays keep their shape."""
+    from ballbal.exceptions import ParameterTypeError
+
+    for bad in (None, True, [513.0, None], np.array([True, False]), "513"):
+        with pytest.raises(ParameterTypeError) as e:
+            data.rpm_to_ratio(bad)
+        assert e.value.parameter == "rpm"
+        with pytest.raises(ParameterTypeError) as e:
+            data.ratio_to_rpm(bad)
+        assert e.value.parameter == "ratio"
+    for bad in (math.nan, [1.0, math.inf]):
+        with pytest.raises(ParameterError) as e:
+            data.rpm_to_ratio(bad)
+        assert e.value.parameter == "rpm"
+    r = data.rpm_to_ratio(np.array([[1026.0, -513.0]]))
+    assert r.shape == (1, 2) and r.tolist() == [[2.0, -1.0]]

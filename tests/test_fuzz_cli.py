@@ -93,3 +93,22 @@ def test_cli_plot(tmp_path_factory: pytest.TempPathFactory, rest: list[str]) -> 
     (cwd / "scene.toml").write_text("Omega = 1.2\nballs = 2\n")
     (cwd / "bad.toml").write_bytes(b"\xff\xfe")
     check(["plot", *rest], cwd, {"x"})
+
+
+def test_plot_without_matplotlib_is_one_line_naming_the_extra(tmp_path: Path) -> None:
+    """Without matplotlib 'ballbal plot' printed a traceback. A package that fails to
+    import stands in for the missing one."""
+    import os
+
+    shim = tmp_path / "shim" / "matplotlib"
+    shim.mkdir(parents=True)
+    (shim / "__init__.py").write_text("raise ImportError('No module named matplotlib')\n")
+    path = [str(tmp_path / "shim"), *filter(None, [os.environ.get("PYTHONPATH")])]
+    r = subprocess.run([sys.executable, "-m", "ballbal.cli", "plot", "out"],
+                       capture_output=True, text=True, timeout=LIMIT, cwd=tmp_path,
+                       env={**os.environ, "PYTHONPATH": os.pathsep.join(path)})
+    assert "Traceback" not in r.stderr, r.stderr
+    assert r.returncode == 2
+    lines = [x for x in r.stderr.splitlines() if x.strip()]
+    assert len(lines) == 1 and lines[0].startswith("ballbal: error: cmd: ")
+    assert 'pip install "ballbal[plot]"' in lines[0]

@@ -418,3 +418,30 @@ def test_ground_signal_during_a_ramp_matches_the_ground_frame_equations():
         acc = ground_rhs(sc, t, s)[n + 2 : n + 4]
         worst = max(worst, abs(complex(X2 - acc[0], Y2 - acc[1])) / abs(complex(*acc)))
     assert worst < 1e-6, worst
+
+
+def test_an_unconverged_solution_is_a_parameter_error_naming_it() -> None:
+    """A solve that did not converge has no lines: that was a plain ValueError."""
+    s = ballbal.periodic(ballbal.Balancer(), "R-R", N=3, max_iter=1)
+    assert s.omega is None
+    for f, name in ((sp.line_spectrum, "solution"), (sp.vibration, "source")):
+        with pytest.raises(ParameterError) as e:
+            f(s)
+        assert e.value.parameter == name
+
+
+def test_peak_labelling_is_bounded() -> None:
+    """The line spacing is estimated in n^2 work over n peaks: more than MAX_LINES are
+    refused, and so is a max_peaks above it (label_peaks took up to 10**6)."""
+    from ballbal import _check
+
+    with pytest.raises(ParameterError) as e:
+        sp.label_lines(np.linspace(0.0, 5.0, _check.MAX_LINES + 1), 1.2)
+    assert e.value.parameter == "frequencies"
+    f = np.linspace(0.0, 5.0, 400)
+    table = pl.DataFrame({"frequency": f, "amplitude": np.exp(-((f - 1.2) / 0.02) ** 2)})
+    with pytest.raises(ParameterError) as e:
+        sp.label_peaks(table, 1.2, max_peaks=_check.MAX_LINES + 1)
+    assert e.value.parameter == "max_peaks"
+    peaks = sp.label_peaks(table, 1.2, max_peaks=_check.MAX_LINES)
+    assert peaks.height == 1 and abs(peaks["frequency"][0] - 1.2) < 1e-3

@@ -40,6 +40,51 @@ MAX_THREADS = 1024
 #: Largest integer a count may be (the core's counts are 64-bit).
 _MAX_COUNT = 2**62
 
+# --- Sizes of the bearing modules: bearing grids and grooves, the groove study, the
+# rotor's output times and the spectra (kept in one block). Measured on the project's
+# 2-core machine while other work ran. ---
+
+#: Most finite-volume cells of one bearing grid (``n_theta * n_zeta``). One film solve on
+#: a grid of this size (1024 x 1024) took 1.3 s and 0.27 GB (plain film), 6.2 s and 0.5 GB
+#: (grooved finite film), 13 s and 1.1 GB (narrow-groove film); an equilibrium or a
+#: trajectory solves it many times. 8000 x 2000 took 42 s and 8.4 GB per solve.
+MAX_BEARING_CELLS = 2**20
+#: Most cells around the bearing (``n_theta``): 32 cells per groove pitch of
+#: :data:`MAX_GROOVES` grooves, and a cell of 1e-4 rad, far finer than any film needs.
+MAX_BEARING_THETA = 2**16
+#: Most cells along the bearing (``n_zeta``). The plain finite film solves one periodic
+#: tridiagonal system per sine mode and holds ``n_zeta^2 / 4`` mode values: an ``8 x
+#: 131072`` grid asked for some 34 GB and was killed; at 1024 the modes take 2 MB.
+MAX_BEARING_ZETA = 1024
+#: Most grooves of a bearing: the default grid of this many (16 cells per pitch, 32
+#: along the length) is the largest allowed, :data:`MAX_BEARING_CELLS`. Herringbone
+#: bearings have tens of grooves; narrow-groove theory stands for many more.
+MAX_GROOVES = MAX_BEARING_CELLS // (16 * 32)
+#: Most points of one groove study (the product of its axes). Each point is a film
+#: solve, its linearised coefficients and the concentric stiffness: 0.04 s on the
+#: default 256 x 32 grid of 8 grooves, so 1e5 points are over an hour on one thread.
+MAX_GROOVE_POINTS = 10**5
+#: Most film cells a groove study holds at once: each thread solves one point's grid at
+#: a time, so threads times the largest point's cells (four grids of
+#: :data:`MAX_BEARING_CELLS`, some 4.5 GB with narrow-groove films).
+MAX_STUDY_CELLS = 4 * MAX_BEARING_CELLS
+#: Most frequencies :func:`ballbal.spectrum.label_lines` labels (and most peaks
+#: :func:`~ballbal.spectrum.label_peaks` keeps): the line spacing is estimated by trying
+#: every peak's offset against every peak, ``n^2`` work (1e8 at this bound).
+MAX_LINES = 10**4
+
+
+def axes(name: str, v: Any) -> Any:
+    """A matplotlib ``Axes`` to draw into, or None (a new figure)."""
+    if v is None:
+        return None
+    from matplotlib.axes import Axes
+
+    if not isinstance(v, Axes):
+        raise ParameterTypeError(name, f"must be a matplotlib Axes or None, got "
+                                 f"{type(v).__name__}", allowed="Axes or None", value=v)
+    return v
+
 
 def _range_text(lo: float, hi: float, lo_open: bool = False, hi_open: bool = False) -> str:
     def fmt(v: float) -> str:

@@ -34,7 +34,7 @@ import polars as pl
 
 from . import _check
 from .bearing import Bearing
-from .exceptions import ParameterTypeError
+from .exceptions import ParameterError, ParameterTypeError
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -55,7 +55,8 @@ class RotorImpulse:
 
     def __post_init__(self) -> None:
         for name in ("amplitude", "center", "sharpness", "direction"):
-            object.__setattr__(self, name, _check.real(f"impulse.{name}", getattr(self, name)))
+            object.__setattr__(self, name, _check.real(f"impulse.{name}", getattr(self, name),
+                                                      finite=True))
 
 
 @dataclass(frozen=True)
@@ -102,6 +103,9 @@ class RotorOnBearing:
         ``length_ratio``. Time: ``t = tau / speed``."""
         from . import _native
 
+        if not isinstance(bearing, Bearing):
+            raise ParameterTypeError("bearing", f"bearing must be ballbal.bearing.Bearing, got "
+                                     f"{type(bearing).__name__}", allowed="Bearing")
         args = {k: _check.real(k, v) for k, v in dict(
             radius=radius, length=length, clearance=clearance, viscosity=viscosity,
             mass=mass, speed=speed, unbalance=unbalance, g=g).items()}
@@ -150,11 +154,12 @@ def simulate_rotor(rotor: RotorOnBearing, x0: Any, t_span: Any, *, samples: int 
                    factor_reuse: float | None = 1e-10) -> RotorTrajectory:
     """Simulates ``rotor`` from ``x0`` = ``(x, y)``, ``(x, y, x', y')`` (units ``c`` and
     ``c w``) or ``"equilibrium"`` (at rest at :func:`rotor_equilibrium`) over
-    ``t_span = (tau0, tau1)``, with ``samples`` evenly spaced rows (or the rows at
-    ``t_eval``). ``method`` ``"explicit"`` (Dormand–Prince 5(4); a run whose steps are held
-    so small by stability that finishing would take more than ``stiff_steps`` steps ends
-    ``"stiff"``, with ``stiff_eccentricity`` where they collapsed) or ``"implicit"``
-    (Rosenbrock 2(3)). ``factor_reuse``: relative residual of the preconditioned solves of
+    ``t_span = (tau0, tau1)`` (``tau0 < tau1``), with ``samples`` evenly spaced rows (or
+    the rows at ``t_eval``; at most :data:`~ballbal._check.MAX_SAMPLES` either way).
+    ``method`` ``"explicit"`` (Dormand–Prince 5(4); a run whose steps are held so small by
+    stability that finishing would take more than ``stiff_steps`` steps ends ``"stiff"``,
+    with ``stiff_eccentricity`` where they collapsed) or ``"implicit"`` (Rosenbrock
+    2(3)). ``factor_reuse``: relative residual of the preconditioned solves of
     finite grooved films (``None``: a fresh factorisation per evaluation)."""
     from . import _native
 
@@ -167,20 +172,27 @@ def simulate_rotor(rotor: RotorOnBearing, x0: Any, t_span: Any, *, samples: int 
     if len(x) == 2:
         x = [*x, 0.0, 0.0]
     if len(x) != 4:
-        from .exceptions import ParameterError
-
         raise ParameterError("x0", f"x0 must be (x, y) or (x, y, vx, vy), got {len(x)} values",
                              allowed="2 or 4 numbers")
     span = _check.reals("t_span", t_span)
     if len(span) != 2:
-        from .exceptions import ParameterError
-
         raise ParameterError("t_span", "t_span must be (tau0, tau1)", allowed="2 numbers")
+    # Checked here, where the caller named them: the core sees only the output times made
+    # from them and would name those (t_eval).
+    tau0 = _check.real("t_span[0]", span[0], finite=True)
+    if not (math.isfinite(span[1]) and span[1] > tau0 and math.isfinite(span[1] - tau0)):
+        raise ParameterError("t_span", f"must be (tau0, tau1) with tau1 > tau0, both finite, "
+                             f"got {tuple(span)}", allowed="tau0 < tau1, finite",
+                             value=t_span)
     if t_eval is None:
         n = _check.integer("samples", samples, 2, _check.MAX_SAMPLES)
         te = np.linspace(span[0], span[1], n)
     else:
         te = np.ascontiguousarray(_check.array("t_eval", t_eval), dtype=float)
+        if te.size > _check.MAX_SAMPLES:
+            raise ParameterError("t_eval", f"{te.size} output times, at most "
+                                 f"{_check.MAX_SAMPLES:.0e}",
+                                 allowed=f"at most {_check.MAX_SAMPLES:.0e} times")
     d = _native.simulate_rotor(
         rotor, (x[0], x[1], x[2], x[3]), span[0], te, _check.real("rtol", rtol),
         _check.real("atol", atol),
@@ -206,9 +218,17 @@ def plot_trajectory(trajectories: RotorTrajectory | dict[str, RotorTrajectory], 
     """The seed's two views of one or more labelled trajectories: the journal orbit inside
     the clearance circle (``x`` down, as the seed draws it), and the tangential film
     force against time. Returns ``(orbit_figure, force_figure)``."""
-    import matplotlib.pyplot as plt
+    from .plot import _pyplot
 
     runs = trajectories if isinstance(trajectories, dict) else {"": trajectories}
+    for label, tr in runs.items():
+        if not isinstance(label, str) or not isinstance(tr, RotorTrajectory):
+            raise ParameterTypeError(
+                "trajectories", f"must be a RotorTrajectory or a dict of them by label (str), "
+                f"got {type(label).__name__}: {type(tr).__name__}", value=trajectories)
+    if title is not None:
+        _check.string("title", title)
+    plt = _pyplot()
     orbit, ax = plt.subplots(figsize=(4.6, 4.6))
     th = np.linspace(0, 2 * math.pi, 361)
     ax.plot(np.sin(th), np.cos(th), color="0.3", lw=1)

@@ -35,7 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _check
-from .exceptions import ParameterError
+from .exceptions import ParameterError, ParameterTypeError
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -63,7 +63,9 @@ CELLS_PER_PITCH = 16
 class Grooves:
     """Herringbone grooves: ``count`` grooves at ``angle`` degrees from the circumferential
     direction, ``depth_ratio`` = groove depth / clearance, ``width_ratio`` = groove width /
-    pitch in (0, 1), over the central ``grooved_length`` fraction of the length."""
+    pitch in (0, 1), over the central ``grooved_length`` fraction of the length. At most
+    :data:`~ballbal._check.MAX_GROOVES` grooves, at most ``1e3`` clearances deep (deeper
+    grooves change no force)."""
 
     count: int
     angle: float
@@ -73,7 +75,8 @@ class Grooves:
     side: str = "sleeve"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "count", _check.integer("grooves.count", self.count, 1))
+        object.__setattr__(self, "count", _check.integer("grooves.count", self.count, 1,
+                                                         _check.MAX_GROOVES))
         for name in ("angle", "depth_ratio", "width_ratio", "grooved_length"):
             object.__setattr__(
                 self, name, _check.real(f"grooves.{name}", getattr(self, name), finite=True)
@@ -97,7 +100,11 @@ class Bearing:
     ``cavitation`` condition (``"half_sommerfeld"``, the seed's and the default;
     ``"reynolds"``; ``"none"``), the film ``model`` (``"short"``, ``"long"``,
     ``"finite"``, ``"narrow_groove"``) and the grid ``(n_theta, n_zeta)`` of the finite
-    and narrow-groove models (``None``: :func:`default_grid`).
+    and narrow-groove models (``None``: :func:`default_grid`); at most
+    :data:`~ballbal._check.MAX_BEARING_CELLS` cells, ``n_theta`` at most
+    :data:`~ballbal._check.MAX_BEARING_THETA` and ``n_zeta`` at most
+    :data:`~ballbal._check.MAX_BEARING_ZETA` (one film solve on the largest grid takes
+    seconds and up to a gigabyte).
 
     ``"narrow_groove"`` is Vohr and Chow's narrow-groove theory: the grooves smoothed into
     an anisotropic film, exact as the groove count grows, on a grid that need not resolve
@@ -115,32 +122,40 @@ class Bearing:
         )
         object.__setattr__(self, "cavitation", _check.string("cavitation", self.cavitation))
         object.__setattr__(self, "model", _check.string("model", self.model))
-        if self.grid is None:
-            object.__setattr__(self, "grid", default_grid(self.grooves, self.model))
-        else:
-            g = _check.sequence("grid", self.grid)
-            if len(g) != 2:
-                from .exceptions import ParameterError
-
-                raise ParameterError(
-                    "grid", f"grid must be (n_theta, n_zeta), got {self.grid!r}",
-                    allowed="two integers",
-                )
-            object.__setattr__(
-                self,
-                "grid",
-                (_check.integer("grid.n_theta", g[0]), _check.integer("grid.n_zeta", g[1])),
-            )
+        # Before the default grid, which reads the grooves' count.
         if self.grooves is not None and not isinstance(self.grooves, Grooves):
-            from .exceptions import ParameterTypeError
-
             raise ParameterTypeError(
                 "grooves",
                 f"grooves must be ballbal.bearing.Grooves or None, got "
                 f"{type(self.grooves).__name__}",
-                allowed="Grooves or None",
+                allowed="Grooves or None", value=self.grooves,
             )
+        if self.grid is None:
+            object.__setattr__(self, "grid", _grid(*default_grid(self.grooves, self.model)))
+        else:
+            g = _check.sequence("grid", self.grid)
+            if len(g) != 2:
+                raise ParameterError(
+                    "grid", f"grid must be (n_theta, n_zeta), got {self.grid!r:.60}",
+                    allowed="two integers",
+                )
+            object.__setattr__(self, "grid", _grid(g[0], g[1]))
         _validate(self)
+
+
+def _grid(n_theta: Any, n_zeta: Any) -> tuple[int, int]:
+    """A grid's cell counts, refused before any solve when one axis or the total is
+    above its bound (:data:`~ballbal._check.MAX_BEARING_CELLS` and the per-axis ones);
+    the smallest sizes are the core's to check."""
+    nt = _check.integer("grid.n_theta", n_theta, 0, _check.MAX_BEARING_THETA)
+    nz = _check.integer("grid.n_zeta", n_zeta, 0, _check.MAX_BEARING_ZETA)
+    if nt * nz > _check.MAX_BEARING_CELLS:
+        name = "grid.n_theta" if nt >= nz else "grid.n_zeta"
+        raise ParameterError(
+            name, f"the grid ({nt}, {nz}) has {nt * nz} cells, at most "
+            f"{_check.MAX_BEARING_CELLS} (n_theta * n_zeta)",
+            allowed=f"n_theta * n_zeta <= {_check.MAX_BEARING_CELLS}", value=(nt, nz))
+    return nt, nz
 
 
 def _validate(bearing: Bearing) -> None:
@@ -160,8 +175,6 @@ def _pair(name: str, v: Any) -> tuple[float, float]:
 
 def _bearing(bearing: Any) -> Bearing:
     if not isinstance(bearing, Bearing):
-        from .exceptions import ParameterTypeError
-
         raise ParameterTypeError(
             "bearing", f"must be ballbal.bearing.Bearing, got {type(bearing).__name__}",
             allowed="Bearing",
@@ -221,11 +234,13 @@ class Dimensions:
 
     def force(self, f: FilmForce, speed: float) -> tuple[float, float]:
         """A film force's ``(F_x, F_y)`` in newtons."""
+        _film_force("f", f)
         k = self.force_scale(speed)
         return (f.fx * k, f.fy * k)
 
     def pressure(self, f: FilmForce, speed: float) -> npt.NDArray[np.float64]:
         """A film force's pressure field in pascals (``film_force(..., field=True)``)."""
+        _film_force("f", f)
         if f.pressure is None:
             raise ParameterError("field", "the film force carries no pressure field: "
                                  "call film_force(..., field=True)")
@@ -259,6 +274,13 @@ class FilmForce:
     pressure: npt.NDArray[np.float64] | None = None
     theta: npt.NDArray[np.float64] | None = None
     zeta: npt.NDArray[np.float64] | None = None
+
+
+def _film_force(name: str, f: Any) -> FilmForce:
+    if not isinstance(f, FilmForce):
+        raise ParameterTypeError(name, f"must be a ballbal.bearing.FilmForce, got "
+                                 f"{type(f).__name__}", allowed="FilmForce", value=f)
+    return f
 
 
 def film_force(bearing: Bearing, position: Any, velocity: Any = (0.0, 0.0), *,
@@ -300,19 +322,32 @@ def _load(load: Any, dimensions: Dimensions | None, speed: float | None) -> tupl
         w = _pair("load", load)
         if w == (0.0, 0.0):
             raise ParameterError("load", "must not be zero", allowed="|load| > 0")
+    if _dimensions(dimensions, speed) is None:
+        return w
+    assert dimensions is not None and speed is not None
+    k = dimensions.force_scale(speed)
+    w = (w[0] / k, w[1] / k)
+    if not (math.isfinite(w[0]) and math.isfinite(w[1])):
+        raise ParameterError("load", f"{load!r:.60} N is {w} in F_S at these dimensions and "
+                             "speed: too large to be a film load", value=load)
+    return w
+
+
+def _dimensions(dimensions: Any, speed: Any) -> Dimensions | None:
+    """``dimensions`` (or None), checked with the ``speed`` it needs."""
     if dimensions is None:
         if speed is not None:
-            raise ParameterError("speed", "a speed needs dimensions= (the load is then in N)")
-        return w
+            raise ParameterError("speed", "a speed needs dimensions= (the results are then "
+                                 "in SI units)")
+        return None
     if not isinstance(dimensions, Dimensions):
-        from .exceptions import ParameterTypeError
-
-        raise ParameterTypeError("dimensions", "must be ballbal.bearing.Dimensions",
-                                 allowed="Dimensions or None")
+        raise ParameterTypeError("dimensions", f"must be ballbal.bearing.Dimensions, got "
+                                 f"{type(dimensions).__name__}", allowed="Dimensions or None",
+                                 value=dimensions)
     if speed is None:
         raise ParameterError("speed", "dimensions= needs the speed [rad/s]")
-    k = dimensions.force_scale(speed)
-    return (w[0] / k, w[1] / k)
+    _check.real("speed", speed, 0.0, lo_open=True, finite=True)
+    return dimensions
 
 
 def equilibrium(bearing: Bearing, load: Any, *, dimensions: Dimensions | None = None,
@@ -351,13 +386,14 @@ def coefficients(bearing: Bearing, position: Any, *, dimensions: Dimensions | No
     force otherwise."""
     from . import _native
 
-    k, c = _native.bearing_coefficients(_bearing(bearing), _pair("position", position))
-    if dimensions is None:
+    b, q = _bearing(bearing), _pair("position", position)
+    dims = _dimensions(dimensions, speed)
+    k, c = _native.bearing_coefficients(b, q)
+    if dims is None:
         return Coefficients(k=k, c=c)
-    if speed is None:
-        raise ParameterError("speed", "dimensions= needs the speed [rad/s]")
-    return Coefficients(k=k, c=c, k_si=k * dimensions.stiffness_scale(speed),
-                        c_si=c * dimensions.damping_scale(speed))
+    assert speed is not None
+    return Coefficients(k=k, c=c, k_si=k * dims.stiffness_scale(speed),
+                        c_si=c * dims.damping_scale(speed))
 
 
 @dataclass(frozen=True)
@@ -402,6 +438,7 @@ def plot_pressure(force_or_bearing: FilmForce | Bearing, position: Any = None,
     :class:`Bearing` and a ``position`` (and ``velocity``)."""
     from .plot import _pyplot
 
+    _check.axes("ax", ax)
     if isinstance(force_or_bearing, Bearing):
         if position is None:
             raise ParameterError("position", "a bearing needs the journal position")
@@ -409,10 +446,9 @@ def plot_pressure(force_or_bearing: FilmForce | Bearing, position: Any = None,
     elif isinstance(force_or_bearing, FilmForce):
         f = force_or_bearing
     else:
-        from .exceptions import ParameterTypeError
-
-        raise ParameterTypeError("force_or_bearing", "must be a FilmForce or a Bearing",
-                                 allowed="FilmForce, Bearing")
+        raise ParameterTypeError("force_or_bearing", f"must be a FilmForce or a Bearing, got "
+                                 f"{type(force_or_bearing).__name__}",
+                                 allowed="FilmForce, Bearing", value=force_or_bearing)
     if f.pressure is None or f.theta is None or f.zeta is None:
         raise ParameterError("force_or_bearing", "the film force carries no pressure "
                              "field: call film_force(..., field=True)")

@@ -208,7 +208,12 @@ def _scan(a: argparse.Namespace) -> int:
 
 
 def _plot(a: argparse.Namespace) -> int:
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError as e:
+        # One line naming the extra, not a traceback: matplotlib is optional.
+        raise ParameterError("cmd", "'ballbal plot' needs matplotlib, which is not "
+                             "installed: pip install \"ballbal[plot]\"") from e
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -26,7 +26,7 @@ import numpy as np
 import polars as pl
 
 from . import _check
-from .exceptions import ParameterError
+from .exceptions import ParameterError, ParameterTypeError
 from .model import zeta_from_log_decrement
 
 __all__ = [
@@ -288,16 +288,32 @@ def single_ball() -> pl.DataFrame:
         "rank_balanced": pl.Int64, "rank_rotating": pl.Int64}).sort("eta")
 
 
+def _values(name: str, v: Any) -> Any:
+    """A finite number, or an array of them in ``v``'s shape. ``None`` (which numpy
+    reads as NaN) and ``True`` (as 1) are refused, not converted."""
+    if _check.is_real(v):
+        return _check.real(name, v, finite=True)
+    if v is None or isinstance(v, (bool, np.bool_, str, bytes)):
+        raise ParameterTypeError(name, f"must be a number or an array of numbers, got "
+                                 f"{v!r:.60}", value=v)
+    flat = _check.array(name, v)
+    if not np.all(np.isfinite(flat)):
+        raise ParameterError(name, "must be finite numbers", allowed="finite numbers",
+                             value=v)
+    return flat.reshape(np.shape(v))
+
+
 def rpm_to_ratio(rpm: Any, natural_frequency_rpm: float = NATURAL_FREQUENCY_RPM) -> Any:
-    """A speed or frequency in rpm as a ratio to the natural frequency (scalar or array)."""
+    """A speed or frequency in rpm as a ratio to the natural frequency (scalar or array;
+    negative for a backward whirl)."""
     fn = _check.real("natural_frequency_rpm", natural_frequency_rpm, 0.0, lo_open=True)
-    return np.asarray(rpm, dtype=float) / fn if not _check.is_real(rpm) else float(rpm) / fn
+    return _values("rpm", rpm) / fn
 
 
 def ratio_to_rpm(ratio: Any, natural_frequency_rpm: float = NATURAL_FREQUENCY_RPM) -> Any:
     """A frequency ratio (to the natural frequency) in rpm (scalar or array)."""
     fn = _check.real("natural_frequency_rpm", natural_frequency_rpm, 0.0, lo_open=True)
-    return np.asarray(ratio, dtype=float) * fn if not _check.is_real(ratio) else float(ratio) * fn
+    return _values("ratio", ratio) * fn
 
 
 def leaf_spring_stiffness(modulus: float, width: float, thickness: float,

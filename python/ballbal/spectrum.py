@@ -24,6 +24,7 @@ units given ``e`` in metres and the natural frequency.
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -84,14 +85,15 @@ def _natural_hz(hz: Any, rpm: Any) -> float | None:
 
 
 def _lines(source: PeriodicSolution | Equilibrium, Omega: float | None,  # noqa: N803
-           ) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """``(k, c_k, Omega, omega)``: the displacement lines ``Z = sum c_k e^{i f_k t}``."""
+           name: str = "solution") -> tuple[np.ndarray, np.ndarray, float, float]:
+    """``(k, c_k, Omega, omega)``: the displacement lines ``Z = sum c_k e^{i f_k t}``
+    (``name``: the caller's name for ``source``)."""
     from .analysis import Equilibrium, PeriodicSolution
 
     if isinstance(source, PeriodicSolution):
         if source.omega is None:
-            raise ValueError(f"no spectrum: the solve did not converge (status "
-                             f"{source.status})")
+            raise ParameterError(name, f"has no spectrum: the solve did not converge (status "
+                                 f"{source.status})", allowed="a converged PeriodicSolution")
         spin = source.balancer.Omega
         if Omega is not None and _check.real("Omega", Omega) != spin:
             raise ParameterError("Omega", f"a periodic solution spins at its model's Omega "
@@ -113,16 +115,16 @@ def _lines(source: PeriodicSolution | Equilibrium, Omega: float | None,  # noqa:
         spin = _check.real("Omega", Omega, finite=True)
         return (np.zeros(1, dtype=int), np.array([source.q[0] + 1j * source.q[1]]),
                 spin, float("nan"))
-    raise ParameterTypeError("solution", f"must be a ballbal.PeriodicSolution or "
+    raise ParameterTypeError(name, f"must be a ballbal.PeriodicSolution or "
                              f"ballbal.Equilibrium, got {type(source).__name__}",
                              value=source)
 
 
 def _scaled_lines(source: PeriodicSolution | Equilibrium, quantity: str,
-                  Omega: float | None,  # noqa: N803
+                  Omega: float | None, name: str = "solution",  # noqa: N803
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float]:
     p = _quantity(quantity)
-    k, c, spin, omega = _lines(source, Omega)
+    k, c, spin, omega = _lines(source, Omega, name)
     f = spin + k * (0.0 if math.isnan(omega) else omega)
     return k, f, (1j * f) ** p * c, spin, omega
 
@@ -286,6 +288,15 @@ def _exact_vibration(C: np.ndarray, k: np.ndarray, quantity: str) -> Vibration:
     return Vibration(quantity, mean, gmin, gmax, rms, True, m, err)
 
 
+def _column(df: pl.DataFrame, c: str, name: str = "df") -> np.ndarray:
+    """Column ``c`` of a table as a float array; a column of anything but numbers is an
+    error naming the table's parameter."""
+    if not df.schema[c].is_numeric():
+        raise ParameterTypeError(name, f"column {c!r} must hold numbers, not {df.schema[c]}",
+                                 value=None)
+    return df[c].cast(pl.Float64).to_numpy()
+
+
 def _uniform_step(t: np.ndarray, name: str = "t") -> float:
     if t.size < 8:
         raise ParameterError(name, f"needs at least 8 samples, got {t.size}")
@@ -324,18 +335,20 @@ def ground_signal(df: pl.DataFrame, quantity: Quantity = "acceleration", *,
         raise ParameterError("df", f"needs the columns of ballbal.simulate; missing "
                              f"{', '.join(missing)}")
     if t_min is not None:
-        df = df.filter(pl.col("t") >= _check.real("t_min", t_min, finite=True))
-    t = df["t"].to_numpy()
-    h = _uniform_step(t)
-    th = df["theta"].to_numpy()
+        lo = _check.real("t_min", t_min, finite=True)
+        df = df.filter(pl.col("t") >= lo) if df.schema["t"].is_numeric() else df
+    col = {c: _column(df, c) for c in need}
+    t = col["t"]
+    h = _uniform_step(t, "df")
+    th = col["theta"]
     rot = np.exp(1j * th)
-    z = df["x"].to_numpy() + 1j * df["y"].to_numpy()
+    z = col["x"] + 1j * col["y"]
     if p == 0:
         Z = rot * z
     else:
         dth = _d5(th, h)
         sl = slice(2, -2)
-        dz = df["dx"].to_numpy() + 1j * df["dy"].to_numpy()
+        dz = col["dx"] + 1j * col["dy"]
         V = rot[sl] * (dz[sl] + 1j * dth * z[sl])
         t = t[sl]
         if p == 1:
@@ -375,7 +388,7 @@ def vibration(
 
     _quantity(quantity)
     if isinstance(source, (PeriodicSolution, Equilibrium)):
-        k, _, C, _, _ = _scaled_lines(source, quantity, Omega)
+        k, _, C, _, _ = _scaled_lines(source, quantity, Omega, "source")
         return _exact_vibration(C, k, quantity)
     if isinstance(source, pl.DataFrame):
         sig = ground_signal(source, quantity, t_min=t_min)
@@ -587,6 +600,11 @@ def label_lines(
     k_max``) and ``omega`` (the one used, the same on every row).
     """
     f = _check.array("frequencies", frequencies)
+    if f.size > _check.MAX_LINES:
+        raise ParameterError("frequencies", f"{f.size} peaks, at most {_check.MAX_LINES}",
+                             allowed=f"at most {_check.MAX_LINES} peaks")
+    if not np.all(np.isfinite(f)):
+        raise ParameterError("frequencies", "must be finite", allowed="finite numbers")
     spin = _check.real("Omega", Omega, finite=True)
     tol = _check.real("tol", tol, 0.0, 0.5, lo_open=True)
     k_max = _check.integer("k_max", k_max, 1, 10**6)
@@ -594,6 +612,8 @@ def label_lines(
     if wgt.size != f.size:
         raise ParameterError("amplitudes", f"needs one per frequency ({f.size}), got "
                              f"{wgt.size}")
+    if not np.all(np.isfinite(wgt)):
+        raise ParameterError("amplitudes", "must be finite", allowed="finite numbers")
     d = f - spin
     if omega is not None:
         om = _check.real("omega", omega, 0.0, math.inf, lo_open=True, finite=True)
@@ -654,29 +674,32 @@ def label_peaks(
     sorted by frequency, with ``amplitude`` the peak bin's value. Use the flat-top or
     Hann window: the rectangular window's side lobes pass a 1 % threshold.
     """
-    if not isinstance(spectrum, pl.DataFrame):
-        raise ParameterTypeError("spectrum", f"must be a polars DataFrame, got "
-                                 f"{type(spectrum).__name__}", value=spectrum)
-    for c, name in ((column, "column"), (amplitude, "amplitude")):
-        if c not in spectrum.columns:
-            raise ParameterError(name, f"{c!r} is not a column of the spectrum "
-                                 f"({', '.join(spectrum.columns)})")
-    sp = spectrum.sort(column)
-    f = sp[column].to_numpy().astype(float)
-    a = sp[amplitude].to_numpy().astype(float)
+    sp = _spectrum_table(spectrum, column, amplitude)
+    f = _column(sp, column, "column")
+    a = _column(sp, amplitude, "amplitude")
     if f.size < 3:
         raise ParameterError("spectrum", "needs at least 3 bins")
+    if not (np.all(np.isfinite(f)) and np.all(np.isfinite(a))):
+        raise ParameterError("spectrum", f"{column!r} and {amplitude!r} must be finite")
     bin_ = float(np.median(np.diff(f)))
     sep = 4 * bin_ if min_separation is None else _check.real(
         "min_separation", min_separation, 0.0, math.inf, finite=True)
     thr = _check.real("threshold", threshold, 0.0, 1.0) * float(a.max())
-    max_peaks = _check.integer("max_peaks", max_peaks, 1, 10**6)
+    max_peaks = _check.integer("max_peaks", max_peaks, 1, _check.MAX_LINES)
     i = np.arange(1, f.size - 1)
     loc = i[(a[i] >= a[i - 1]) & (a[i] > a[i + 1]) & (a[i] >= thr)]
     loc = loc[np.argsort(-a[loc], kind="stable")]
+    # Largest first, each kept unless within sep of a kept one: the kept frequencies are
+    # held sorted, so that only the two neighbours need a look (a spectrum can have
+    # hundreds of thousands of local maxima).
     kept: list[int] = []
+    kept_f: list[float] = []
     for j in loc:
-        if all(abs(f[j] - f[q]) > sep for q in kept):
+        fj = float(f[j])
+        pos = bisect.bisect_left(kept_f, fj)
+        if ((pos == 0 or fj - kept_f[pos - 1] > sep)
+                and (pos == len(kept_f) or kept_f[pos] - fj > sep)):
+            kept_f.insert(pos, fj)
             kept.append(int(j))
             if len(kept) == max_peaks:
                 break
@@ -693,6 +716,21 @@ def label_peaks(
     return label_lines(fr, Omega, omega=omega, amplitudes=a[idx], tol=tol, k_max=k_max)
 
 
+def _spectrum_table(spectrum: Any, column: Any, amplitude: Any,
+                    name: str = "spectrum") -> pl.DataFrame:
+    """A spectrum table (the caller's parameter ``name``) sorted by ``column``, both
+    columns present."""
+    if not isinstance(spectrum, pl.DataFrame):
+        raise ParameterTypeError(name, f"must be a polars DataFrame, got "
+                                 f"{type(spectrum).__name__}", value=spectrum)
+    for c, name in ((column, "column"), (amplitude, "amplitude")):
+        if not isinstance(c, str) or c not in spectrum.columns:
+            raise ParameterError(name, f"{c!r:.60} is not a column of the spectrum "
+                                 f"({', '.join(spectrum.columns)})",
+                                 allowed=", ".join(spectrum.columns))
+    return spectrum.sort(column)
+
+
 # --------------------------------------------------------------------------------------
 # Waterfall and plots
 
@@ -702,6 +740,9 @@ def waterfall(items: Iterable[tuple[float, pl.DataFrame]], *, name: str = "Omega
     """A long table of spectra over a speed sweep: ``(speed, spectrum)`` pairs (line or
     signal spectra of the same kind), each row tagged with its speed in column ``name``."""
     _check.string("name", name)
+    if isinstance(items, (str, bytes, pl.DataFrame)) or not isinstance(items, Iterable):
+        raise ParameterTypeError("items", f"must be (speed, spectrum) pairs, got "
+                                 f"{type(items).__name__}", value=items)
     parts = []
     for n, item in enumerate(items):
         if not (isinstance(item, tuple) and len(item) == 2
@@ -709,10 +750,15 @@ def waterfall(items: Iterable[tuple[float, pl.DataFrame]], *, name: str = "Omega
             raise ParameterTypeError("items", f"item {n} must be a pair (speed, spectrum "
                                      f"DataFrame)", value=item)
         speed = _check.real("items", item[0], finite=True)
+        if name in item[1].columns:
+            raise ParameterError("name", f"{name!r} is already a column of spectrum {n}",
+                                 value=name)
         parts.append(item[1].with_columns(pl.lit(speed).alias(name)).select(
             [name, *item[1].columns]))
     if not parts:
         raise ParameterError("items", "give at least one (speed, spectrum) pair")
+    if any(p.schema != parts[0].schema for p in parts):
+        raise ParameterError("items", "the spectra must be of one kind (the same columns)")
     return pl.concat(parts, how="vertical")
 
 
@@ -724,11 +770,17 @@ def plot_spectrum(spectrum: pl.DataFrame, *, column: str = "frequency",
     annotated with their ``k``), a curve for :func:`signal_spectrum`. Returns the axes."""
     from .plot import _pyplot
 
+    spectrum = _spectrum_table(spectrum, column, amplitude)
+    f = _column(spectrum, column, "column")
+    a = _column(spectrum, amplitude, "amplitude")
+    label = _check.real("label", label, 0.0, 1.0)
+    min_relative = _check.real("min_relative", min_relative, 0.0, 1.0)
+    if title is not None:
+        _check.string("title", title)
+    _check.axes("ax", ax)
     plt = _pyplot()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 3.5))
-    f = spectrum[column].to_numpy()
-    a = spectrum[amplitude].to_numpy()
     if "k" in spectrum.columns:
         top = float(a.max()) if a.size else 0.0
         keep = a >= min_relative * top
@@ -758,6 +810,15 @@ def plot_waterfall(table: pl.DataFrame, *, name: str = "Omega", column: str = "f
     (vertical axis), amplitudes scaled so the largest spans ``height`` speed steps."""
     from .plot import _pyplot
 
+    _spectrum_table(table, column, amplitude, "table")
+    _check.string("name", name)
+    if name not in table.columns:
+        raise ParameterError("name", f"{name!r} is not a column of the table",
+                             allowed=", ".join(table.columns))
+    for c, pname in ((name, "name"), (column, "column"), (amplitude, "amplitude")):
+        _column(table, c, pname)
+    height = _check.real("height", height, 0.0, math.inf, lo_open=True, finite=True)
+    _check.axes("ax", ax)
     plt = _pyplot()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))

@@ -60,6 +60,18 @@ const NON_NEGATIVE: Interval = iv(0.0, false, INF, true);
 /// any finite number
 const FINITE: Interval = iv(-INF, true, INF, true);
 
+/// Largest `rho = e / c` of a bearing support. The journal sits at `rho |q|` clearances
+/// from the centre, so at `rho = 1e3` it reaches the wall with the disk centre `1e-3 e`
+/// off the axis: only the balanced state is left inside the clearance. Larger values mean
+/// nothing physically, and searches from `|q| ~ 1` put the journal far outside the
+/// clearance (`equilibria` at `rho = 1e5` spun without an answer).
+pub const MAX_RHO: f64 = 1e3;
+/// Largest groove depth over the clearance. The film's load stops changing long before
+/// (a finite film with 8 grooves at `eps = 0.5`: 0.003643 `F_S` at `1e3`, 0.003642 at
+/// `1e10`: a groove that deep is a reservoir), and near `1e102` the conductance `H^3`
+/// overflows and the Reynolds solve fails as if the matrix were not positive definite.
+pub const MAX_DEPTH_RATIO: f64 = 1e3;
+
 /// One registry row.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamSpec {
@@ -225,13 +237,20 @@ pub const REGISTRY: &[ParamSpec] = &[
     ),
     // the journal-bearing support: e / c, and its grooves (angle in degrees from the
     // circumferential direction, as ballbal.bearing.Grooves gives it)
-    spec(P::Rho, "rho", Some("rho"), "bearing", POSITIVE, false),
+    spec(
+        P::Rho,
+        "rho",
+        Some("rho"),
+        "bearing",
+        iv(0.0, true, MAX_RHO, false),
+        false,
+    ),
     spec(
         P::GrooveDepth,
         "grooves.depth_ratio",
         Some("depth_ratio"),
         "bearing",
-        NON_NEGATIVE,
+        iv(0.0, false, MAX_DEPTH_RATIO, false),
         false,
     ),
     spec(

@@ -30,6 +30,7 @@ pub mod study;
 mod tests;
 
 use crate::error::{check_range, Error, Result};
+use crate::model::ParamId;
 use std::f64::consts::PI;
 
 pub use finite::FiniteSolver;
@@ -88,14 +89,7 @@ impl Grooves {
             90.0,
             true,
         )?;
-        check_range(
-            "grooves.depth_ratio",
-            self.depth,
-            0.0,
-            false,
-            f64::INFINITY,
-            true,
-        )?;
+        ParamId::GrooveDepth.check_named("grooves.depth_ratio", self.depth)?;
         check_range("grooves.width_ratio", self.width, 0.0, true, 1.0, true)?;
         check_range(
             "grooves.grooved_length",

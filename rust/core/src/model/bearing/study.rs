@@ -21,6 +21,7 @@ use super::linear::{linear_coefficients, rigid_rotor_stability};
 use super::{Bearing, FilmModel, GrooveSide, Grooves, JournalState, MIN_CELLS_PER_PITCH};
 use crate::cancel;
 use crate::error::{check_range, Error, Result};
+use crate::model::ParamId;
 
 /// The axes of a groove study (their cartesian product is scanned, `angle` slowest).
 #[derive(Debug, Clone, PartialEq)]
@@ -85,7 +86,7 @@ impl GrooveAxes {
             check_range("angle", a, 0.0, true, 90.0, false)?;
         }
         for &d in &self.depth {
-            check_range("depth_ratio", d, 0.0, false, f64::INFINITY, true)?;
+            ParamId::GrooveDepth.check_named("depth_ratio", d)?;
         }
         for &w in &self.width {
             check_range("width_ratio", w, 0.0, true, 1.0, true)?;
