@@ -27,7 +27,7 @@ import numpy as np
 THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 
 
-def emit(name: str, values: object) -> None:
+def emit(name: str, values: Any) -> None:
     """One line per value: ``name[i] hex``; complex values as their real and imaginary
     parts."""
     arr = np.atleast_1d(np.asarray(values, dtype=complex if np.iscomplexobj(values)
