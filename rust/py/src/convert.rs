@@ -9,7 +9,7 @@ use ballbal_core::hb::HbOptions;
 use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
 use ballbal_core::periodic::{AutoHarmonics, GuessOptions, PeriodicOptions};
-use ballbal_core::{Error, Planar, Scene, SpringLayout};
+use ballbal_core::{Dynamics, Error, Planar, Scene, SpringLayout};
 use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 
@@ -266,6 +266,15 @@ pub struct PeriodicArgs {
 
 impl PeriodicArgs {
     /// The core's options, validated before any work starts; errors name the option.
+    /// [`Self::to_core`], checked against the model's size (the harmonic-balance system
+    /// it would build).
+    pub fn to_core_for(&self, m: &Model) -> PyResult<PeriodicOptions> {
+        let opts = self.to_core()?;
+        let ndof = dispatch!(m, x => x.ndof());
+        opts.validate_for(ndof).py()?;
+        Ok(opts)
+    }
+
     pub fn to_core(&self) -> PyResult<PeriodicOptions> {
         let h = &self.harmonic_balance;
         let f = &self.floquet;

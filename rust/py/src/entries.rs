@@ -259,7 +259,7 @@ pub fn periodic<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = autonomous(&model, false, "periodic")?;
     let ball_winding = parse_windings(pattern, windings.as_deref(), m.n_balls()).py()?;
-    let opts = options.to_core()?;
+    let opts = options.to_core_for(&m)?;
     let guess = match &guess {
         Some((w, c)) => Some(start(&m, &ball_winding, *w, slice(c, "guess")?)?),
         None => None,
@@ -369,7 +369,7 @@ pub fn scan(
         .map(|s| parse_pattern(s, m.n_balls()))
         .collect::<Result<Vec<_>, _>>()
         .py()?;
-    let opts = args.to_core()?;
+    let opts = args.to_core_for(&m)?;
     let n_harm = opts.hb.n_harm;
     let cols = Columns {
         names: &names,

@@ -65,7 +65,7 @@ pub fn periodic_branch<'py>(
     let m = model.build(always_scene).py()?;
     dispatch!(&m, x => require_autonomous(x)).map_err(|e| not_autonomous(e, "periodic_branch"))?;
     let n_balls = m.n_balls();
-    let popts = options.to_core()?;
+    let popts = options.to_core_for(&m)?;
     let (omega, coeffs, winding) = start;
     let coeffs = slice(&coeffs, "start")?.to_vec();
     let d = dispatch!(&m, x => x.ndof());

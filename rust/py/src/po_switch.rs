@@ -39,7 +39,7 @@ pub fn switch_periodic<'py>(
 ) -> PyResult<Out<'py>> {
     let m = model.build(false).py()?;
     let kind = Switch::parse(kind).py()?;
-    let opts = options.to_core()?;
+    let opts = options.to_core_for(&m)?;
     let d = winding.len();
     let c = slice(&coeffs, "coeffs")?.to_vec();
     if d == 0
@@ -80,7 +80,7 @@ pub fn switch_hopf<'py>(
     options: PeriodicArgs,
 ) -> PyResult<Out<'py>> {
     let m = model.build(false).py()?;
-    let opts = options.to_core()?;
+    let opts = options.to_core_for(&m)?;
     let s = guarded(
         py,
         || dispatch!(&m, x => core_hopf(x, parameter, &q, amplitude, &opts)),

@@ -212,7 +212,39 @@ impl Default for PeriodicOptions {
     }
 }
 
+/// Most unknowns of one harmonic-balance system, `ndof (2 N + 1) + 1`. Its dense Jacobian
+/// takes `8 n^2` bytes (8192 unknowns: 537 MB, and the factorisation works on a copy) and
+/// one LU about `2 n^3 / 3` flops (10 balls at N = 256, 6157 unknowns: 3-5 s on the 2-core
+/// machine). 64 balls at N = 256 asked for 36 GB and aborted the process when the
+/// allocation failed. Ten balls keep N = 256; 64 balls allow N <= 61.
+pub const MAX_HB_UNKNOWNS: usize = 8192;
+
 impl PeriodicOptions {
+    /// [`Self::validate`], and that the largest harmonic-balance system these options can
+    /// build for a model of `ndof` coordinates (`N`, or `N_max` with `N = "auto"`) stays
+    /// within [`MAX_HB_UNKNOWNS`]: checked before anything is allocated.
+    pub fn validate_for(&self, ndof: usize) -> crate::Result<()> {
+        self.validate()?;
+        let (name, n) = match &self.auto {
+            Some(a) => ("N_max", a.n_max),
+            None => ("N", self.hb.n_harm),
+        };
+        let most = (MAX_HB_UNKNOWNS - 1) / ndof.max(1);
+        let n_most = most.saturating_sub(1) / 2;
+        if ndof.saturating_mul(2 * n + 1) + 1 > MAX_HB_UNKNOWNS {
+            return Err(crate::Error::param_range(
+                name,
+                format!(
+                    "{n} harmonics of {ndof} coordinates make {} unknowns, at most \
+                     {MAX_HB_UNKNOWNS} (memory: 8 n^2 bytes); at most {n_most} here",
+                    ndof * (2 * n + 1) + 1
+                ),
+                format!("[1, {n_most}]"),
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks every option before any work starts; errors name the option.
     pub fn validate(&self) -> crate::Result<()> {
         self.hb.validate()?;
@@ -1124,6 +1156,39 @@ mod tests {
         let r = periodic(&q, &[true, true], None, &opts);
         assert_eq!(r.sol.status, Status::Converged);
         assert!(r.floquet.unwrap().separation_error.is_none());
+    }
+
+    /// The system's size, `ndof (2 N + 1) + 1` unknowns, is bounded before anything is
+    /// allocated: ten balls (12 coordinates) keep N = 256 (6157 unknowns); 64 balls (66
+    /// coordinates) allow N = 61 (8119) and not 62 (8251); with N = "auto" its N_max is
+    /// the one checked.
+    #[test]
+    fn harmonic_balance_systems_are_bounded_by_their_unknowns() {
+        let at = |n: usize| PeriodicOptions {
+            hb: HbOptions {
+                n_harm: n,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let refused = |o: &PeriodicOptions, ndof: usize| match o.validate_for(ndof) {
+            Err(crate::Error::InvalidParameter { name, allowed, .. }) => Some((name, allowed)),
+            Ok(()) => None,
+            Err(e) => panic!("{e}"),
+        };
+        assert_eq!(refused(&at(256), 12), None);
+        assert_eq!(refused(&at(61), 66), None);
+        let (name, allowed) = refused(&at(62), 66).unwrap();
+        assert_eq!((name.as_str(), allowed.as_deref()), ("N", Some("[1, 61]")));
+        let auto = PeriodicOptions {
+            auto: Some(AutoHarmonics {
+                target: 1e-4,
+                n_max: 256,
+            }),
+            ..at(3)
+        };
+        assert_eq!(refused(&auto, 66).unwrap().0, "N_max");
+        assert_eq!(refused(&auto, 12), None);
     }
 
     #[test]
