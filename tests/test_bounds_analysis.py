@@ -199,3 +199,18 @@ def test_continuation_sizes_are_bounded():
     refused(lambda: Continuation(max_points=10**9), "max_points")
     refused(lambda: Continuation(max_newton=10**6), "max_newton")
     assert Continuation(max_points=_check.MAX_BRANCH_POINTS).max_points == 10**5
+
+
+def test_harmonic_balance_size_is_bounded_before_allocation() -> None:
+    """64 balls at N = 256 make 66 x 513 + 1 = 33 859 unknowns, a 9.2 GB Jacobian whose
+    allocation aborted the process; the bound (8192 unknowns) allows N <= 61 there."""
+    from ballbal.exceptions import ParameterError
+
+    b = ballbal.Balancer(eta=(1.0 / 32,) * 64)
+    pattern = "-".join(["R"] * 64)
+    with pytest.raises(ParameterError) as e:
+        ballbal.periodic(b, pattern, N=256)
+    assert e.value.parameter == "N" and e.value.allowed == "[1, 61]"
+    with pytest.raises(ParameterError) as e:
+        ballbal.scan(b, Omega=[1.2], patterns=[pattern], N=62)
+    assert e.value.parameter == "N"
