@@ -306,18 +306,8 @@ fn spectrum<D: Dynamics + ?Sized>(
 /// forms, the same perfect balance [`equilibria`] would report first (its order:
 /// kind, then `x`), analysed alike.
 pub fn perfect_balance_verdict(p: &Planar) -> Option<Verdict> {
-    let n = p.n_balls();
-    let found = if n == 2 && equal_balls(p) {
-        closed_form_two_equal(p)
-    } else if n == 1 && p.omega_s > 0.0 {
-        closed_form_one(p)
-    } else {
-        // The search alone: the states off the axis that `equilibria` adds in closed
-        // form are never perfect balances, and a scan asks this at every point.
-        return equilibria_of(p, equal_balls(p), true)
-            .into_iter()
-            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
-            .map(|e| e.verdict);
+    let Some(found) = closed_forms(p) else {
+        return perfect_balance(p).map(|e| e.verdict);
     };
     found
         .into_iter()
@@ -325,6 +315,36 @@ pub fn perfect_balance_verdict(p: &Planar) -> Option<Verdict> {
         // `min_by` keeps the first of equal ones, as `sorted_analysed`'s stable sort
         .min_by(|a, b| a.0[0].total_cmp(&b.0[0]))
         .map(|(q, k)| spectrum(p, &q, k, true).verdict)
+}
+
+/// The first perfect balance [`equilibria`] lists for `p`. Where there are no closed
+/// forms, from the search alone: the states off the axis that [`equilibria`] adds are
+/// never perfect balances, and a scan asks this at every point.
+pub fn perfect_balance(p: &Planar) -> Option<Equilibrium> {
+    let all = match closed_forms(p) {
+        Some(found) => sorted_analysed(p, found, true),
+        None => equilibria_of(p, equal_balls(p), true),
+    };
+    all.into_iter()
+        .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+}
+
+/// Whether every equilibrium of `p` has a closed form: two equal balls, or one ball on
+/// a turning disk.
+pub fn has_closed_forms(p: &Planar) -> bool {
+    let n = p.n_balls();
+    n == 2 && equal_balls(p) || n == 1 && p.omega_s > 0.0
+}
+
+/// The closed-form equilibria of `p`, unanalysed, where [`has_closed_forms`].
+fn closed_forms(p: &Planar) -> Option<Vec<(Vec<f64>, EquilibriumKind)>> {
+    has_closed_forms(p).then(|| {
+        if p.n_balls() == 2 {
+            closed_form_two_equal(p)
+        } else {
+            closed_form_one(p)
+        }
+    })
 }
 
 /// Whether all balls have the same mass (states that differ by relabelling are one).
@@ -576,12 +596,8 @@ fn same_equilibrium(equal: bool, o: usize, a: &[f64], b: &[f64]) -> bool {
 /// All equilibria found for the balancer, each analysed. Closed forms for two equal
 /// balls; otherwise Newton from a deterministic set of starts.
 pub fn equilibria(p: &Planar) -> Vec<Equilibrium> {
-    let n = p.n_balls();
-    if n == 2 && equal_balls(p) {
-        return sorted_analysed(p, closed_form_two_equal(p), true);
-    }
-    if n == 1 && p.omega_s > 0.0 {
-        return sorted_analysed(p, closed_form_one(p), true);
+    if let Some(found) = closed_forms(p) {
+        return sorted_analysed(p, found, true);
     }
     let equal = equal_balls(p);
     let mut out = equilibria_of(p, equal, true);

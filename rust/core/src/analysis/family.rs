@@ -3,8 +3,7 @@
 //! scan knows only the trait.
 
 use crate::equilibria::{
-    equal_balls, equilibria, equilibria_of, perfect_balance_verdict, Equilibrium, EquilibriumKind,
-    Verdict,
+    equilibria, has_closed_forms, perfect_balance, perfect_balance_verdict, Equilibrium, Verdict,
 };
 use crate::error::Result;
 use crate::model::ParamRef;
@@ -41,26 +40,14 @@ impl Parametric for Planar {
 
 impl Family for Planar {
     fn balance(&self) -> Option<Equilibrium> {
-        // Where there are no closed forms, the search alone finds the perfect balances
-        // (`equilibria` adds only states off the axis to it), without analysing the rest.
-        let n = self.n_balls();
-        let closed = n == 2 && equal_balls(self) || n == 1 && self.omega_s > 0.0;
-        let all = if closed {
-            equilibria(self)
-        } else {
-            equilibria_of(self, equal_balls(self), true)
-        };
-        all.into_iter()
-            .find(|e| e.kind == EquilibriumKind::PerfectBalance)
+        perfect_balance(self)
     }
     fn balance_verdict(&self) -> Option<Verdict> {
         perfect_balance_verdict(self)
     }
     fn attracting_rests(&self) -> Vec<(Vec<f64>, f64)> {
         let n = self.n_balls();
-        let closed =
-            (n == 2 && equal_balls(self) || n == 1 && self.omega_s > 0.0) && self.zeta > 0.0;
-        if !closed {
+        if !(has_closed_forms(self) && self.zeta > 0.0) {
             return vec![];
         }
         let mut out = vec![];
