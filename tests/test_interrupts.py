@@ -27,6 +27,12 @@ CALLS = {
     # (lags of 3.2-4.5 s measured); the blocked LU polls between panels.
     "periodic_6balls_N256": ('b = Balancer(eta=(0.3,) * 6); periodic(b, "R-R-R-R-R-R", '
                              'N=256, guess=periodic(b, "R-R-R-R-R-R", N=3))'),
+    # A grooved film with Reynolds cavitation on a large grid: the active set factorises
+    # the 98304-unknown half-domain system once per iteration, tens of times, and no step
+    # of it looked for Ctrl-C (lags of 18-19 s measured); each factorisation is short.
+    "film_force_grooved_reynolds": (
+        'bearing.film_force(bearing.Bearing(grooves=bearing.Grooves(8, 30.0, 1.0), '
+        'cavitation="reynolds", grid=(1024, 192)), (0.4, -0.3), (0.01, 0.02))'),
     "simulate_long": "simulate(Balancer(), t_eval=[0.0, 1e6])",
     "equilibria_springs": "equilibria(Scene(Balancer(eta=(0.04,) * 64), springs=0.5))",
     # balanced states in parallel (rayon threads must see the cancellation too)
@@ -97,6 +103,24 @@ def test_sigint_at_first_native_call_never_panics(delay: float) -> None:
     assert "PanicException" not in err and "panicked" not in err, err
     assert code == 7, (code, out, err)
     assert lag < 1.0
+
+
+TEN_BALLS = ('b = Balancer(eta=(0.3,) * 10); periodic(b, "R-R-R-R-R-R-R-R-R-R", N=256, '
+             'guess=periodic(b, "R-R-R-R-R-R-R-R-R-R", N=3))')
+
+
+@pytest.mark.parametrize("delay", [1.0, 2.0, 3.0])
+def test_sigint_during_a_ten_ball_newton_step(delay: float) -> None:
+    """Ten balls at N = 256: every Newton step copies its 6157-row Jacobian (300 MB) into
+    the column-major matrix that the panels then factorise. That copy was one call of 1-3 s
+    on the loaded machine (lags of 1.0-1.8 s measured with SIGINT 2-3 s in); the delays
+    span the first step's copy, under a second in when the machine is idle, 2-3 s when it
+    is loaded (the factorisation that follows polls between panels)."""
+    code, out, err, lag = _interrupt(CHILD.format(call=TEN_BALLS), delay)
+    assert "PanicException" not in err and "panicked" not in err, err
+    assert "finished" not in out, f"ended before the signal at {delay:.2f} s: too short"
+    assert code == 7, (code, out, err)
+    assert lag < 1.0, f"KeyboardInterrupt {lag:.2f} s after SIGINT"
 
 
 SPRING_SCENE = ("[balancer]\neta = [" + ", ".join(["0.04"] * 64)

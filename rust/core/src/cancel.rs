@@ -68,6 +68,8 @@ pub fn current() -> Option<Token> {
 
 /// Whether this thread's token asks to stop.
 pub fn cancelled() -> bool {
+    #[cfg(test)]
+    gaps::mark();
     CURRENT.with(|c| c.borrow().as_ref().is_some_and(Token::is_cancelled))
 }
 
@@ -77,6 +79,39 @@ pub fn check() -> Result<()> {
         Err(Error::Cancelled)
     } else {
         Ok(())
+    }
+}
+
+/// The longest stretch between two polls of this thread: the longest that a cancellation
+/// waits (a measuring aid for the `#[ignore]`d latency reports).
+#[cfg(test)]
+pub(crate) mod gaps {
+    use std::cell::Cell;
+    use std::time::Instant;
+
+    thread_local! {
+        /// While measuring: the last poll and the longest gap so far (seconds).
+        static GAP: Cell<Option<(Instant, f64)>> = const { Cell::new(None) };
+    }
+
+    pub(crate) fn mark() {
+        GAP.with(|g| {
+            if let Some((last, longest)) = g.get() {
+                let now = Instant::now();
+                g.set(Some((now, longest.max((now - last).as_secs_f64()))));
+            }
+        });
+    }
+
+    /// `f`'s result, its wall time and the longest gap between its polls (the start and
+    /// the end count as polls), in seconds.
+    pub(crate) fn longest<R>(f: impl FnOnce() -> R) -> (R, f64, f64) {
+        let start = Instant::now();
+        GAP.with(|g| g.set(Some((start, 0.0))));
+        let r = f();
+        mark();
+        let longest = GAP.with(|g| g.take()).map_or(0.0, |(_, l)| l);
+        (r, start.elapsed().as_secs_f64(), longest)
     }
 }
 

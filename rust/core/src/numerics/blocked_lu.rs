@@ -35,6 +35,23 @@ pub struct BlockedLu {
     perm: Vec<usize>,
 }
 
+/// The column-major copy of the row-major `n x n` matrix `a`, filled [`PANEL`] columns
+/// at a time with a cancellation poll before each, or `None` once cancellation was asked
+/// for. The copy of a 6157-row harmonic-balance Jacobian (10 balls at N = 256, 300 MB)
+/// took 2-3 s in one `Mat::from_fn` on a loaded machine, most of it the first touch of
+/// fresh pages, and Ctrl-C waited for it (lags up to 2.3 s measured). The same values in
+/// a matrix of the same shape (so the same layout) as `Mat::from_fn` makes.
+pub fn column_major_copy(a: &[f64], n: usize) -> Option<Mat<f64>> {
+    let mut m = Mat::<f64>::with_capacity(n, n);
+    for j in (0..n).step_by(PANEL) {
+        if crate::cancel::cancelled() {
+            return None;
+        }
+        m.resize_with(n, (j + PANEL).min(n), |i, k| a[i * n + k]);
+    }
+    Some(m)
+}
+
 impl BlockedLu {
     /// Factorises `a` (consumed), or `None` once cancellation was asked for.
     pub fn factor(mut a: Mat<f64>) -> Option<Self> {
@@ -189,11 +206,60 @@ mod tests {
     }
 
     #[test]
+    fn the_polled_copy_equals_from_fn_and_factors_alike() {
+        // Sizes below, at and across copy panels; the factors of both copies too.
+        for n in [0, 1, 5, 128, 129, 300] {
+            let m = matrix(n);
+            let a: Vec<f64> = (0..n * n).map(|k| m[(k / n, k % n)]).collect();
+            let want = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+            let got = column_major_copy(&a, n).unwrap();
+            assert_eq!((got.nrows(), got.ncols()), (n, n));
+            assert_eq!(got.col_stride(), want.col_stride(), "n {n}: layout");
+            assert!(got == want, "n {n}");
+            if n > 0 {
+                let (x, y) = (
+                    BlockedLu::factor(got).unwrap(),
+                    BlockedLu::factor(want).unwrap(),
+                );
+                assert_eq!(x.perm, y.perm);
+                assert!(x.lu == y.lu, "n {n}: factors");
+            }
+        }
+        // Cancelled before the first panel: no copy.
+        let tok = crate::cancel::Token::new();
+        tok.cancel();
+        let a = vec![1.0; 300 * 300];
+        assert!(crate::cancel::with(Some(tok), || column_major_copy(&a, 300)).is_none());
+    }
+
+    #[test]
     fn a_cancelled_factorisation_stops() {
         let tok = crate::cancel::Token::new();
         tok.cancel();
         let out = crate::cancel::with(Some(tok), || BlockedLu::factor(matrix(300)));
         assert!(out.is_none());
+    }
+
+    /// How long Ctrl-C can wait during `lu_factor` of harmonic-balance-sized systems (the
+    /// copy into column-major order included): the call's time and the longest stretch
+    /// between two cancellation polls. `BLU_N=4105,6157 cargo test --release -p
+    /// ballbal-core lu_cancel_latency -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn lu_cancel_latency() {
+        let sizes: Vec<usize> = std::env::var("BLU_N").map_or(vec![4105, 6157], |v| {
+            v.split(',').map(|x| x.parse().unwrap()).collect()
+        });
+        for n in sizes {
+            let m = matrix(n);
+            let a: Vec<f64> = (0..n * n).map(|k| m[(k / n, k % n)]).collect();
+            drop(m);
+            let (ok, total, longest) = crate::cancel::gaps::longest(|| {
+                crate::numerics::linalg::lu_factor(&a, n).is_some()
+            });
+            assert!(ok);
+            println!("n {n}: lu_factor {total:.3} s, longest between polls {longest:.3} s");
+        }
     }
 
     /// Wall time against faer's one-call LU at harmonic-balance sizes:

@@ -1855,6 +1855,40 @@ mod tests {
         println!("{acc}");
     }
 
+    /// How long Ctrl-C can wait during `periodic` with many balls at N = 256 (stability
+    /// included), from an N = 3 guess as in `tests/test_interrupts.py`: the call's time and
+    /// the longest stretch between two cancellation polls. `BALLBAL_HB_BALLS=6,10 cargo test
+    /// --release -p ballbal-core hb_cancel_latency -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn hb_cancel_latency() {
+        use crate::periodic::{periodic, PeriodicOptions};
+        let balls: Vec<usize> = std::env::var("BALLBAL_HB_BALLS").map_or(vec![6, 10], |v| {
+            v.split(',').map(|x| x.parse().unwrap()).collect()
+        });
+        let opts = |n_harm| PeriodicOptions {
+            hb: HbOptions {
+                n_harm,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        for b in balls {
+            let p = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &vec![0.3; b]).unwrap();
+            let pattern = vec![true; b];
+            let guess = periodic(&p, &pattern, None, &opts(3)).sol;
+            let (sol, total, longest) = crate::cancel::gaps::longest(|| {
+                periodic(&p, &pattern, Some(&guess), &opts(256)).sol
+            });
+            println!(
+                "{b} balls, N = 256 ({} unknowns): {total:.3} s, longest between polls \
+                 {longest:.3} s (omega {:.6})",
+                sol.coeffs.len() + 1,
+                sol.omega
+            );
+        }
+    }
+
     /// One warm solve (certificates included): the frame callgrind reports.
     #[inline(never)]
     fn warm_solve(p: &crate::Planar, g: &HbSolution, o: &crate::periodic::PeriodicOptions) -> f64 {

@@ -45,7 +45,7 @@ pub struct LuFactor {
 pub fn lu_factor(a: &[f64], n: usize) -> Option<LuFactor> {
     if n >= crate::numerics::blocked_lu::BLOCKED_MIN_ROWS {
         // `None` also when cancelled: the caller's result is discarded then.
-        let m = Mat::<f64>::from_fn(n, n, |i, j| a[i * n + j]);
+        let m = crate::numerics::blocked_lu::column_major_copy(&a[..n * n], n)?;
         let lu = crate::numerics::blocked_lu::BlockedLu::factor(m)?;
         let pivot_ratio = pivot_ratio(lu.pivots())?;
         return Some(LuFactor {

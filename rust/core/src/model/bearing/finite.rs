@@ -20,7 +20,14 @@
 //! depends on `theta` only, so `M = A (x) I + C (x) T` with `T` the cell-centred Dirichlet
 //! Laplacian in `zeta`, whose eigenvectors are the DST-II vectors `sin(k pi (j + 1/2) / n_zeta)`:
 //! one periodic tridiagonal system per (odd) sine mode, the fast path. Everything else is a
-//! sparse Cholesky (faer) whose symbolic factorisation is built once per solver.
+//! sparse Cholesky (faer) whose symbolic factorisation is built once per solver, by its
+//! first sparse solve.
+//!
+//! Ctrl-C ([`crate::cancel`]) is polled between faer's calls (each one uninterruptible: the
+//! symbolic factorisation, a numeric factorisation, a solve), per active-set and
+//! conjugate-gradient iteration; a cancelled solve returns `Error::Cancelled`. The longest
+//! wait is then one faer call or the plain film's sine sweep, which the grid's size bounds
+//! (`film_cancel_latency` below measures it).
 //!
 //! The film is mirror-symmetric about the mid-plane for every model here (aligned journal,
 //! `H` and the groove phase depend on `|zeta|`, ambient pressure at both ends, the squeeze
@@ -181,7 +188,8 @@ pub struct FiniteSolver {
     modes: Vec<(f64, f64, Vec<f64>)>,
     pattern: SymbolicSparseColMat<usize>,
     entries: Vec<Entry>,
-    chol: Cholesky,
+    /// Built by the first sparse solve ([`Self::ensure_cholesky`]).
+    chol: Option<Cholesky>,
     /// Groove fractions on the theta and zeta faces for the last pattern offset.
     groove_cache: Option<(f64, Vec<f64>, Vec<f64>)>,
     /// Along a trajectory: precondition conjugate gradients with an old factor instead of
@@ -205,6 +213,8 @@ impl FiniteSolver {
         let cf = (0..=nt).map(|i| (i as f64 * dth).cos()).collect();
         let mut modes = Vec::new();
         for k in 1..=nz {
+            // O(nz^2) sines: a fraction of a second at thousands of cells across.
+            crate::cancel::check()?;
             let v: Vec<f64> = (0..nz)
                 .map(|j| (k as f64 * PI * (j as f64 + 0.5) / nz as f64).sin())
                 .collect();
@@ -243,7 +253,6 @@ impl FiniteSolver {
             }
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let chol = Cholesky::new(&pattern)?;
         Ok(FiniteSolver {
             lambda,
             nt,
@@ -258,7 +267,7 @@ impl FiniteSolver {
             modes,
             pattern,
             entries,
-            chol,
+            chol: None,
             groove_cache: None,
             reuse: None,
             old_factor: None,
@@ -284,6 +293,17 @@ impl FiniteSolver {
         }
     }
 
+    /// Builds the sparse Cholesky's symbolic factor if no solve has yet: a plain film's
+    /// force never needs it (the sine-transform path), and its AMD ordering is one
+    /// uninterruptible faer call, the longest step of setting up a large grid.
+    fn ensure_cholesky(&mut self) -> Result<()> {
+        if self.chol.is_none() {
+            crate::cancel::check()?;
+            self.chol = Some(Cholesky::new(&self.pattern)?);
+        }
+        Ok(())
+    }
+
     /// Film force at a journal state in the fixed frame.
     pub fn force(&mut self, s: &JournalState, want_field: bool) -> Result<FilmForce> {
         let pb = self.problem(s);
@@ -294,6 +314,7 @@ impl FiniteSolver {
     /// Pressure on the whole grid for a problem; `force_sparse` bypasses the
     /// sine-transform fast path.
     pub(crate) fn solve(&mut self, pb: &Problem, force_sparse: bool) -> Result<Vec<f64>> {
+        crate::cancel::check()?;
         if self.grooves.is_none() && self.cavitation != Cavitation::Reynolds && !force_sparse {
             let mut p = self.solve_plain(pb);
             if self.cavitation == Cavitation::HalfSommerfeld {
@@ -384,11 +405,15 @@ impl FiniteSolver {
         let film = self.film(&pb);
         let rhs = self.rhs(&pb, &film);
         let vals = self.values(&film, None);
+        self.ensure_cholesky()?;
+        // Between faer's calls (each one uninterruptible): see `cancel`.
+        crate::cancel::check()?;
+        let chol = self.chol.as_mut().expect("built above");
         let mut factor = std::mem::take(&mut self.factor_values);
-        self.chol.factor(&self.pattern, &vals, &mut factor)?;
+        chol.factor(&self.pattern, &vals, &mut factor)?;
         let n = nt * nh;
         let mut p: Vec<f64> = rhs.iter().map(|r| -r).collect();
-        self.chol.solve(&factor, &mut p, 1);
+        chol.solve(&factor, &mut p, 1);
         let mut b = vec![0.0; 4 * n];
         let (ct, cz) = (self.dz / self.dth, self.dth / self.dz);
         for (col, (gx, gy)) in [(1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
@@ -434,7 +459,8 @@ impl FiniteSolver {
                 b[3 * n + i * nh + j] = -dsy;
             }
         }
-        self.chol.solve(&factor, &mut b, 4);
+        let chol = self.chol.as_mut().expect("built above");
+        chol.solve(&factor, &mut b, 4);
         self.factor_values = factor;
         let clip = self.cavitation == Cavitation::HalfSommerfeld;
         let mut out = [[0.0; 4]; 2];
@@ -571,7 +597,9 @@ impl FiniteSolver {
 
     /// Fast path for a plain film: one periodic tridiagonal solve per odd sine mode. The
     /// same face films, conductances and right-hand side as [`Self::film`] and [`Self::rhs`],
-    /// once per theta column since nothing depends on `zeta`.
+    /// once per theta column since nothing depends on `zeta`. Not polled for cancellation:
+    /// `O(n_theta n_zeta^2)` work, 0.06 s at 2048 x 256 on a loaded machine, and a poll per
+    /// mode made this path several per cent slower (callgrind, 128 x 32).
     fn solve_plain(&self, pb: &Problem) -> Vec<f64> {
         let (nt, nz) = (self.nt, self.nz);
         let (ctf, czf) = (self.dz / self.dth, self.dth / self.dz);
@@ -664,15 +692,18 @@ impl FiniteSolver {
         fixed: Option<&[bool]>,
     ) -> Result<Vec<f64>> {
         let vals = self.values(film, fixed);
+        self.ensure_cholesky()?;
+        crate::cancel::check()?;
+        let chol = self.chol.as_mut().expect("built above");
         let mut factor = std::mem::take(&mut self.factor_values);
-        let res = self.chol.factor(&self.pattern, &vals, &mut factor);
+        let res = chol.factor(&self.pattern, &vals, &mut factor);
         let mut b: Vec<f64> = rhs
             .iter()
             .enumerate()
             .map(|(c, r)| if fixed.is_some_and(|f| f[c]) { 0.0 } else { -r })
             .collect();
         if res.is_ok() {
-            self.chol.solve(&factor, &mut b, 1);
+            chol.solve(&factor, &mut b, 1);
         }
         self.factor_values = factor;
         res.map(|()| b)
@@ -690,8 +721,11 @@ impl FiniteSolver {
 
     fn factor(&mut self, film: &Film) -> Result<()> {
         let vals = self.values(film, None);
+        self.ensure_cholesky()?;
+        crate::cancel::check()?;
+        let chol = self.chol.as_mut().expect("built above");
         let mut factor = self.old_factor.take().unwrap_or_default();
-        self.chol.factor(&self.pattern, &vals, &mut factor)?;
+        chol.factor(&self.pattern, &vals, &mut factor)?;
         self.old_factor = Some(factor);
         self.factorisations += 1;
         Ok(())
@@ -711,17 +745,22 @@ impl FiniteSolver {
         let mut ad = vec![0.0; n];
         for attempt in 0..2 {
             let factor = self.old_factor.take().expect("factored above");
+            let chol = self.chol.as_mut().expect("built with the factor");
             let mut x = vec![0.0; n];
             let mut r = b.clone();
             z.copy_from_slice(&r);
-            self.chol.solve(&factor, &mut z, 1);
+            chol.solve(&factor, &mut z, 1);
             let mut d = z.clone();
             let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
             let mut converged = false;
             let mut iterations = 0;
             for _ in 0..25 {
+                if crate::cancel::cancelled() {
+                    self.old_factor = Some(factor);
+                    return Err(Error::Cancelled);
+                }
                 iterations += 1;
-                self.apply_into(film, &d, &mut ad);
+                apply_half(self.nt, self.nh, film, &d, &mut ad);
                 let alpha = rz / d.iter().zip(&ad).map(|(a, b)| a * b).sum::<f64>();
                 for k in 0..n {
                     x[k] += alpha * d[k];
@@ -733,7 +772,7 @@ impl FiniteSolver {
                     break;
                 }
                 z.copy_from_slice(&r);
-                self.chol.solve(&factor, &mut z, 1);
+                chol.solve(&factor, &mut z, 1);
                 let rz_new: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
                 let beta = rz_new / rz;
                 rz = rz_new;
@@ -787,7 +826,8 @@ impl FiniteSolver {
 
 /// Swift–Stieber: `P >= 0`, `w = M P + rhs >= 0`, `P w = 0`, by a primal–dual active set
 /// started from the linear solution `p0` (finite for an M-matrix). `solve` solves `M P = -rhs`
-/// with the cells marked fixed held at 0, `apply` is `P -> M P`.
+/// with the cells marked fixed held at 0, `apply` is `P -> M P`. Stops with
+/// `Error::Cancelled` between iterations once cancelled ([`crate::cancel`]).
 pub(crate) fn active_set(
     rhs: &[f64],
     p0: Vec<f64>,
@@ -796,6 +836,8 @@ pub(crate) fn active_set(
 ) -> Result<Vec<f64>> {
     let mut fixed: Vec<bool> = p0.iter().map(|v| *v < 0.0).collect();
     for _ in 0..100 {
+        // Each iteration is a factorisation: seconds in all on a large grid.
+        crate::cancel::check()?;
         let p = solve(&fixed)?;
         let mp = apply(&p);
         let mut changed = false;
@@ -892,6 +934,184 @@ impl CyclicWork {
         let fact = (x[0] + beta * x[n - 1] / g) / (1.0 + self.u[0] + beta * self.u[n - 1] / g);
         for (xi, ui) in x.iter_mut().zip(&self.u) {
             *xi -= fact * ui;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::*;
+    use crate::cancel::{with, Token};
+
+    fn herringbone() -> Grooves {
+        Grooves {
+            count: 8,
+            angle: 30f64.to_radians(),
+            depth: 1.0,
+            width: 0.5,
+            length_fraction: 1.0,
+            side: GrooveSide::Sleeve,
+        }
+    }
+
+    #[test]
+    fn a_cancelled_film_call_stops_with_cancelled_and_the_solver_stays_usable() {
+        let st = JournalState {
+            x: 0.4,
+            y: -0.3,
+            vx: 0.01,
+            vy: 0.02,
+            tau: 0.0,
+        };
+        let cancelled = || {
+            let t = Token::new();
+            t.cancel();
+            Some(t)
+        };
+        let (finite, narrow) = (
+            FilmModel::Finite {
+                n_theta: 128,
+                n_zeta: 16,
+            },
+            FilmModel::NarrowGroove {
+                n_theta: 64,
+                n_zeta: 16,
+            },
+        );
+        for (grooves, model) in [
+            (None, finite),
+            (Some(herringbone()), finite),
+            (Some(herringbone()), narrow),
+        ] {
+            for cavitation in [Cavitation::HalfSommerfeld, Cavitation::Reynolds] {
+                for reuse in [None, Some(1e-10)] {
+                    let b = Bearing {
+                        lambda: 1.0,
+                        grooves,
+                        cavitation,
+                        model,
+                    };
+                    let what = format!("{model:?} {grooves:?} {cavitation:?} reuse {reuse:?}");
+                    assert_eq!(
+                        with(cancelled(), || b.solver().map(|_| ())),
+                        Err(Error::Cancelled),
+                        "{what}: new"
+                    );
+                    let mut s = b.solver().unwrap();
+                    s.set_factor_reuse(reuse);
+                    let got = with(cancelled(), || s.force(&st, false).map(|f| f.fx));
+                    assert_eq!(got, Err(Error::Cancelled), "{what}: force");
+                    // The Reynolds condition has no derivatives from a factorisation: no work.
+                    let got = with(cancelled(), || {
+                        s.force_derivatives(&st).map(|d| d.is_some())
+                    });
+                    let want = match cavitation {
+                        Cavitation::Reynolds => Ok(false),
+                        _ => Err(Error::Cancelled),
+                    };
+                    assert_eq!(got, want, "{what}: derivatives");
+                    // Not cancelled: the same force as a solver that never was.
+                    let fx = s.force(&st, false).unwrap().fx;
+                    let fresh = b.solver().unwrap().force(&st, false).unwrap().fx;
+                    assert!(
+                        (fx - fresh).abs() <= 1e-9 * fresh.abs(),
+                        "{what}: {fx} {fresh}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_active_set_stops_at_the_iteration_after_a_cancellation() {
+        // One cell whose solves alternate in sign, so that it enters and leaves the
+        // cavitated set at every iteration: without the poll the active set runs its 100
+        // iterations and reports that it did not settle.
+        let tok = Token::new();
+        let mut solves = 0;
+        let out = with(Some(tok.clone()), || {
+            super::active_set(
+                &[0.0],
+                vec![1.0],
+                |_| {
+                    solves += 1;
+                    if solves == 3 {
+                        tok.cancel();
+                    }
+                    Ok(vec![if solves % 2 == 1 { -1.0 } else { 1.0 }])
+                },
+                |p| p.iter().map(|v| -v).collect(),
+            )
+        });
+        assert_eq!(out, Err(Error::Cancelled));
+        assert_eq!(solves, 3);
+    }
+
+    /// How long Ctrl-C can wait during one film-force call as `ballbal.bearing.film_force`
+    /// makes it (a new solver, one force): the call's time and the longest stretch between
+    /// two cancellation polls. `FILM_GRIDS=1024x128,2048x256 cargo test --release -p
+    /// ballbal-core film_cancel_latency -- --ignored --nocapture` (`FILM_CASES`: some of
+    /// the labels, comma-separated).
+    #[test]
+    #[ignore]
+    fn film_cancel_latency() {
+        let grids = std::env::var("FILM_GRIDS").unwrap_or("512x64,1024x128,2048x256".into());
+        let grooves = herringbone();
+        for g in grids.split(',') {
+            let (a, b) = g.split_once('x').expect("grid as NTxNZ");
+            let (n_theta, n_zeta): (usize, usize) = (a.parse().unwrap(), b.parse().unwrap());
+            let cases = [
+                ("plain finite", None, Cavitation::HalfSommerfeld, false),
+                (
+                    "grooved finite",
+                    Some(grooves),
+                    Cavitation::HalfSommerfeld,
+                    false,
+                ),
+                (
+                    "grooved finite Reynolds",
+                    Some(grooves),
+                    Cavitation::Reynolds,
+                    false,
+                ),
+                (
+                    "narrow groove",
+                    Some(grooves),
+                    Cavitation::HalfSommerfeld,
+                    true,
+                ),
+            ];
+            let only = std::env::var("FILM_CASES").unwrap_or_default();
+            for (label, grooves, cavitation, narrow) in cases {
+                if !only.is_empty() && !only.split(',').any(|c| label == c) {
+                    continue;
+                }
+                let b = Bearing {
+                    lambda: 1.0,
+                    grooves,
+                    cavitation,
+                    model: if narrow {
+                        FilmModel::NarrowGroove { n_theta, n_zeta }
+                    } else {
+                        FilmModel::Finite { n_theta, n_zeta }
+                    },
+                };
+                let st = JournalState {
+                    x: 0.4,
+                    y: -0.3,
+                    vx: 0.01,
+                    vy: 0.02,
+                    tau: 0.0,
+                };
+                let (f, total, longest) = crate::cancel::gaps::longest(|| {
+                    b.solver().and_then(|mut s| s.force(&st, false))
+                });
+                println!(
+                    "{label} {n_theta}x{n_zeta}: call {total:.3} s, longest between polls \
+                     {longest:.3} s (fx {:.6})",
+                    f.unwrap().fx
+                );
+            }
         }
     }
 }

@@ -75,6 +75,9 @@
 //! symmetric and conservative (a 9-point stencil; positive definite since `A` is, though not an
 //! M-matrix), and with `delta_g = 0` it is exactly [`super::finite`]'s matrix. Cavitation as
 //! there: clip, Swift–Stieber active set, or none.
+//!
+//! Ctrl-C ([`crate::cancel`]) is polled as in [`super::finite`]: between faer's calls (each
+//! one uninterruptible), assemblies and active-set iterations.
 
 use super::finite::{active_set, FiniteSolver};
 use super::{Bearing, Cavitation, FilmForce, Grooves, JournalState};
@@ -212,6 +215,8 @@ impl NarrowSolver {
             }
         }
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        // The symbolic factorisation is one uninterruptible faer call (see `cancel`).
+        crate::cancel::check()?;
         let symbolic = SymbolicLlt::try_new(pattern.as_ref(), Side::Upper)
             .map_err(|e| Error::param("model", format!("sparse factorisation failed: {e:?}")))?;
         Ok(NarrowSolver {
@@ -360,6 +365,8 @@ impl NarrowSolver {
 
     fn solve_fixed(&self, st: &[f64], rhs: &[f64], fixed: Option<&[bool]>) -> Result<Vec<f64>> {
         let vals = self.values(st, fixed);
+        // Before faer's factorisation, one uninterruptible call (see `cancel`).
+        crate::cancel::check()?;
         let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
         let llt =
             Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper).map_err(|e| {
@@ -400,6 +407,7 @@ impl NarrowSolver {
 
     /// The (cavitated) pressure at `s`.
     pub fn pressure(&self, s: &JournalState) -> Result<Vec<f64>> {
+        crate::cancel::check()?;
         let (st, rhs) = self.assemble(s);
         let p = self.solve_fixed(&st, &rhs, None)?;
         Ok(match self.cavitation {
@@ -434,8 +442,10 @@ impl NarrowSolver {
             return Ok(None);
         }
         let n = self.nt * self.nz;
+        crate::cancel::check()?;
         let (st, rhs) = self.assemble(s);
         let vals = self.values(&st, None);
+        crate::cancel::check()?;
         let mat = SparseColMatRef::new(self.pattern.as_ref(), &vals);
         let llt =
             Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Upper).map_err(|e| {
@@ -454,6 +464,7 @@ impl NarrowSolver {
             ..*s
         };
         for (col, (gx, gy)) in [(1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
+            crate::cancel::check()?;
             let (stp, rp) = self.assemble(&moved(h * gx, h * gy));
             let (stm, rm) = self.assemble(&moved(-h * gx, -h * gy));
             let dst: Vec<f64> = stp
@@ -473,6 +484,7 @@ impl NarrowSolver {
         };
         let (_, r0) = self.assemble(&still);
         for (col, (vx, vy)) in [(1.0, 0.0), (0.0, 1.0)].into_iter().enumerate() {
+            crate::cancel::check()?;
             let (_, r1) = self.assemble(&JournalState { vx, vy, ..still });
             for c in 0..n {
                 b[(c, 3 + col)] = -(r1[c] - r0[c]);
