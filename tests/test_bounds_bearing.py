@@ -48,7 +48,17 @@ def test_a_grid_with_too_many_cells_in_all_is_refused() -> None:
     e = raises(ParameterError, "grid.n_theta", br.Bearing, grooves=G8, grid=(nt, nz))
     assert e.allowed is not None and str(_check.MAX_BEARING_CELLS) in e.allowed
     # The largest grid allowed is accepted (it is only made here, not solved).
-    assert br.Bearing(grooves=G8, grid=(1024, 1024)).grid == (1024, 1024)
+    assert br.Bearing(grooves=G8, grid=(1024, 256)).grid == (1024, 256)
+
+
+def test_a_narrow_groove_grid_has_the_lower_bound() -> None:
+    """The narrow-groove factorisation is the slower one between Ctrl-C polls: a grid the
+    finite film accepts is refused there, naming the longer axis and the bound."""
+    assert _check.MAX_NARROW_GROOVE_CELLS < 1024 * 256 <= _check.MAX_BEARING_CELLS
+    e = raises(ParameterError, "grid.n_theta", br.Bearing, grooves=G8,
+               model="narrow_groove", grid=(1024, 256))
+    assert e.allowed is not None and str(_check.MAX_NARROW_GROOVE_CELLS) in e.allowed
+    assert br.Bearing(grooves=G8, model="narrow_groove", grid=(512, 256)).grid == (512, 256)
 
 
 def test_grid_bounds_hold_in_scene_files(tmp_path) -> None:
@@ -120,12 +130,12 @@ def test_groove_study_points_and_grids_are_bounded() -> None:
            depth_ratio=[1.0 + x / n for x in many], width_ratio=[0.3 + 0.4 * x / n
                                                                 for x in many],
            eccentricity=2.0)
-    # MAX_GROOVES (2048) grooves round n_theta = 256 up to 8 cells per pitch: 16384 x 128
-    # = 2^21 cells.
+    # MAX_GROOVES (512) grooves round n_theta = 256 up to 8 cells per pitch: 4096 x 128
+    # = 2^19 cells.
     raises(ParameterError, "count", br.groove_study, br.Bearing(grid=(256, 128)),
            count=[8, _check.MAX_GROOVES], eccentricity=2.0)
-    # Five threads, five points of 2^20 cells each: 5 x 2^20 cells at once.
-    raises(ParameterError, "threads", br.groove_study, br.Bearing(grid=(1024, 1024)),
+    # Five threads, five points of 2^18 cells each: 5 x 2^18 cells at once.
+    raises(ParameterError, "threads", br.groove_study, br.Bearing(grid=(1024, 256)),
            angle=[20.0, 30.0, 40.0, 50.0, 60.0], threads=5, eccentricity=2.0)
 
 

@@ -44,11 +44,16 @@ _MAX_COUNT = 2**62
 # rotor's output times and the spectra (kept in one block). Measured on the project's
 # 2-core machine while other work ran. ---
 
-#: Most finite-volume cells of one bearing grid (``n_theta * n_zeta``). One film solve on
-#: a grid of this size (1024 x 1024) took 1.3 s and 0.27 GB (plain film), 6.2 s and 0.5 GB
-#: (grooved finite film), 13 s and 1.1 GB (narrow-groove film); an equilibrium or a
-#: trajectory solves it many times. 8000 x 2000 took 42 s and 8.4 GB per solve.
-MAX_BEARING_CELLS = 2**20
+#: Most finite-volume cells of one bearing grid (``n_theta * n_zeta``), set by Ctrl-C:
+#: faer's sparse factorisations are single calls that cannot be interrupted, and the film
+#: solvers poll between them. The longest stretch between two polls measured 0.25-0.9 s
+#: (grooved finite film) up to 2^19 cells on the project's loaded 2-core machine, and
+#: the plain film's sine sweep took 1.3 s at 2^20. An equilibrium or a trajectory solves
+#: the film many times. (8000 x 2000 took 42 s and 8.4 GB per solve.)
+MAX_BEARING_CELLS = 2**18
+#: Most cells of a narrow-groove grid: its 9-point factorisation is the slower one, about
+#: 1 s between polls at 2^18 cells and 0.3-0.7 s at this bound.
+MAX_NARROW_GROOVE_CELLS = 2**17
 #: Most cells around the bearing (``n_theta``): 32 cells per groove pitch of
 #: :data:`MAX_GROOVES` grooves, and a cell of 1e-4 rad, far finer than any film needs.
 MAX_BEARING_THETA = 2**16
@@ -66,7 +71,7 @@ MAX_GROOVES = MAX_BEARING_CELLS // (16 * 32)
 MAX_GROOVE_POINTS = 10**5
 #: Most film cells a groove study holds at once: each thread solves one point's grid at
 #: a time, so threads times the largest point's cells (four grids of
-#: :data:`MAX_BEARING_CELLS`, some 4.5 GB with narrow-groove films).
+#: :data:`MAX_BEARING_CELLS`, about a gigabyte with narrow-groove films).
 MAX_STUDY_CELLS = 4 * MAX_BEARING_CELLS
 #: Most frequencies :func:`ballbal.spectrum.label_lines` labels (and most peaks
 #: :func:`~ballbal.spectrum.label_peaks` keeps): the line spacing is estimated by trying

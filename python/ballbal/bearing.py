@@ -101,10 +101,11 @@ class Bearing:
     ``"reynolds"``; ``"none"``), the film ``model`` (``"short"``, ``"long"``,
     ``"finite"``, ``"narrow_groove"``) and the grid ``(n_theta, n_zeta)`` of the finite
     and narrow-groove models (``None``: :func:`default_grid`); at most
-    :data:`~ballbal._check.MAX_BEARING_CELLS` cells, ``n_theta`` at most
+    :data:`~ballbal._check.MAX_BEARING_CELLS` cells
+    (:data:`~ballbal._check.MAX_NARROW_GROOVE_CELLS` narrow-groove), ``n_theta`` at most
     :data:`~ballbal._check.MAX_BEARING_THETA` and ``n_zeta`` at most
-    :data:`~ballbal._check.MAX_BEARING_ZETA` (one film solve on the largest grid takes
-    seconds and up to a gigabyte).
+    :data:`~ballbal._check.MAX_BEARING_ZETA` (so that Ctrl-C stops a film solve within
+    about a second).
 
     ``"narrow_groove"`` is Vohr and Chow's narrow-groove theory: the grooves smoothed into
     an anisotropic film, exact as the groove count grows, on a grid that need not resolve
@@ -140,6 +141,14 @@ class Bearing:
                     allowed="two integers",
                 )
             object.__setattr__(self, "grid", _grid(g[0], g[1]))
+        nt, nz = self.grid
+        if self.model == "narrow_groove" and nt * nz > _check.MAX_NARROW_GROOVE_CELLS:
+            raise ParameterError(
+                "grid.n_theta" if nt >= nz else "grid.n_zeta",
+                f"the narrow-groove grid ({nt}, {nz}) has {nt * nz} cells, at most "
+                f"{_check.MAX_NARROW_GROOVE_CELLS} (n_theta * n_zeta)",
+                allowed=f"n_theta * n_zeta <= {_check.MAX_NARROW_GROOVE_CELLS}",
+                value=(nt, nz))
         _validate(self)
 
 

@@ -515,12 +515,6 @@ fn closed_form_two_equal(p: &Planar) -> Vec<(Vec<f64>, EquilibriumKind)> {
     out
 }
 
-/// Iterations of the least-squares Newton's SVD before the start is taken as failed: an
-/// ordinary Jacobian needs a few per singular value. nalgebra's own SVD has no limit, and
-/// the equilibrium search of a finite-film bearing scene at `Omega = 10` (or `rho = 1e5`)
-/// spun in it for over a minute without an answer.
-const SVD_MAX_ITER: usize = 10_000;
-
 /// Newton (least squares, so that families of equilibria do not stall it) on `F(q,0,0) = 0`.
 pub fn newton_static<D: Dynamics + ?Sized>(p: &D, q0: &[f64]) -> Option<Vec<f64>> {
     newton_least_squares(&mut EquilibriumProblem::new(ModelAt::fixed(p)), q0)
@@ -555,7 +549,12 @@ pub fn newton_least_squares<P: Problem + ?Sized>(prob: &mut P, q0: &[f64]) -> Op
             return None;
         }
         let j = DMatrix::from_row_slice(d, d, &k);
-        let svd = j.try_svd(true, true, f64::EPSILON, SVD_MAX_ITER)?;
+        let svd = j.try_svd(
+            true,
+            true,
+            f64::EPSILON,
+            crate::numerics::linalg::SVD_MAX_ITER,
+        )?;
         let rhs = DVector::from_column_slice(&r);
         let step = svd.solve(&rhs, 1e-10 * svd.singular_values.max()).ok()?;
         let sn = step.amax();

@@ -1001,7 +1001,17 @@ type CBorder = Border<C64>;
 impl<T: ComplexField<RealField = f64>> Border<T> {
     /// The smallest singular value's left and right vectors.
     fn from_svd(h: &DMatrix<T>) -> Result<Self> {
-        let svd = h.clone().svd(true, true);
+        let svd = h
+            .clone()
+            .try_svd(
+                true,
+                true,
+                f64::EPSILON,
+                crate::numerics::linalg::SVD_MAX_ITER,
+            )
+            .ok_or(Error::Eigen(
+                "SVD of the test matrix did not converge".into(),
+            ))?;
         let (u, vt) = match (svd.u, svd.v_t) {
             (Some(u), Some(vt)) => (u, vt),
             _ => return Err(Error::Eigen("SVD of the test matrix failed".into())),

@@ -730,7 +730,14 @@ pub fn switch_direction<D: Dynamics + Clone>(
             0.0
         }
     });
-    let svd = m.svd(false, true);
+    let svd = m
+        .try_svd(
+            false,
+            true,
+            f64::EPSILON,
+            crate::numerics::linalg::SVD_MAX_ITER,
+        )
+        .ok_or(Error::Eigen("SVD did not converge".into()))?;
     let vt = svd.v_t.ok_or(Error::Eigen("SVD failed".into()))?;
     let mut order: Vec<usize> = (0..n + 1).collect();
     order.sort_by(|&a, &b| svd.singular_values[a].total_cmp(&svd.singular_values[b]));

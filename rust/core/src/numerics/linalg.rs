@@ -5,6 +5,12 @@ use crate::model::Dynamics;
 use faer::prelude::*;
 use faer::Mat;
 
+/// Iterations of an SVD before it is taken as failed: an ordinary matrix needs a few per
+/// singular value. nalgebra's own `svd` has no limit, and the equilibrium search of a
+/// finite-film bearing scene at `Omega = 10` (or `rho = 1e5`) spun in it for over a minute
+/// without an answer; every SVD of the core goes through `try_svd` with this limit.
+pub const SVD_MAX_ITER: usize = 10_000;
+
 /// Eigenvalues `(re, im)` of the row-major `n x n` matrix `a`, sorted by decreasing
 /// real part then imaginary part, or `None` if the QR iteration failed.
 pub fn eigenvalues(a: &[f64], n: usize) -> Option<Vec<(f64, f64)>> {
