@@ -14,10 +14,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Seed points: the lattice, every chunk's middle line if the lattice misses the
-/// chunk, and (when an oscillating type is wanted) the points on either side of the
-/// perfect balance's stability boundary, where O motions are born in a Hopf
-/// bifurcation; these get half the starts, since there are many of them. Returns the
-/// (point, start) tasks, sorted, and the starts' indices into [`initial_states`].
+/// chunk, and the points on either side of the perfect balance's stability boundary,
+/// where O motions are born in a Hopf bifurcation and where the rotating motions that
+/// coexist with an unstable balance are reached; these get half the starts, since there
+/// are many of them. The tasks do not depend on which patterns were asked for, so that
+/// neither do a pattern's rows (asking for "O-O" beside "R-R" once added 54 stable R-R
+/// rows to a 91-point scan: its boundary starts settled on them). Returns the (point,
+/// start) tasks, sorted, and the starts' indices into [`initial_states`].
 pub(super) fn seed_tasks<D: Family>(
     spec: &ScanSpec<'_, D>,
     geo: &Local,
@@ -42,14 +45,9 @@ pub(super) fn seed_tasks<D: Family>(
             (0..dims).all(|k| per_dim[k].contains(&idx[k]))
         })
         .collect();
-    let mut boundary: Vec<usize> = vec![];
-    if spec.patterns.iter().any(|r| r.iter().any(|&b| !b)) {
-        boundary = (0..npts)
-            .filter(|&p| {
-                !seeds.contains(&p) && geo.neighbours(p).iter().any(|&(q, _)| pb[q] != pb[p])
-            })
-            .collect();
-    }
+    let boundary: Vec<usize> = (0..npts)
+        .filter(|&p| !seeds.contains(&p) && geo.neighbours(p).iter().any(|&(q, _)| pb[q] != pb[p]))
+        .collect();
     let starts = spread(initial_states(spec.base).len(), spec.starts);
     let half = starts.len().div_ceil(2);
     let mut tasks: Vec<(usize, usize)> = seeds
