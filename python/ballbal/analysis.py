@@ -278,6 +278,12 @@ class PeriodicSolution:
     verdicts_disagree: bool | None = None
     closure: float | None = None
     separation_error: float | None = None
+    #: Bound on the error of ``max_modulus`` that ``stability`` was judged against: twice
+    #: its difference to the same multiplier of a series with more harmonics, plus that
+    #: series' own error measures (see :func:`periodic`). ``None`` without a monodromy.
+    modulus_error: float | None = None
+    #: Which series the bound compares: ``"N 3 vs 5"``.
+    modulus_error_source: str | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -392,11 +398,19 @@ def _windings(windings: Any) -> list[int]:
     return [_check.integer("windings", w, -16, 16) for w in items]
 
 
+#: The ``Omega`` offsets ``periodic(homotopy=True)`` (and by default, last) starts from, in
+#: order. The nearest come first; the far ones reach orbits that simulation finds only near
+#: the perfect balance's stability boundary: the stable R-R orbit of the thesis map
+#: ``zeta = 0.02, zeta_b = 0.2`` at ``Omega = 1.6, eta = 1.4`` is reached from 1.2 only,
+#: that of ``zeta_b = 0.05`` at ``Omega = 1.75, eta = 1`` (N = 8) from 1.2 too.
+HOMOTOPY_OMEGA_STEPS = (-0.1, 0.1, -0.2, 0.2, -0.4, 0.4, -0.6, 0.6)
+
+
 def _homotopy(model: Balancer | Scene, homotopy: Any) -> list[tuple[str, float]]:
     """The ``(parameter, value)`` starts of ``periodic(homotopy=...)``."""
     if homotopy is True:
         om = model.Omega if isinstance(model, Balancer) else model.balancer.Omega
-        starts = [("Omega", om + d) for d in (-0.1, 0.1, -0.2, 0.2) if om + d > 0]
+        starts = [("Omega", round(om + d, 12)) for d in HOMOTOPY_OMEGA_STEPS if om + d > 0]
         return starts + [("eta", 1.0)]
     items = list(homotopy.items()) if isinstance(homotopy, dict) else _check.sequence(
         "homotopy", homotopy)
@@ -459,11 +473,12 @@ def periodic(
     exists (every start settling to the perfect balance, as at the thesis' R-R point of
     its table 4-7), find the orbit at a nearby parameter point instead and follow it
     here by natural-parameter continuation (secant predictor, each step certified, the
-    step halved on failure). ``True`` tries ``Omega`` 0.1 and 0.2 below and above the
-    model's, then ``eta = 1``; a dict ``{"Omega": 1.2}`` or pairs ``[("Omega", 1.2)]``
-    give the starts to try, in order. Only used without ``guess`` and only when
-    simulation here finds nothing. By default (``None``) the ``True`` starts are tried
-    last, after the constructed starts; ``False`` never tries them.
+    step halved on failure). ``True`` tries ``Omega`` 0.1, 0.2, 0.4 and 0.6 below and
+    above the model's (:data:`HOMOTOPY_OMEGA_STEPS`), then ``eta = 1``; a dict
+    ``{"Omega": 1.2}`` or pairs ``[("Omega", 1.2)]`` give the starts to try, in order.
+    Only used without ``guess`` and only when simulation here finds nothing. By default
+    (``None``) the ``True`` starts are tried last, after the constructed starts;
+    ``False`` never tries them.
     ``info["guess_source"]`` says how every result was found: ``"simulation"``,
     ``"guess"``, ``"constructed (...)"`` or ``"homotopy from Omega=1.2"``.
 
@@ -494,6 +509,18 @@ def periodic(
       the product of the two ball-separation multipliers against its exact value
       ``exp(-2 zeta_b T)`` (Liouville's formula on the separation mode); above
       ``max_trivial`` the verdict is ``undetermined`` too.
+    * ``modulus_error``: every verdict is judged against a bound on the error of the
+      leading non-trivial modulus ``max_modulus``, not only the trivial multiplier's
+      (which does not bound it: at N = 3 the leading modulus' real error exceeded the
+      trivial one's in a quarter of the thesis rows, by up to 195 times). The series is
+      solved again with half as many harmonics more (at least two) and its multipliers
+      computed with the same options; the bound is twice the two leading moduli's
+      difference plus the finer series' own error measures, and the verdict needs
+      ``max_modulus`` farther than it (and than ``margin``, ``trivial_error``) from 1.
+      Where it is not, the finer series becomes the result (``N`` says so) and is
+      checked the same way, up to ``N = 27``; then, or where no finer series converges,
+      the verdict is ``undetermined``. ``modulus_error_source`` names the two series
+      (``"N 5 vs 8"``).
 
     A ``not_closed``, ``truncated`` or ``equilibrium`` result keeps ``coeffs`` (and,
     but for an equilibrium, ``omega``) for inspection but has no multipliers and no
@@ -553,6 +580,7 @@ def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:
     return PeriodicSolution(
         tail=d["tail"], target_met=d["target_met"], hill_multipliers=hill_m,
         hill_stability=d["hill_stability"], verdicts_disagree=d["verdicts_disagree"],
+        modulus_error=d["modulus_error"], modulus_error_source=d["modulus_error_source"],
         balancer=model, status=d["status"], type=d["type"], omega=d["omega"],
         coeffs=d["coeffs"], winding=d["winding"], N=d["N"], samples=d["samples"],
         residual=d["residual"], iterations=d["iterations"], multipliers=mult,

@@ -141,7 +141,7 @@ class Bearing:
                     allowed="two integers",
                 )
             object.__setattr__(self, "grid", _grid(g[0], g[1]))
-        nt, nz = self.grid
+        nt, nz = self.grid or (0, 0)
         if self.model == "narrow_groove" and nt * nz > _check.MAX_NARROW_GROOVE_CELLS:
             raise ParameterError(
                 "grid.n_theta" if nt >= nz else "grid.n_zeta",

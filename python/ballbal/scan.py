@@ -57,7 +57,8 @@ GridSpec = Sequence[float] | np.ndarray | tuple[float, float, float] | str
 MULTIPLIER = pl.List(pl.Struct({"re": pl.Float64, "im": pl.Float64}))
 _SCHEMA: dict[str, Any] = {
     "type": pl.Utf8, "solution": pl.Int64, "status": pl.Utf8, "omega": pl.Float64,
-    "stability": pl.Utf8, "max_modulus": pl.Float64, "trivial_error": pl.Float64,
+    "stability": pl.Utf8, "max_modulus": pl.Float64, "modulus_error": pl.Float64,
+    "modulus_error_source": pl.Utf8, "trivial_error": pl.Float64,
     "multipliers": MULTIPLIER, "residual": pl.Float64, "tail": pl.Float64,
     "closure": pl.Float64, "separation_error": pl.Float64,
     "pivot_ratio": pl.Float64, "iterations": pl.Int64, "floquet_steps": pl.Int64,
@@ -149,6 +150,8 @@ class _Job:
             "grid": {n: list(v) for n, v in zip(self.names, self.values, strict=True)},
             "patterns": list(self.patterns), "options": _meta_options(self.options),
             "block": self.block, "chunk": self.chunk,
+            # A store written with other columns is not resumed into this table.
+            "columns": list(_SCHEMA),
         }
 
 
@@ -676,7 +679,9 @@ def scan(  # noqa: E302 - overloads above
     last harmonic is that large relative to the motion (``N`` too small). Every solution
     is certified as in :func:`~ballbal.periodic` (``max_closure``, ``max_trivial``, the
     same defaults): a series that fails is neither reported nor continued, and a row
-    gets a stability verdict only with an accurate trivial multiplier. The solution
+    gets a stability verdict only with an accurate trivial multiplier and a bound on its
+    leading modulus' error (``modulus_error``; a row whose verdict the bound leaves open
+    is refined to more harmonics first, see :func:`~ballbal.periodic`). The solution
     columns have the names and meaning of :class:`~ballbal.PeriodicSolution`'s fields
     (``pivot_ratio``, ...); the multipliers are a list of ``{re, im}``.
 

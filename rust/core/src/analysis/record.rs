@@ -21,11 +21,13 @@ pub enum Cell {
 /// The schema's names, in the order of [`solution_cells`]. `pivot_ratio` is the last
 /// Newton matrix's largest over smallest LU pivot, a lower bound of its condition
 /// number (`PeriodicSolution.condition` before; stored scan tables use this name).
-pub const SOLUTION_FIELDS: [&str; 19] = [
+pub const SOLUTION_FIELDS: [&str; 21] = [
     "status",
     "omega",
     "stability",
     "max_modulus",
+    "modulus_error",
+    "modulus_error_source",
     "trivial_error",
     "mult_re",
     "mult_im",
@@ -47,7 +49,7 @@ pub const SOLUTION_FIELDS: [&str; 19] = [
 /// but failed a certificate (`not_closed`, `truncated`) keeps its `omega` for
 /// inspection; its status says why it is not a result. An `equilibrium` has no `omega`
 /// (any value solves its equations).
-pub fn solution_cells(r: &Periodic) -> [Cell; 19] {
+pub fn solution_cells(r: &Periodic) -> [Cell; 21] {
     let s = &r.sol;
     let fl = r.floquet.as_ref();
     let ok = matches!(
@@ -60,6 +62,11 @@ pub fn solution_cells(r: &Periodic) -> [Cell; 19] {
         Cell::F(ok.then_some(s.omega)),
         Cell::S(Some(fl.map_or("undetermined", |f| f.stability.as_str()))),
         Cell::F(fl.map(|f| f.max_modulus)),
+        Cell::F(fl.and_then(|f| f.modulus_error)),
+        Cell::Text(fl.and_then(|f| {
+            f.modulus_error_against
+                .map(|m| format!("N {} vs {m}", s.n_harm))
+        })),
         Cell::F(fl.map(|f| f.trivial_error)),
         Cell::V(part(|z| z.0)),
         Cell::V(part(|z| z.1)),
@@ -80,9 +87,13 @@ pub fn solution_cells(r: &Periodic) -> [Cell; 19] {
 
 /// The schema's values where no solution was found (a scan row `not_found`, with the
 /// harmonics it was asked for).
-pub fn missing_cells(n_harm: usize) -> [Cell; 19] {
-    let mut c: [Cell; 19] = std::array::from_fn(|_| Cell::F(None));
+pub fn missing_cells(n_harm: usize) -> [Cell; 21] {
+    let mut c: [Cell; 21] = std::array::from_fn(|_| Cell::F(None));
     c[0] = Cell::S(Some("not_found"));
-    c[15] = Cell::U(Some(n_harm));
+    c[N_FIELD] = Cell::U(Some(n_harm));
     c
 }
+
+/// The position of `N` in [`SOLUTION_FIELDS`].
+const N_FIELD: usize = 17;
+const _: () = assert!(matches!(SOLUTION_FIELDS[N_FIELD].as_bytes(), b"N"));

@@ -150,6 +150,14 @@ pub struct Floquet {
     /// Magnus: the estimated error of the multipliers (relative to the larger of 1 and
     /// their modulus), which widens the verdict's margin like the trivial error does.
     pub method_error: Option<f64>,
+    /// The bound on `max_modulus`'s error that the verdict was judged against (see
+    /// [`crate::periodic::bound_verdict`]): twice its difference to the same multiplier of
+    /// a series with more harmonics, plus that series' own integration measures. `None`
+    /// where no such series was computed: then the verdict is undetermined, except for a
+    /// bare [`floquet`] call, which judges by the trivial multiplier alone.
+    pub modulus_error: Option<f64>,
+    /// The harmonics of the series that [`Floquet::modulus_error`] compares with.
+    pub modulus_error_against: Option<usize>,
 }
 
 /// The verdict on a set of multipliers (largest modulus first).
@@ -431,7 +439,34 @@ pub fn floquet<D: Dynamics + ?Sized>(
         steps,
         rhs_evals: evals,
         method_error,
+        modulus_error: None,
+        modulus_error_against: None,
     })
+}
+
+/// The verdict on multipliers `ev` whose leading non-trivial modulus is known to within
+/// `modulus_error`: [`judge`] with the margin widened to it (and to the integration's
+/// estimate `method_error`), undetermined when merged balls' separation product is off
+/// by more than `max_trivial`, as in [`floquet`].
+pub fn bounded_verdict(
+    ev: &[(f64, f64)],
+    opts: &FloquetOptions,
+    method_error: Option<f64>,
+    separation_error: Option<f64>,
+    modulus_error: f64,
+) -> Stability {
+    let margin = opts
+        .margin
+        .max(method_error.unwrap_or(0.0))
+        .max(modulus_error);
+    // A NaN error is no bound.
+    if modulus_error.is_nan() {
+        return Stability::Undetermined;
+    }
+    match separation_error {
+        Some(e) if !(e <= opts.max_trivial) => Stability::Undetermined,
+        _ => judge(ev, margin, opts.max_trivial).stability,
+    }
 }
 
 /// The first pair of balls `(i, j)` whose series are the same motion (coefficients equal
