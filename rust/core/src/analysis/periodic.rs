@@ -536,6 +536,19 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
     finish_certified(p, sol, opts, None)
 }
 
+/// [`finish`] at the series' own harmonics, for the points of a branch or curve, whose
+/// continuation needs one truncation throughout: no [`bound_verdict`] (it would refine a
+/// point to more harmonics, and double the multipliers' cost along the branch). Their
+/// verdicts are judged by the trivial multiplier's error as before, and their
+/// `modulus_error` is `None`.
+pub fn finish_on_branch<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: HbSolution,
+    opts: &PeriodicOptions,
+) -> Periodic {
+    finish_inner(p, sol, opts, None, false)
+}
+
 /// [`finish`] of a series whose [`certify`] (with these options) already passed and
 /// gave the closure `passed`: without `auto`, that certificate is not computed again.
 pub fn finish_certified<D: Dynamics + ?Sized>(
@@ -543,6 +556,16 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
     sol: HbSolution,
     opts: &PeriodicOptions,
     passed: Option<f64>,
+) -> Periodic {
+    finish_inner(p, sol, opts, passed, true)
+}
+
+fn finish_inner<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: HbSolution,
+    opts: &PeriodicOptions,
+    passed: Option<f64>,
+    bounded: bool,
 ) -> Periodic {
     let mut sol = sol;
     let mut target_met = None;
@@ -600,11 +623,13 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
         }
     }
     let mut closure = closure;
-    if let (Some(fo), Some(f)) = (&opts.floquet, fl.take()) {
-        let b = bound_verdict(p, sol, f, closure, fo, opts);
-        (sol, fl, closure) = (b.sol, Some(b.floquet), b.closure);
-        if let Some(why) = b.unbounded {
-            fl_err.get_or_insert(why);
+    if let (true, Some(fo)) = (bounded, &opts.floquet) {
+        if let Some(f) = fl.take() {
+            let b = bound_verdict(p, sol, f, closure, fo, opts);
+            (sol, fl, closure) = (b.sol, Some(b.floquet), b.closure);
+            if let Some(why) = b.unbounded {
+                fl_err.get_or_insert(why);
+            }
         }
     }
     let hill = if opts.hill

@@ -33,7 +33,7 @@ use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
 use crate::numerics::problem::{ModelAt, Parametric, Problem};
-use crate::periodic::{finish, Periodic, PeriodicOptions};
+use crate::periodic::{finish_on_branch, Periodic, PeriodicOptions};
 use nalgebra::DMatrix;
 
 /// Settings of [`periodic_branch`].
@@ -212,7 +212,7 @@ impl<D: Parametric> Ctx<'_, D> {
     /// Certificates and multipliers of the point, as `periodic()` gives them.
     fn judge(&self, pt: &ArcPoint) -> Result<Periodic> {
         let m = self.base.with_param(self.name, pt.p)?;
-        Ok(finish(&m, self.series(pt), &self.popts))
+        Ok(finish_on_branch(&m, self.series(pt), &self.popts))
     }
 
     fn point<P: Problem + ?Sized>(&self, prob: &mut P, pt: &ArcPoint) -> Result<PoPoint> {

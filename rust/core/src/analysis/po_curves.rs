@@ -51,7 +51,7 @@ use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::error::{Error, Result};
 use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
 use crate::numerics::problem::{Parametric, Problem};
-use crate::periodic::{finish, Periodic, PeriodicOptions};
+use crate::periodic::{finish_on_branch, Periodic, PeriodicOptions};
 use nalgebra::{Complex, ComplexField, DMatrix, DVector};
 use std::f64::consts::PI;
 
@@ -1953,7 +1953,7 @@ fn half<'a, D: Parametric>(
         let prob = arc.problem();
         let sol = prob.sys.series(&pt.x[..n], pt.residual);
         let model = prob.sys.model(p)?.clone();
-        let result = finish(&model, sol, popts);
+        let result = finish_on_branch(&model, sol, popts);
         let g = prob.g(&pt.x, pt.p)?;
         let g = if ns { g[0].hypot(g[1]) } else { g[0] };
         // New borders for the next step (the curve is the same set: g = 0 iff H is

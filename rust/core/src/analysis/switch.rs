@@ -19,7 +19,7 @@
 //! doubling or Hopf branch `p - p*` grows like the amplitude squared, which the corrector
 //! finds by itself.
 
-use crate::analysis::periodic::{finish, Periodic, PeriodicOptions};
+use crate::analysis::periodic::{finish_on_branch, Periodic, PeriodicOptions};
 use crate::continuation::{point_at, ArcOptions, ArcPoint};
 use crate::error::{Error, Result};
 use crate::floquet::{merged_pair, monodromy, FloquetOptions};
@@ -345,7 +345,7 @@ fn step_off<D: Parametric>(
                         ..opts.hb.clone()
                     },
                 );
-                let periodic = finish(&at, polished, opts);
+                let periodic = finish_on_branch(&at, polished, opts);
                 return Ok(Switched {
                     periodic,
                     p: pt.p,
