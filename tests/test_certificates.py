@@ -143,7 +143,9 @@ def test_scan_rows_are_certified():
     # margin of that size), and the slowest (eta 0.6) "converged" with a simulated
     # closure of 0.94.
     b = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
-    df = ballbal.scan(b, Omega=(1.0, 1.2, 0.1), eta=(0.6, 1.1, 0.1), patterns=["R-R"])
+    # refine=False: the N = 3 rows themselves (the verdict's bound refines these to N = 5).
+    df = ballbal.scan(b, Omega=(1.0, 1.2, 0.1), eta=(0.6, 1.1, 0.1), patterns=["R-R"],
+                      refine=False)
     assert {"closure", "separation_error"} <= set(df.columns)
     ok = df.filter(df["status"] == "converged")
     assert ok.height >= 10
@@ -154,7 +156,7 @@ def test_scan_rows_are_certified():
     # independent: the slowest rows reported as orbits close under scipy simulation
     for row in ok.sort("omega").head(3).iter_rows(named=True):
         s = ballbal.periodic(b.replace(Omega=row["Omega"], eta=(row["eta"],) * 2), "R-R",
-                             N=3, rtol=1e-6, atol=1e-9)
+                             N=3, rtol=1e-6, atol=1e-9, refine=False)
         assert s.converged and abs(s.omega - row["omega"]) < 1e-6
         assert simulated_closure(s, rtol=1e-9) < 0.75
 
@@ -243,8 +245,10 @@ def test_auto_harmonics_from_a_non_orbit_certifies_after_refinement():
     b = ballbal.Balancer(**REPRO, Omega=1.0, eta=(1.0, 1.0))
     prev = ballbal.periodic(b, "R-R", N=8)
     for W in (0.98, 0.96, 0.94, 0.92):
+        # refine=False: the N = 8 series, which the verdict's bound would raise to an
+        # orbit at N = 18.
         prev = ballbal.periodic(b.replace(Omega=W), "R-R", N=8, guess=prev,
-                                max_closure=1e300)
+                                max_closure=1e300, refine=False)
     assert prev.converged and simulated_closure(prev, rtol=1e-9) > 1.0  # certificate off
     outcomes = set()
     for W in (0.92, 0.915, 0.9):

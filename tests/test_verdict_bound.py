@@ -149,3 +149,19 @@ def test_verdicts_near_a_stability_change_are_right_or_undetermined(family: str)
     assert judged >= 5, judged
     # Rarely undetermined: at 1e-3 and 1e-4 from 1 the refinement settles every verdict.
     assert definite >= 4, (definite, judged)
+
+
+def test_the_issues_example_is_unstable_or_undetermined_at_n_3() -> None:
+    """N = 3 said stable (|mu| 0.99998027, trivial error 5.1e-6) where the orbit is
+    unstable (1.0000036 by the shooting above). Kept at N = 3 (refine=False) the bound
+    leaves it undetermined; refined, it is unstable at more harmonics."""
+    b = ballbal.Balancer(mu=0.25, zeta=0.08, zeta_b=0.02, delta=20, Omega=1.3584277344,
+                         eta=(1.0, 1.0))
+    kept = ballbal.periodic(b, "R-R", refine=False)
+    assert kept.converged and kept.N == 3 and kept.stability == "undetermined"
+    assert kept.modulus_error is not None and kept.modulus_error > abs(kept.max_modulus - 1)
+    refined = ballbal.periodic(b, "R-R")
+    assert refined.N > 3 and refined.stability == "unstable"
+    lead, accuracy = _truth(b, "R-R", ballbal.periodic(b, "R-R", N=12, guess=refined), 2)
+    assert lead - 1.0 > 100 * accuracy and lead > 1.0
+    assert abs(refined.max_modulus - lead) <= refined.modulus_error

@@ -442,8 +442,8 @@ def periodic(
     search, certificates; default :data:`ballbal.options.PERIODIC_DEFAULTS`). The flat
     keywords below are still accepted and change those options: ``N, target, N_max,
     samples, tol, step_tol, max_iter`` (:class:`~ballbal.HarmonicBalance`), ``floquet``
-    (its ``monodromy``), ``hill, hill_band, rtol, atol, margin, max_steps, max_trivial``
-    (:class:`~ballbal.Floquet`; ``hill_band`` limits Hill to verdicts in doubt, as in
+    (its ``monodromy``), ``hill, hill_band, rtol, atol, margin, max_steps, max_trivial,
+    refine`` (:class:`~ballbal.Floquet`; ``hill_band`` limits Hill to verdicts in doubt, as in
     scans, and ``hill_stability`` is then None elsewhere), ``settle, window, guess_rtol,
     guess_atol`` (:class:`~ballbal.GuessSearch`), ``max_closure, max_tail``.
 

@@ -159,6 +159,13 @@ class Floquet:
     multipliers' accuracy asked for (relative to the larger of 1 and their modulus;
     ``atol`` unused), the estimated error widens the margin like ``trivial_error``, and
     ``max_steps`` bounds the steps of all grids together.
+
+    ``refine``: every verdict is judged against a bound on the leading modulus' error
+    (``modulus_error``, from a solve with more harmonics; see :func:`~ballbal.periodic`).
+    Where the bound leaves the verdict open, ``True`` (the default) raises the harmonics
+    of that solution, up to 27, before calling it undetermined, so a result's ``N`` may
+    exceed the one asked for; ``False`` keeps the truncation asked for (a study of one
+    ``N``) and leaves such a verdict undetermined.
     """
 
     rtol: float = 1e-8
@@ -171,6 +178,7 @@ class Floquet:
     method: Literal["rk45", "magnus"] = "rk45"
     hill_target: Literal["multipliers", "verdict"] = "multipliers"
     hill_band: float | None = None
+    refine: bool = True
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "method", _check.string("method", self.method))
@@ -179,7 +187,7 @@ class Floquet:
             object.__setattr__(self, "hill_band", _check.real("hill_band", self.hill_band))
         _reals(self, "rtol", "atol", "margin", "max_trivial")
         _counts(self, "max_steps")
-        _flags(self, "monodromy", "hill")
+        _flags(self, "monodromy", "hill", "refine")
 
 
 @dataclass(frozen=True)
@@ -309,6 +317,7 @@ _LEGACY: dict[str, tuple[str, str]] = {
     "margin": ("floquet", "margin"), "max_steps": ("floquet", "max_steps"),
     "max_trivial": ("floquet", "max_trivial"), "floquet_method": ("floquet", "method"),
     "hill_target": ("floquet", "hill_target"), "hill_band": ("floquet", "hill_band"),
+    "refine": ("floquet", "refine"),
     "settle": ("guess", "settle"), "window": ("guess", "window"),
     "guess_rtol": ("guess", "rtol"), "guess_atol": ("guess", "atol"),
     "seeds": ("guess", "seeds"), "starts": ("guess", "starts"),

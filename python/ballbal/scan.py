@@ -654,7 +654,7 @@ def scan(  # noqa: E302 - overloads above
     :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`). The flat keywords
     of :func:`~ballbal.periodic` (``N, target, N_max, hill, hill_band, samples, tol, step_tol,
     max_iter, floquet, rtol, atol, margin, max_steps, settle, window, guess_rtol,
-    guess_atol, max_tail, max_closure, max_trivial``) and ``seeds, starts, block`` are
+    guess_atol, max_tail, max_closure, max_trivial, refine``) and ``seeds, starts, block`` are
     still accepted beside the axes and change those options. ``execution``: an
     :class:`~ballbal.Execution` (where it runs: ``threads, chunk, executor, progress,
     out, lazy``); the keywords of the same names override it. Execution never changes

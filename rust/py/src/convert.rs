@@ -240,6 +240,7 @@ pub struct FloquetArgs {
     hill: bool,
     hill_target: String,
     hill_band: Option<f64>,
+    refine: bool,
 }
 
 /// `ballbal.options.GuessSearch`.
@@ -298,6 +299,7 @@ impl PeriodicArgs {
             hill_judging: Some((f.margin, f.max_trivial)),
             hill_target: HillTarget::parse(&f.hill_target).py()?,
             hill_band: f.hill_band,
+            refine_verdicts: f.refine,
             hb: HbOptions {
                 n_harm: h.start,
                 samples: h.samples,

@@ -187,6 +187,11 @@ pub struct PeriodicOptions {
     /// monodromy's own error measures of 1; without a monodromy (`floquet` `None`), not at
     /// all.
     pub hill_band: Option<f64>,
+    /// Where the verdict's error bound ([`bound_verdict`]) leaves it open, raise the
+    /// harmonics (the result's `N` then differs from the one asked for). `false` keeps
+    /// the series asked for and leaves such a verdict undetermined, as a study of one
+    /// truncation needs.
+    pub refine_verdicts: bool,
     /// Largest integrated ODE defect ([`defect_closure`]) of a converged series; above
     /// it the result is `NotClosed`.
     pub max_closure: f64,
@@ -206,6 +211,7 @@ impl Default for PeriodicOptions {
             hill_judging: None,
             hill_target: HillTarget::Multipliers,
             hill_band: None,
+            refine_verdicts: true,
             max_closure: MAX_CLOSURE,
             max_tail: MAX_TAIL,
         }
@@ -705,8 +711,9 @@ pub struct Bounded {
 ///
 /// Where that (or a trivial multiplier off by more than `max_trivial`) leaves the verdict
 /// undetermined, the finer series (certified like any result) becomes the result and is checked against a finer one again, up to
-/// [`BOUND_N_MAX`] harmonics. Where no finer series converges, or its multipliers cannot
-/// be computed, there is no bound and the verdict is undetermined.
+/// [`BOUND_N_MAX`] harmonics (unless [`PeriodicOptions::refine_verdicts`] is off). Where no
+/// finer series converges, or its multipliers cannot be computed, there is no bound and the
+/// verdict is undetermined.
 pub fn bound_verdict<D: Dynamics + ?Sized>(
     p: &D,
     sol: HbSolution,
@@ -778,7 +785,7 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
         // Whatever left the verdict open (the bound, or a trivial multiplier off by more
         // than `max_trivial`: both shrink with the truncation error), more harmonics may
         // settle it; a modulus at 1 to round-off stops at `BOUND_N_MAX`.
-        if fl.stability != Stability::Undetermined || m > BOUND_N_MAX {
+        if fl.stability != Stability::Undetermined || m > BOUND_N_MAX || !opts.refine_verdicts {
             return Bounded {
                 sol,
                 floquet: fl,
