@@ -27,9 +27,10 @@ How:
   joined with ``-`` in ballbal's ball order. This is ballbal's convention
   (``PeriodicSolution``: ``q_j = ... + w_j omega t``, ``w_j = -1`` for a rotating ball,
   ``omega`` the orbit's frequency), so a ballbal R-R orbit has windings ``(-1, -1)``.
-  A start is settled when the section returns to 1e-6, or when two consecutive windows
-  agree (same pattern and windings, ``omega`` to 1e-5 relative, velocity amplitude to
-  1e-3) with returns within 1e-3; otherwise it is *unsettled* (quasi-periodic, chaotic
+  A start is settled when the section returns to 1e-6 (relative to the largest
+  velocity), or when two consecutive windows agree (same pattern and windings, ``omega``
+  to 1e-5 relative, velocity amplitude to 1e-3) with returns within 1e-3 and shrinking
+  by at least 10 %; otherwise it is *unsettled* (quasi-periodic, chaotic, near-neutral
   or slower than ``--t-max``): reported, never counted as a miss.
 * ballbal is then run as a user would, at default options and with every pattern of the
   ball count, on a 1-point grid at the point and, separately, on a small grid holding it
@@ -43,10 +44,14 @@ How:
   stable equilibrium, which scans have no rows for, when ``ballbal.equilibria()`` lists it
   as stable at the same disk position (1e-4).
 * *Missed*: an attractor simulation settled on that the scan (1-point or small grid)
-  does not list as above. For each miss ``ballbal.periodic()`` is started from the
-  simulated orbit (its Fourier series, N = 3 and ``N="auto"``) to give its own verdict
-  and leading multiplier modulus. Stable scan rows that no start reached are printed for
-  information (basins can be small).
+  does not list as above. For each missed orbit the benchmark gives its leading
+  non-trivial multiplier modulus twice: independently (monodromy by central differences
+  of the DOP853 flow over one period) and by ``ballbal.periodic()`` started from the
+  simulated orbit's Fourier series (N = 3 and ``N="auto"``). Stable scan rows that no
+  start reached are printed for information (basins can be small). ``returns`` is the
+  section's relative return distance in the last window (and the window before):
+  shrinking means converging; one that stays near 1e-7 marks an orbit within about 1e-5
+  of a stability change (or a thin torus), where 8000 time units cannot tell.
 
 Run (from the repository root, with ballbal importable)::
 
@@ -404,7 +409,10 @@ def simulate_start(task: tuple[Point, int, int, Settings]) -> Outcome:
             agree = (prev is not None and prev.kind == "periodic"
                      and prev.pattern == o.pattern and prev.windings == o.windings
                      and abs(prev.omega - o.omega) <= 1e-5 * o.omega
-                     and abs(prev.speed - o.speed) <= 1e-3 * o.speed)
+                     and abs(prev.speed - o.speed) <= 1e-3 * o.speed
+                     # still converging: an orbit whose returns stall is too near neutral
+                     # (or a thin torus) for this window to tell
+                     and o.returns < 0.9 * prev.returns)
             if o.returns < RETURN_TIGHT or agree:
                 o.prev_returns = prev.returns if prev is not None else math.nan
                 o.unc = (abs(prev.omega - o.omega) if prev is not None
@@ -644,6 +652,33 @@ def periodic_verdicts(p: Point, o: Outcome) -> str:
     return "; ".join(parts)
 
 
+def monodromy_modulus(p: Point, o: Outcome) -> float:
+    """Largest non-trivial Floquet multiplier modulus of the simulated orbit, independent
+    of ballbal: the monodromy matrix by central differences of the DOP853 flow over one
+    period (rtol 1e-12) from the section state; the eigenvalue nearest 1 is the trivial
+    one. Good to about 1e-6, not for orbits closer than that to a stability change."""
+    if o.section is None:
+        return math.nan
+    f = make_rhs(p)
+    T = TWO_PI / o.omega
+    s0 = o.section
+
+    def flow(s: np.ndarray) -> np.ndarray:
+        return np.asarray(solve_ivp(f, (0.0, T), s, method="DOP853", rtol=1e-12,
+                                    atol=1e-13).y[:, -1])
+
+    d = s0.size
+    m = np.empty((d, d))
+    for i in range(d):
+        h = 1e-6 * (1.0 + abs(s0[i]))
+        e = np.zeros(d)
+        e[i] = h
+        m[:, i] = (flow(s0 + e) - flow(s0 - e)) / (2 * h)
+    mult = np.linalg.eigvals(m)
+    trivial = int(np.argmin(np.abs(mult - 1.0)))
+    return float(np.max(np.abs(np.delete(mult, trivial))))
+
+
 def describe(o: Outcome) -> str:
     """One attractor in a few words."""
     if o.kind == "perfect_balance":
@@ -746,9 +781,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"  {describe(a.example)}  [{a.starts} starts]  {tag}"
                   f"  (1-point: {why1 or 'ok'}; grid: {whyg or 'ok'})")
             if not (ok1 and okg):
-                extra = periodic_verdicts(p, a.example) if a.kind == "periodic" else ""
+                extra = ""
+                if a.kind == "periodic":
+                    extra = (f"independent |mu| {monodromy_modulus(p, a.example):.6f}; "
+                             f"ballbal periodic() from the simulated orbit: "
+                             f"{periodic_verdicts(p, a.example)}")
                 if extra:
-                    print(f"      periodic() from the simulated orbit: {extra}")
+                    print(f"      {extra}")
                 misses.append(f"{p.label}: {p.describe()}: {describe(a.example)} "
                               f"[{tag}] {extra}")
         for o in other:
