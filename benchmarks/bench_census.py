@@ -31,7 +31,10 @@ How:
   velocity), or when two consecutive windows agree (same pattern and windings, ``omega``
   to 1e-5 relative, velocity amplitude to 1e-3) with returns within 1e-3 and shrinking
   by at least 10 %; otherwise it is *unsettled* (quasi-periodic, chaotic, near-neutral
-  or slower than ``--t-max``): reported, never counted as a miss.
+  or slower than ``--t-max``): reported, never counted as a miss. A motion too slow
+  for its window (fewer than 10 section crossings: a rotating branch near its
+  infinite-period end, periods of thousands) gets doubling windows up to ``--t-slow``
+  (cheap: the integrator's steps are long there).
 * ballbal is then run as a user would, at default options and with every pattern of the
   ball count, on a 1-point grid at the point and, separately, on a small grid holding it
   (5 Omega values 0.05 apart times 3 eta values 0.1 apart; ``eta[0]`` for unequal
@@ -218,6 +221,7 @@ class Settings:
     settle: float
     window: float
     t_max: float
+    t_slow: float
     rtol: float
     atol: float
     reference_rhs: bool
@@ -238,6 +242,7 @@ class Outcome:
     speed: float = math.nan  # largest velocity over the window (the motion's size)
     section: np.ndarray | None = None  # the window's last section state
     prev_returns: float = math.nan  # the window before's returns (shrinking: converging)
+    slow: bool = False  # too few section crossings in the window to look for a period
     q: tuple[float, ...] = ()  # equilibrium position
     t_end: float = 0.0
     seconds: float = 0.0
@@ -293,10 +298,11 @@ def _levels(n: int) -> list[Callable[[float, np.ndarray], float]]:
 
 
 def _window(f: Callable[[float, np.ndarray], np.ndarray], p: Point, s: np.ndarray,
-            t0: float, cfg: Settings, prev_speed: float | None) -> tuple[Outcome, np.ndarray]:
+            t0: float, width: float, cfg: Settings,
+            prev_speed: float | None) -> tuple[Outcome, np.ndarray]:
     """Integrate one window and read the motion off it (not yet a verdict)."""
     n = p.n
-    sol = solve_ivp(f, (t0, t0 + cfg.window), s, method="DOP853", rtol=cfg.rtol,
+    sol = solve_ivp(f, (t0, t0 + width), s, method="DOP853", rtol=cfg.rtol,
                     atol=cfg.atol, events=_levels(n))
     if sol.status != 0:
         return Outcome("failed", note=sol.message), s
@@ -309,7 +315,7 @@ def _window(f: Callable[[float, np.ndarray], np.ndarray], p: Point, s: np.ndarra
     # state is about ``speed / lam`` from it.
     unc = 0.0
     if prev_speed is not None and speed < 1e-5 and speed < 0.7 * prev_speed:
-        lam = math.log(prev_speed / speed) / cfg.window
+        lam = math.log(prev_speed / speed) / width
         unc = speed / lam
     if speed < EQ_SPEED or unc:
         at_axis = math.hypot(end[0], end[1]) < max(PB_RADIUS, 3 * unc)
@@ -338,8 +344,9 @@ def _window(f: Callable[[float, np.ndarray], np.ndarray], p: Point, s: np.ndarra
             break
     if best is None:
         pattern = "-".join("R" if abs(d) >= 1.0 else "O" for d in drift)
-        rates = ", ".join(f"{TWO_PI * d / cfg.window:+.4f}" for d in drift)
+        rates = ", ".join(f"{TWO_PI * d / width:+.4f}" for d in drift)
         best = Outcome("unsettled", pattern=pattern, radius=radius, speed=speed,
+                       slow=te.size < 2 * K_MAX + 2,
                        note=f"mean ball rates {rates}")
     return best, end
 
@@ -396,9 +403,14 @@ def simulate_start(task: tuple[Point, int, int, Settings]) -> Outcome:
     s, t = sol.y[:, -1], cfg.settle
     prev: Outcome | None = None
     result: Outcome | None = None
-    while t + cfg.window <= cfg.t_max + 1e-9:
-        o, s_next = _window(f, p, s, t, cfg, None if prev is None else prev.speed)
-        t += cfg.window
+    width = cfg.window
+    while t + width <= (cfg.t_slow if prev is not None and prev.slow else cfg.t_max) + 1e-9:
+        o, s_next = _window(f, p, s, t, width, cfg, None if prev is None else prev.speed)
+        t += width
+        if o.slow:
+            # A slow motion (a rotating branch near its infinite-period end: periods of
+            # thousands) is cheap to integrate: windows double, up to --t-slow.
+            width = min(2 * width, max(cfg.t_slow - t, cfg.window))
         if o.kind == "failed":
             result = o
             break
@@ -712,6 +724,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--window", type=float, default=500.0, help="window length (default 500)")
     ap.add_argument("--t-max", type=float, default=8000.0,
                     help="longest simulation (default 8000)")
+    ap.add_argument("--t-slow", type=float, default=100000.0,
+                    help="longest simulation of a motion too slow for its windows (default "
+                    "1e5; the windows double)")
     ap.add_argument("--rtol", type=float, default=1e-10, help="DOP853 rtol (default 1e-10)")
     ap.add_argument("--atol", type=float, default=1e-11, help="DOP853 atol (default 1e-11)")
     ap.add_argument("--reference-rhs", action="store_true",
@@ -720,12 +735,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     for name in ("points", "starts", "jobs"):
         if getattr(args, name) < (0 if name == "points" else 1):
             ap.error(f"--{name} must be at least {0 if name == 'points' else 1}")
-    if not 0 < args.window <= args.t_max or args.settle < 0:
-        ap.error("need 0 < --window <= --t-max and --settle >= 0")
+    if not 0 < args.window <= args.t_max <= args.t_slow or args.settle < 0:
+        ap.error("need 0 < --window <= --t-max <= --t-slow and --settle >= 0")
     if args.quick:
         args.points, args.starts = 2, 6
-        args.settle, args.window, args.t_max = 800.0, 400.0, 3000.0
-    cfg = Settings(args.settle, args.window, args.t_max, args.rtol, args.atol,
+        args.settle, args.window, args.t_max, args.t_slow = 800.0, 400.0, 3000.0, 2e4
+    cfg = Settings(args.settle, args.window, args.t_max, args.t_slow, args.rtol, args.atol,
                    args.reference_rhs)
     rng = np.random.default_rng(args.seed)
     points = [] if args.no_issue_points else issue_points()
@@ -735,7 +750,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     keep = args.only.split(",")
     points = [p for p in points if any(k in f"{p.label}]" for k in keep)]
     print(f"census: seed {args.seed}, {len(points)} points x {args.starts} starts, "
-          f"settle {cfg.settle:g}, window {cfg.window:g}, t_max {cfg.t_max:g}, DOP853 rtol "
+          f"settle {cfg.settle:g}, window {cfg.window:g}, t_max {cfg.t_max:g} (slow motions "
+          f"{cfg.t_slow:g}), DOP853 rtol "
           f"{cfg.rtol:g} atol {cfg.atol:g}, {args.jobs} processes, ballbal {ballbal.__file__}")
     worst = max(check_rhs(p, rng) for p in points)
     print(f"rhs transcription vs tests/reference.py::rhs: largest relative difference "
