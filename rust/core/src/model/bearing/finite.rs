@@ -954,15 +954,21 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_cancelled_film_call_stops_with_cancelled_and_the_solver_stays_usable() {
-        let st = JournalState {
+    /// An eccentric, moving journal: the state the cancellation tests and the latency
+    /// report solve the film at.
+    fn moving_state() -> JournalState {
+        JournalState {
             x: 0.4,
             y: -0.3,
             vx: 0.01,
             vy: 0.02,
             tau: 0.0,
-        };
+        }
+    }
+
+    #[test]
+    fn a_cancelled_film_call_stops_with_cancelled_and_the_solver_stays_usable() {
+        let st = moving_state();
         let cancelled = || {
             let t = Token::new();
             t.cancel();
@@ -1096,13 +1102,7 @@ mod tests {
                         FilmModel::Finite { n_theta, n_zeta }
                     },
                 };
-                let st = JournalState {
-                    x: 0.4,
-                    y: -0.3,
-                    vx: 0.01,
-                    vy: 0.02,
-                    tau: 0.0,
-                };
+                let st = moving_state();
                 let (f, total, longest) = crate::cancel::gaps::longest(|| {
                     b.solver().and_then(|mut s| s.force(&st, false))
                 });
