@@ -583,7 +583,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
         _ => (None, None),
     };
     let (mut fl, mut fl_err);
-    let closure;
+    let mut closure;
     match (&opts.auto, sol.status == Status::Converged) {
         (Some(a), true) => {
             // The floor below which RK45's own error hides the trivial multiplier's.
@@ -628,7 +628,6 @@ fn finish_inner<D: Dynamics + ?Sized>(
             (fl, fl_err) = run_floquet(&sol);
         }
     }
-    let mut closure = closure;
     if let (true, Some(fo)) = (bounded, &opts.floquet) {
         if let Some(f) = fl.take() {
             let b = bound_verdict(p, sol, f, closure, fo, opts);
@@ -723,52 +722,13 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
     opts: &PeriodicOptions,
 ) -> Bounded {
     let (mut sol, mut fl, mut closure) = (sol, fl, closure);
-    let ndof = p.ndof();
-    loop {
-        let n = sol.n_harm;
-        let m = finer_harmonics(n);
-        let undetermined = |mut fl: Floquet, why: String| {
-            fl.stability = Stability::Undetermined;
-            (fl, Some(why))
-        };
-        if ndof * (2 * m + 1) + 1 > MAX_HB_UNKNOWNS {
-            let (floquet, unbounded) = undetermined(
-                fl,
-                format!("no error bound: a series with {m} harmonics exceeds the size bound"),
-            );
-            return Bounded {
-                sol,
-                floquet,
-                closure,
-                unbounded,
-            };
-        }
-        let fine = solve(
-            p,
-            &sol,
-            &HbOptions {
-                n_harm: m,
-                ..opts.hb.clone()
-            },
-        );
-        let ff = if fine.status == Status::Converged && fine.winding == sol.winding {
-            floquet(p, &fine, fo).map_err(|e| e.to_string())
-        } else {
-            Err(format!("status {}", fine.status.as_str()))
-        };
-        let ff = match ff {
-            Ok(ff) => ff,
-            Err(e) => {
-                let (floquet, unbounded) = undetermined(
-                    fl,
-                    format!("no error bound: the series with {m} harmonics failed ({e})"),
-                );
-                return Bounded {
-                    sol,
-                    floquet,
-                    closure,
-                    unbounded,
-                };
+    let unbounded = loop {
+        let m = finer_harmonics(sol.n_harm);
+        let (fine, ff) = match finer_floquet(p, &sol, m, fo, opts) {
+            Ok(pair) => pair,
+            Err(why) => {
+                fl.stability = Stability::Undetermined;
+                break Some(format!("no error bound: {why}"));
             }
         };
         let own = ff.trivial_error.max(ff.method_error.unwrap_or(0.0));
@@ -786,25 +746,52 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
         // than `max_trivial`: both shrink with the truncation error), more harmonics may
         // settle it; a modulus at 1 to round-off stops at `BOUND_N_MAX`.
         if fl.stability != Stability::Undetermined || m > BOUND_N_MAX || !opts.refine_verdicts {
-            return Bounded {
-                sol,
-                floquet: fl,
-                closure,
-                unbounded: None,
-            };
+            break None;
         }
         let mut fine = fine;
         let fine_closure = certify(p, &mut fine, opts);
         if fine.status != Status::Converged {
-            return Bounded {
-                sol,
-                floquet: fl,
-                closure,
-                unbounded: None,
-            };
+            break None;
         }
         (sol, fl, closure) = (fine, ff, fine_closure);
+    };
+    Bounded {
+        sol,
+        floquet: fl,
+        closure,
+        unbounded,
     }
+}
+
+/// [`bound_verdict`]'s finer series with `m` harmonics, solved from `sol`, and its
+/// multipliers; why not, if it exceeds the size bound, fails to converge (or converges
+/// to another winding) or its multipliers cannot be computed.
+fn finer_floquet<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: &HbSolution,
+    m: usize,
+    fo: &FloquetOptions,
+    opts: &PeriodicOptions,
+) -> std::result::Result<(HbSolution, Floquet), String> {
+    if p.ndof() * (2 * m + 1) + 1 > MAX_HB_UNKNOWNS {
+        return Err(format!(
+            "a series with {m} harmonics exceeds the size bound"
+        ));
+    }
+    let hb = HbOptions {
+        n_harm: m,
+        ..opts.hb.clone()
+    };
+    let fine = solve(p, sol, &hb);
+    if fine.status != Status::Converged || fine.winding != sol.winding {
+        return Err(format!(
+            "the series with {m} harmonics failed (status {})",
+            fine.status.as_str()
+        ));
+    }
+    let ff =
+        floquet(p, &fine, fo).map_err(|e| format!("the series with {m} harmonics failed ({e})"))?;
+    Ok((fine, ff))
 }
 
 /// Whether Hill's cross-check is wanted beside the monodromy result `fl` (`None` if the

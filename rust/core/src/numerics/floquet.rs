@@ -455,14 +455,14 @@ pub fn bounded_verdict(
     separation_error: Option<f64>,
     modulus_error: f64,
 ) -> Stability {
-    let margin = opts
-        .margin
-        .max(method_error.unwrap_or(0.0))
-        .max(modulus_error);
     // A NaN error is no bound.
     if modulus_error.is_nan() {
         return Stability::Undetermined;
     }
+    let margin = opts
+        .margin
+        .max(method_error.unwrap_or(0.0))
+        .max(modulus_error);
     match separation_error {
         Some(e) if !(e <= opts.max_trivial) => Stability::Undetermined,
         _ => judge(ev, margin, opts.max_trivial).stability,
