@@ -131,8 +131,10 @@ class Bearing:
                 f"{type(self.grooves).__name__}",
                 allowed="Grooves or None", value=self.grooves,
             )
+        narrow = self.model == "narrow_groove"
         if self.grid is None:
-            object.__setattr__(self, "grid", _grid(*default_grid(self.grooves, self.model)))
+            object.__setattr__(self, "grid",
+                               _grid(*default_grid(self.grooves, self.model), narrow))
         else:
             g = _check.sequence("grid", self.grid)
             if len(g) != 2:
@@ -140,30 +142,24 @@ class Bearing:
                     "grid", f"grid must be (n_theta, n_zeta), got {self.grid!r:.60}",
                     allowed="two integers",
                 )
-            object.__setattr__(self, "grid", _grid(g[0], g[1]))
-        nt, nz = self.grid or (0, 0)
-        if self.model == "narrow_groove" and nt * nz > _check.MAX_NARROW_GROOVE_CELLS:
-            raise ParameterError(
-                "grid.n_theta" if nt >= nz else "grid.n_zeta",
-                f"the narrow-groove grid ({nt}, {nz}) has {nt * nz} cells, at most "
-                f"{_check.MAX_NARROW_GROOVE_CELLS} (n_theta * n_zeta)",
-                allowed=f"n_theta * n_zeta <= {_check.MAX_NARROW_GROOVE_CELLS}",
-                value=(nt, nz))
+            object.__setattr__(self, "grid", _grid(g[0], g[1], narrow))
         _validate(self)
 
 
-def _grid(n_theta: Any, n_zeta: Any) -> tuple[int, int]:
+def _grid(n_theta: Any, n_zeta: Any, narrow: bool) -> tuple[int, int]:
     """A grid's cell counts, refused before any solve when one axis or the total is
-    above its bound (:data:`~ballbal._check.MAX_BEARING_CELLS` and the per-axis ones);
-    the smallest sizes are the core's to check."""
+    above its bound (:data:`~ballbal._check.MAX_BEARING_CELLS`, for the narrow-groove
+    model :data:`~ballbal._check.MAX_NARROW_GROOVE_CELLS`, and the per-axis ones); the
+    smallest sizes are the core's to check."""
     nt = _check.integer("grid.n_theta", n_theta, 0, _check.MAX_BEARING_THETA)
     nz = _check.integer("grid.n_zeta", n_zeta, 0, _check.MAX_BEARING_ZETA)
-    if nt * nz > _check.MAX_BEARING_CELLS:
+    most = _check.MAX_NARROW_GROOVE_CELLS if narrow else _check.MAX_BEARING_CELLS
+    if nt * nz > most:
         name = "grid.n_theta" if nt >= nz else "grid.n_zeta"
+        what = "the narrow-groove grid" if narrow else "the grid"
         raise ParameterError(
-            name, f"the grid ({nt}, {nz}) has {nt * nz} cells, at most "
-            f"{_check.MAX_BEARING_CELLS} (n_theta * n_zeta)",
-            allowed=f"n_theta * n_zeta <= {_check.MAX_BEARING_CELLS}", value=(nt, nz))
+            name, f"{what} ({nt}, {nz}) has {nt * nz} cells, at most {most} "
+            "(n_theta * n_zeta)", allowed=f"n_theta * n_zeta <= {most}", value=(nt, nz))
     return nt, nz
 
 
