@@ -34,6 +34,18 @@ def flow(b, y0, T, rtol=FLOW_RTOL, atol=FLOW_ATOL):
     return r.y[:, -1]
 
 
+def central_jacobian(F: Callable[[np.ndarray], np.ndarray], z: np.ndarray,
+                     h: float) -> np.ndarray:
+    """The Jacobian of ``F`` at ``z`` by central differences, column ``j`` with the step
+    ``h * max(1, |z_j|)``."""
+    cols = []
+    for j in range(len(z)):
+        e = np.zeros(len(z))
+        e[j] = h * max(1.0, abs(z[j]))
+        cols.append((F(z + e) - F(z - e)) / (2 * e[j]))
+    return np.column_stack(cols)
+
+
 def newton(F: Callable[[np.ndarray], np.ndarray], z0: Sequence[float] | np.ndarray,
            tol: float = SHOOT_TOL, h: float = 1e-6, max_iter: int = 12) -> np.ndarray:
     """A zero of ``F`` near ``z0``: Newton with a central-difference Jacobian (step ``h``:
@@ -47,11 +59,7 @@ def newton(F: Callable[[np.ndarray], np.ndarray], z0: Sequence[float] | np.ndarr
     for _ in range(max_iter):
         if best <= tol:
             return z
-        J = np.empty((len(r), len(z)))
-        for j in range(len(z)):
-            e = np.zeros(len(z))
-            e[j] = h * max(1.0, abs(z[j]))
-            J[:, j] = (F(z + e) - F(z - e)) / (2 * e[j])
+        J = central_jacobian(F, z, h)
         step = np.linalg.lstsq(J, -r, rcond=None)[0]
         lam = 1.0
         while True:

@@ -26,7 +26,7 @@ from scipy.integrate import solve_ivp
 import ballbal
 
 from reference import rhs
-from shooting import FLOW_ATOL, FLOW_RTOL, shoot
+from shooting import FLOW_ATOL, FLOW_RTOL, central_jacobian, shoot
 
 # (balancer, pattern, Omega bracket of a stability change, phase index of the shooting)
 FAMILIES = {
@@ -77,16 +77,6 @@ def _crossing(b, pattern, lo, hi):
     return lo, (fp - fm) / (2 * h), s
 
 
-def _jacobian(b, y, h=1e-6):
-    n = len(y)
-    J = np.empty((n, n))
-    for j in range(n):
-        e = np.zeros(n)
-        e[j] = h * max(1.0, abs(y[j]))
-        J[:, j] = (rhs(b, 0.0, y + e) - rhs(b, 0.0, y - e)) / (2 * e[j])
-    return J
-
-
 def _multipliers(b, y0, T):
     """Monodromy by the variational equations along the orbit (orbit and fundamental
     matrix integrated together)."""
@@ -95,7 +85,8 @@ def _multipliers(b, y0, T):
     def f(t, z):
         y = z[:n]
         phi = z[n:].reshape(n, n)
-        return np.concatenate([rhs(b, t, y), (_jacobian(b, y) @ phi).ravel()])
+        J = central_jacobian(lambda s: rhs(b, 0.0, s), y, 1e-6)
+        return np.concatenate([rhs(b, t, y), (J @ phi).ravel()])
 
     z0 = np.concatenate([y0, np.eye(n).ravel()])
     r = solve_ivp(f, (0.0, T), z0, method="DOP853", rtol=FLOW_RTOL, atol=FLOW_ATOL)
