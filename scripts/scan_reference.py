@@ -8,7 +8,9 @@ delta 50, N 3, R-R / O-O / R-O) for all nine zeta x zeta_b maps of the thesis (z
 {0.02, 0.05, 0.1}, zeta_b in {0.05, 0.1, 0.2}), and the fine grid (101 x 111, step 0.01,
 R-R, N 3, zeta = zeta_b = 0.05).
 
-``compare`` checks, per table, on the rows keyed by (grid point, type, solution):
+``compare`` checks, per table, on the rows keyed by (grid point, type, orbit): a new
+row is paired with the reference row of its point and type whose omega is nearest
+(within ``MATCH_TOL``), since new orbits renumber the others:
 
 * no solution lost: every key converged in the reference is converged now; new ones
   (solutions a scan used to miss) are listed, allowed;
@@ -49,6 +51,9 @@ FINE = {"Omega": (1.0, 2.0, 0.01), "eta": (0.4, 1.5, 0.01)}
 ZETAS, ZETA_BS = (0.02, 0.05, 0.1), (0.05, 0.1, 0.2)
 PATTERNS = ("R-R", "O-O", "R-O")
 OMEGA_TOL, MULT_TOL = 1e-8, 1e-5
+# Same orbit in both tables: omega within this (relative; a row the bound refined to
+# more harmonics moves by its truncation error, below 1e-4 on the thesis grids).
+MATCH_TOL = 1e-4
 KEY = ["Omega", "eta", "type", "solution"]
 STILL_TAIL = 1e-12
 
@@ -91,13 +96,40 @@ def _renumbered(df: pl.DataFrame) -> pl.DataFrame:
         .cast(pl.Int64).alias("solution"))
 
 
+def _matched(rc: pl.DataFrame, nc: pl.DataFrame) -> pl.DataFrame:
+    """``nc`` with each row's ``solution`` replaced by the number of the reference row
+    of its point and type that is the same orbit (nearest omega, within ``MATCH_TOL``
+    relative, one to one), or by a number above every reference one if none is: new
+    orbits of a type renumber the others (rows are ordered by omega), so the solution
+    number alone would pair different orbits."""
+    groups = ["Omega", "eta", "type"]
+    ref_of: dict[tuple, list[tuple[int, float]]] = {}
+    for r in rc.select([*groups, "solution", "omega"]).iter_rows():
+        ref_of.setdefault(r[:3], []).append((r[3], r[4]))
+    numbers = []
+    fresh = 1000
+    taken: dict[tuple, set[int]] = {}
+    for r in nc.select([*groups, "omega"]).iter_rows():
+        g, w = r[:3], r[3]
+        used = taken.setdefault(g, set())
+        best = min(((abs(w - wr), k) for k, wr in ref_of.get(g, []) if k not in used),
+                   default=None)
+        if best is not None and best[0] <= MATCH_TOL * max(1.0, abs(w)):
+            used.add(best[1])
+            numbers.append(best[1])
+        else:
+            numbers.append(fresh)
+            fresh += 1
+    return nc.with_columns(pl.Series("solution", numbers, dtype=nc["solution"].dtype))
+
+
 def compare_table(name: str, ref: pl.DataFrame, new: pl.DataFrame) -> tuple[bool, str]:
     ref, new = _keyed(ref), _keyed(new)
     refused = ref.filter(_still())
     still_new = new.filter(_still())
     ref = _renumbered(ref.filter(~_still()))
     rc = ref.filter(pl.col("status") == "converged")
-    nc = new.filter(pl.col("status") == "converged")
+    nc = _matched(rc, new.filter(pl.col("status") == "converged"))
     lost = rc.join(nc, on=KEY, how="anti")
     gained = nc.join(rc, on=KEY, how="anti")
     both = rc.join(nc, on=KEY, how="inner", suffix="_new")
