@@ -134,7 +134,8 @@ def test_periodic_and_scan_share_the_solution_schema():
         harmonic_balance=o.harmonic_balance, floquet=o.floquet, guess=o.guess))
     names = {"status", "omega", "stability", "max_modulus", "trivial_error", "residual",
              "tail", "closure", "separation_error", "pivot_ratio", "iterations",
-             "floquet_steps", "N", "target_met", "hill_stability", "verdicts_disagree"}
+             "floquet_steps", "N", "target_met", "hill_stability", "verdicts_disagree",
+             "omega_error", "modulus_error", "modulus_error_source"}
     assert names <= set(df.columns)
     for n in names:
         assert hasattr(s, n), n

@@ -12,7 +12,8 @@ from 1 measures its accuracy, which must be far below the point's ``|mu| - 1``.
 ballbal's verdict at its default N = 3 (``periodic(b, pattern, guess=...)`` on that orbit)
 must be that truth or
 ``undetermined``; ``stable`` for an unstable orbit was the defect (issue 31: 18 wrong
-rows at N = 3, every certificate passing).
+rows at N = 3, every certificate passing). The frequency's bound ``omega_error``, from
+the same comparison of two truncations, must hold against the shot period.
 """
 
 from __future__ import annotations
@@ -94,13 +95,15 @@ def _multipliers(b, y0, T):
     return ev[np.argsort(-np.abs(ev))]
 
 
-def _truth(b, pattern, sol, phase_index):
+def _truth(b, pattern, sol, phase_index, with_omega=False):
     winding = [0, 0] + [-1 if c == "R" else 0 for c in pattern.split("-")]
     y0, T = shoot(b, sol.state(0.0), sol.period, winding, phase_index)
     ev = _multipliers(b, y0, T)
     k = int(np.argmin(np.abs(ev - 1.0)))
     accuracy = float(abs(ev[k] - 1.0))
     lead = float(np.max(np.abs(np.delete(ev, k))))
+    if with_omega:
+        return lead, accuracy, 2 * np.pi / T
     return lead, accuracy
 
 
@@ -115,7 +118,7 @@ def test_verdicts_near_a_stability_change_are_right_or_undetermined(family: str)
             om = om_c + sign * off / slope
             bb = replace(b, Omega=om)
             ref = ballbal.periodic(bb, pattern, N=12, guess=s_c)
-            lead, accuracy = _truth(bb, pattern, ref, phase_index)
+            lead, accuracy, omega = _truth(bb, pattern, ref, phase_index, with_omega=True)
             # The independent monodromy must resolve the point: its own error (the trivial
             # multiplier's) far below the leading modulus' distance from 1.
             assert accuracy < 0.05 * abs(lead - 1.0), (om, lead, accuracy)
@@ -136,6 +139,11 @@ def test_verdicts_near_a_stability_change_are_right_or_undetermined(family: str)
                 assert got.modulus_error is not None
                 assert abs(got.max_modulus - lead) <= got.modulus_error, (
                     om, got.max_modulus, lead, got.modulus_error)
+            # So does the frequency's, from the same comparison (the shot period is
+            # right to ~1e-9 relative: SHOOT_TOL).
+            assert got.omega_error is not None
+            assert abs(got.omega - omega) <= got.omega_error + 1e-8 * omega, (
+                om, got.N, got.omega, omega, got.omega_error)
     assert not wrong, wrong
     assert judged >= 5, judged
     # Rarely undetermined: at 1e-3 and 1e-4 from 1 the refinement settles every verdict.

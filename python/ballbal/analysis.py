@@ -284,6 +284,10 @@ class PeriodicSolution:
     modulus_error: float | None = None
     #: Which series the bound compares: ``"N 3 vs 5"``.
     modulus_error_source: str | None = None
+    #: Bound on the error of ``omega`` from the same comparison (twice the two series'
+    #: frequencies' difference); ``None`` without it. Near the infinite-period end of a
+    #: rotating branch the trivial multiplier's error says little about the frequency's.
+    omega_error: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
     @property
@@ -520,7 +524,8 @@ def periodic(
       Where it is not, the finer series becomes the result (``N`` says so) and is
       checked the same way, up to ``N = 27``; then, or where no finer series converges,
       the verdict is ``undetermined``. ``modulus_error_source`` names the two series
-      (``"N 5 vs 8"``).
+      (``"N 5 vs 8"``). The same comparison bounds the frequency: ``omega_error`` is
+      twice the two series' frequencies' difference.
 
     A ``not_closed``, ``truncated`` or ``equilibrium`` result keeps ``coeffs`` (and,
     but for an equilibrium, ``omega``) for inspection but has no multipliers and no
@@ -581,7 +586,8 @@ def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:
         tail=d["tail"], target_met=d["target_met"], hill_multipliers=hill_m,
         hill_stability=d["hill_stability"], verdicts_disagree=d["verdicts_disagree"],
         modulus_error=d["modulus_error"], modulus_error_source=d["modulus_error_source"],
-        balancer=model, status=d["status"], type=d["type"], omega=d["omega"],
+        omega_error=d["omega_error"], balancer=model, status=d["status"], type=d["type"],
+        omega=d["omega"],
         coeffs=d["coeffs"], winding=d["winding"], N=d["N"], samples=d["samples"],
         residual=d["residual"], iterations=d["iterations"], multipliers=mult,
         stability=d["stability"], max_modulus=d["max_modulus"],

@@ -57,8 +57,8 @@ GridSpec = Sequence[float] | np.ndarray | tuple[float, float, float] | str
 MULTIPLIER = pl.List(pl.Struct({"re": pl.Float64, "im": pl.Float64}))
 _SCHEMA: dict[str, Any] = {
     "type": pl.Utf8, "solution": pl.Int64, "status": pl.Utf8, "omega": pl.Float64,
-    "stability": pl.Utf8, "max_modulus": pl.Float64, "modulus_error": pl.Float64,
-    "modulus_error_source": pl.Utf8, "trivial_error": pl.Float64,
+    "omega_error": pl.Float64, "stability": pl.Utf8, "max_modulus": pl.Float64,
+    "modulus_error": pl.Float64, "modulus_error_source": pl.Utf8, "trivial_error": pl.Float64,
     "multipliers": MULTIPLIER, "residual": pl.Float64, "tail": pl.Float64,
     "closure": pl.Float64, "separation_error": pl.Float64,
     "pivot_ratio": pl.Float64, "iterations": pl.Int64, "floquet_steps": pl.Int64,

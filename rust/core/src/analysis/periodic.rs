@@ -324,6 +324,11 @@ pub struct Periodic {
     /// The series' tail relative to the support's motion ([`HbSolution::tail_ratio_on`]
     /// the model's layout).
     pub tail: f64,
+    /// A bound on the error of `sol.omega`, from the series [`bound_verdict`] compares
+    /// with (twice the two frequencies' difference, as the modulus' bound); `None`
+    /// without that comparison. Near the infinite-period end of a rotating branch the
+    /// trivial multiplier's error says little about the frequency's, this does.
+    pub omega_error: Option<f64>,
 }
 
 impl Periodic {
@@ -584,6 +589,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
     };
     let (mut fl, mut fl_err);
     let mut closure;
+    let mut omega_error = None;
     match (&opts.auto, sol.status == Status::Converged) {
         (Some(a), true) => {
             // The floor below which RK45's own error hides the trivial multiplier's.
@@ -631,7 +637,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
     if let (true, Some(fo)) = (bounded, &opts.floquet) {
         if let Some(f) = fl.take() {
             let b = bound_verdict(p, sol, f, closure, fo, opts);
-            (sol, fl, closure) = (b.sol, Some(b.floquet), b.closure);
+            (sol, fl, closure, omega_error) = (b.sol, Some(b.floquet), b.closure, b.omega_error);
             if let Some(why) = b.unbounded {
                 fl_err.get_or_insert(why);
             }
@@ -670,6 +676,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
         target_met,
         hill,
         tail,
+        omega_error,
     }
 }
 
@@ -692,6 +699,8 @@ pub struct Bounded {
     pub sol: HbSolution,
     pub floquet: Floquet,
     pub closure: Option<f64>,
+    /// Twice `sol.omega`'s difference from the finer series' (as [`Periodic::omega_error`]).
+    pub omega_error: Option<f64>,
     /// Why no bound could be computed (the verdict is then undetermined).
     pub unbounded: Option<String>,
 }
@@ -722,6 +731,7 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
     opts: &PeriodicOptions,
 ) -> Bounded {
     let (mut sol, mut fl, mut closure) = (sol, fl, closure);
+    let mut omega_error = None;
     let unbounded = loop {
         let m = finer_harmonics(sol.n_harm);
         let (fine, ff) = match finer_floquet(p, &sol, m, fo, opts) {
@@ -733,6 +743,7 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
         };
         let own = ff.trivial_error.max(ff.method_error.unwrap_or(0.0));
         let err = 2.0 * (fl.max_modulus - ff.max_modulus).abs() + own;
+        omega_error = Some(2.0 * (sol.omega - fine.omega).abs());
         fl.modulus_error = Some(err);
         fl.modulus_error_against = Some(m);
         fl.stability = bounded_verdict(
@@ -759,6 +770,7 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
         sol,
         floquet: fl,
         closure,
+        omega_error,
         unbounded,
     }
 }

@@ -21,9 +21,10 @@ pub enum Cell {
 /// The schema's names, in the order of [`solution_cells`]. `pivot_ratio` is the last
 /// Newton matrix's largest over smallest LU pivot, a lower bound of its condition
 /// number (`PeriodicSolution.condition` before; stored scan tables use this name).
-pub const SOLUTION_FIELDS: [&str; 21] = [
+pub const SOLUTION_FIELDS: [&str; 22] = [
     "status",
     "omega",
+    "omega_error",
     "stability",
     "max_modulus",
     "modulus_error",
@@ -49,7 +50,7 @@ pub const SOLUTION_FIELDS: [&str; 21] = [
 /// but failed a certificate (`not_closed`, `truncated`) keeps its `omega` for
 /// inspection; its status says why it is not a result. An `equilibrium` has no `omega`
 /// (any value solves its equations).
-pub fn solution_cells(r: &Periodic) -> [Cell; 21] {
+pub fn solution_cells(r: &Periodic) -> [Cell; 22] {
     let s = &r.sol;
     let fl = r.floquet.as_ref();
     let ok = matches!(
@@ -60,6 +61,7 @@ pub fn solution_cells(r: &Periodic) -> [Cell; 21] {
     [
         Cell::S(Some(s.status.as_str())),
         Cell::F(ok.then_some(s.omega)),
+        Cell::F(r.omega_error),
         Cell::S(Some(fl.map_or("undetermined", |f| f.stability.as_str()))),
         Cell::F(fl.map(|f| f.max_modulus)),
         Cell::F(fl.and_then(|f| f.modulus_error)),
@@ -87,13 +89,13 @@ pub fn solution_cells(r: &Periodic) -> [Cell; 21] {
 
 /// The schema's values where no solution was found (a scan row `not_found`, with the
 /// harmonics it was asked for).
-pub fn missing_cells(n_harm: usize) -> [Cell; 21] {
-    let mut c: [Cell; 21] = std::array::from_fn(|_| Cell::F(None));
+pub fn missing_cells(n_harm: usize) -> [Cell; 22] {
+    let mut c: [Cell; 22] = std::array::from_fn(|_| Cell::F(None));
     c[0] = Cell::S(Some("not_found"));
     c[N_FIELD] = Cell::U(Some(n_harm));
     c
 }
 
 /// The position of `N` in [`SOLUTION_FIELDS`].
-const N_FIELD: usize = 17;
+const N_FIELD: usize = 18;
 const _: () = assert!(matches!(SOLUTION_FIELDS[N_FIELD].as_bytes(), b"N"));
