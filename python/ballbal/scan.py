@@ -669,9 +669,15 @@ def scan(  # noqa: E302 - overloads above
     The grid is cut along its last axis into blocks of ``block`` values (default: about
     1024 points, fixed by the grid's shape). Each block is solved in the Rust core on
     ``threads`` cores with the GIL released: simulated starts at ``seeds`` points per
-    axis (and, for O-types, along the perfect balance's stability boundary) are
-    classified by rotation pattern, then every solution is continued to its grid
-    neighbours until nothing new appears. Continuation does not cross block edges, so
+    axis (and along the perfect balance's stability boundary) are classified by
+    rotation pattern; for types in which some balls rotate and others rest on the disk
+    (R-O, O-R), the ``seeds`` points are also simulated from whirl starts (rotating
+    balls turning at the natural frequency in the ground frame, the disk on its resonant
+    response to them), since such stable orbits are reached from rest only from a
+    sliver of starts; then every solution is continued to its grid neighbours until
+    nothing new appears. ``origin`` says how a row's solution was reached: ``seed``
+    (simulated start at that point), ``continuation`` (from a neighbour), ``none`` (no
+    solution). Continuation does not cross block edges, so
     ``block`` is a numerical option (smaller blocks find fewer continued solutions);
     the table depends on it and on nothing else of the layout. Coexisting solutions of
     one type get separate rows (``solution`` 0, 1, ...); a point and type with none gets

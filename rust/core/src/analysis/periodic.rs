@@ -421,9 +421,10 @@ pub fn periodic_wound<D: Dynamics + ?Sized>(
     finish(p, sol, opts)
 }
 
-/// [`periodic_wound`], and for one ball, when the usual starts find no orbit, also from
-/// [`whirl_starts`]: the starts of `periodic()` (the Python facade) and of homotopy.
-/// For two or more balls, or with a guess, it is [`periodic_wound`] itself.
+/// [`periodic_wound`], and when the usual starts find no orbit, also from
+/// [`whirl_starts`] (one ball) or [`pattern_whirl_starts`] (a pattern of rotating and
+/// resting balls): the starts of `periodic()` (the Python facade) and of homotopy.
+/// With a guess, or for other patterns, it is [`periodic_wound`] itself.
 pub fn periodic_searched<D: Parametric>(
     p: &D,
     ball_winding: &[f64],
@@ -438,7 +439,8 @@ pub fn periodic_searched<D: Parametric>(
         return first;
     }
     let rotating: Vec<bool> = ball_winding.iter().map(|w| *w != 0.0).collect();
-    for y0 in whirl_starts(p) {
+    let whirling = pattern_whirl_starts(p, &rotating);
+    for y0 in whirl_starts(p).into_iter().chain(whirling) {
         if crate::cancel::cancelled() {
             break;
         }
@@ -500,6 +502,86 @@ pub fn whirl_starts<D: Parametric>(p: &D) -> Vec<Vec<f64>> {
             y[d] = dz.re;
             y[d + 1] = dz.im;
             y[d + o] = s - om;
+            out.push(y);
+        }
+    }
+    out
+}
+
+/// Simulation starts for a pattern in which some balls rotate and others do not, built
+/// as [`whirl_starts`] builds them for one ball: the stable R-O orbits of the thesis'
+/// maps have the rotating ball turning in the ground frame just below the natural
+/// frequency (omega close to `Omega - 1`) with the disk whirling at resonant amplitude
+/// (|Z| about 6 at `zeta 0.02`), and no start at rest reaches them (of 36 such starts at
+/// four points of the map `mu 0.2, zeta 0.02, zeta_b 0.1, delta 50`, 3 to 12 settled on
+/// the stable R-O, none at `s = 0.9`; every point was reached from `s = 1`). Each start
+/// puts the first rotating ball at angle `beta` (four angles) turning at ground rate
+/// `s = 1` (the natural frequency), the other rotating balls
+/// spread evenly behind it at the same rate, the oscillating balls at rest on the disk a
+/// quarter turn either side of `beta`, and the disk on the linear response to all of
+/// them and the imbalance: `mu eta_j s^2 e^(i beta_j) / (1 - s^2 + 2 i zeta s)` per
+/// rotating ball, `mu eta_j Omega^2 e^(i gamma_j) / (1 - Omega^2 + 2 i zeta Omega)` per
+/// resting one and `mu Omega^2 / (1 - Omega^2 + 2 i zeta Omega)` (ground frame at
+/// `t = 0`). Empty unless the pattern mixes rotating and resting balls, without damping
+/// (`zeta = 0`), and for models without `mu`, `zeta` and per-ball `eta` or with more
+/// coordinates than the disk's two and the balls'.
+pub fn pattern_whirl_starts<D: Parametric>(p: &D, rotating: &[bool]) -> Vec<Vec<f64>> {
+    use nalgebra::Complex;
+    let o = p.first_ball();
+    let d = p.ndof();
+    let n = rotating.len();
+    if o != 2 || d != o + n || rotating.iter().all(|r| *r) || !rotating.iter().any(|r| *r) {
+        return vec![];
+    }
+    let (Ok(mu), Ok(z)) = (p.param_value("mu"), p.param_value("zeta")) else {
+        return vec![];
+    };
+    if z <= 0.0 {
+        // Undamped, the resonant response has no finite amplitude to start from.
+        return vec![];
+    }
+    let Ok(eta) = (0..n)
+        .map(|j| p.param_value(&format!("eta[{j}]")))
+        .collect::<crate::Result<Vec<f64>>>()
+    else {
+        return vec![];
+    };
+    let om = p.base_spin();
+    let i = Complex::new(0.0, 1.0);
+    let spin_gain = om * om / (1.0 - om * om + 2.0 * i * z * om);
+    let n_rot = rotating.iter().filter(|r| **r).count();
+    let s = 1.0;
+    let mut out = vec![];
+    let whirl_gain = s * s / (1.0 - s * s + 2.0 * i * z * s);
+    for k in 0..4 {
+        let beta = -PI + (k as f64 + 0.1) * PI / 2.0;
+        for side in [0.5, -0.5] {
+            let mut y = vec![0.0; 2 * d];
+            // The disk's response to what turns with it (imbalance, resting balls)
+            // and to what whirls at `s` (rotating balls).
+            let (mut with_disk, mut whirling) = (mu * spin_gain, Complex::new(0.0, 0.0));
+            let mut kr = 0;
+            for j in 0..n {
+                let angle = if rotating[j] {
+                    kr += 1;
+                    let a = beta + 2.0 * PI * (kr - 1) as f64 / n_rot as f64;
+                    whirling += mu * eta[j] * whirl_gain * Complex::from_polar(1.0, a);
+                    y[d + o + j] = s - om;
+                    a
+                } else {
+                    let a = beta + side * PI;
+                    with_disk += mu * eta[j] * spin_gain * Complex::from_polar(1.0, a);
+                    a
+                };
+                y[o + j] = angle;
+            }
+            let zz = with_disk + whirling;
+            // rotating-frame velocity: the ground velocity less the frame's turn
+            let dz = i * om * with_disk + i * s * whirling - i * om * zz;
+            y[0] = zz.re;
+            y[1] = zz.im;
+            y[d] = dz.re;
+            y[d + 1] = dz.im;
             out.push(y);
         }
     }

@@ -193,10 +193,12 @@ fn scan_chunk<D: Family>(
     check()?;
 
     let t = std::time::Instant::now();
-    let (tasks, starts) = seeding::seed_tasks(spec, &geo, &range, &pb);
+    let (tasks, starts, lattice) = seeding::seed_tasks(spec, &geo, &range, &pb);
+    let whirls = seeding::whirl_tasks(spec, &lattice);
     profile::serial(profile::GLUE, t.elapsed());
     // Its parallel steps record themselves.
-    let (mut sols, frontier) = seeding::run_seeds(spec, &params, &tasks, &starts, &pb, cancel);
+    let (mut sols, frontier) =
+        seeding::run_seeds(spec, &params, &tasks, &starts, &whirls, &pb, cancel);
     add_stage(1, t);
     check()?;
 
@@ -209,7 +211,7 @@ fn scan_chunk<D: Family>(
     continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
     add_stage(2, t);
     let t = std::time::Instant::now();
-    let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &pb);
+    let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &whirls, &pb);
     profile::serial(profile::ROWS, t.elapsed());
     add_stage(3, t);
     Ok(rows)

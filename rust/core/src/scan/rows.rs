@@ -47,19 +47,26 @@ pub struct ScanRow {
 }
 
 /// The rows of a block: `sols` per point, `tally` of the continuation, one seed run
-/// counted per task.
+/// counted per start at rest (`tasks`), and per whirl start (`whirls`) of the row's
+/// type.
 pub(super) fn rows(
     geo: &Local,
     classes: usize,
     sols: &[Vec<Found>],
     tally: &Tally,
     tasks: &[(usize, usize)],
+    whirls: &[(usize, usize, usize)],
     pb: &[(bool, bool)],
 ) -> Vec<ScanRow> {
     let npts = geo.size();
     let mut seed_runs = vec![0usize; npts];
     for &(p, _) in tasks {
         seed_runs[p] += 1;
+    }
+    // Per (point, type), flat: `p * classes + k`.
+    let mut whirl_runs = vec![0usize; npts * classes];
+    for &(p, k, _) in whirls {
+        whirl_runs[p * classes + k] += 1;
     }
     let mut rows = vec![];
     for p in 0..npts {
@@ -73,7 +80,7 @@ pub(super) fn rows(
                 solution: None,
                 result: None,
                 origin: Origin::None,
-                attempts: tally.attempts[p][k] + seed_runs[p],
+                attempts: tally.attempts[p][k] + seed_runs[p] + whirl_runs[p * classes + k],
                 seconds: tally.fail_secs[p][k],
                 pb_exists: pb[p].0,
                 pb_stable: pb[p].1,

@@ -5,6 +5,7 @@ use super::grid::Local;
 use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
 use super::{count, profile, work, Family, Found, Origin, ScanSpec};
 use crate::analysis::attractors::{seed_guess, Capture};
+use crate::analysis::periodic::pattern_whirl_starts;
 use crate::continuation::Lattice;
 use crate::hb::{solve, HbSolution, Status};
 use crate::periodic::{finish, initial_states};
@@ -20,13 +21,14 @@ use std::time::Instant;
 /// are many of them. The tasks do not depend on which patterns were asked for, so that
 /// neither do a pattern's rows (asking for "O-O" beside "R-R" once added 54 stable R-R
 /// rows to a 91-point scan: its boundary starts settled on them). Returns the (point,
-/// start) tasks, sorted, and the starts' indices into [`initial_states`].
+/// start) tasks, sorted, the starts' indices into [`initial_states`] and the lattice's
+/// points (where [`whirl_tasks`] start mixed patterns as well).
 pub(super) fn seed_tasks<D: Family>(
     spec: &ScanSpec<'_, D>,
     geo: &Local,
     range: &Range<usize>,
     pb: &[(bool, bool)],
-) -> (Vec<(usize, usize)>, Vec<usize>) {
+) -> (Vec<(usize, usize)>, Vec<usize>, Vec<usize>) {
     let npts = geo.size();
     let dims = spec.names.len();
     let mut per_dim: Vec<Vec<usize>> = spec
@@ -60,7 +62,38 @@ pub(super) fn seed_tasks<D: Family>(
         )
         .collect();
     tasks.sort_unstable();
-    (tasks, starts)
+    (tasks, starts, seeds)
+}
+
+/// The requested patterns in which some balls rotate and others do not (R-O, O-R).
+fn mixed_patterns<D: Family>(spec: &ScanSpec<'_, D>) -> Vec<usize> {
+    (0..spec.patterns.len())
+        .filter(|&k| {
+            let r = &spec.patterns[k];
+            r.iter().any(|x| *x) && !r.iter().all(|x| *x)
+        })
+        .collect()
+}
+
+/// Whirl starts at the lattice points: for every mixed pattern, each start of
+/// [`pattern_whirl_starts`] at each point, as (point, pattern, start). Simulated like
+/// the starts at rest; a start counts only if it settles on its own pattern, so that
+/// asking for R-O adds no row of another pattern.
+pub(super) fn whirl_tasks<D: Family>(
+    spec: &ScanSpec<'_, D>,
+    lattice: &[usize],
+) -> Vec<(usize, usize, usize)> {
+    let per: Vec<(usize, usize)> = mixed_patterns(spec)
+        .into_iter()
+        .map(|k| (k, pattern_whirl_starts(spec.base, &spec.patterns[k]).len()))
+        .collect();
+    lattice
+        .iter()
+        .flat_map(|&p| {
+            per.iter()
+                .flat_map(move |&(k, n)| (0..n).map(move |j| (p, k, j)))
+        })
+        .collect()
 }
 
 /// A seed's solved series before its Floquet analysis: (point, type, series, key,
@@ -81,6 +114,7 @@ pub(super) fn run_seeds<D: Family>(
     params: &[D],
     tasks: &[(usize, usize)],
     starts: &[usize],
+    whirls: &[(usize, usize, usize)],
     pb: &[(bool, bool)],
     cancel: &AtomicBool,
 ) -> (Vec<Vec<Found>>, Vec<(usize, usize)>) {
@@ -136,7 +170,41 @@ pub(super) fn run_seeds<D: Family>(
         })
         .unzip();
     profile::step(profile::SEEDS, t.elapsed(), &times);
-    let mut cands: Vec<(usize, Candidate)> = cands.into_iter().flatten().collect();
+    let t = Instant::now();
+    let (whirl_cands, whirl_times): (Vec<Option<(usize, Candidate)>>, Vec<profile::Task>) = whirls
+        .par_iter()
+        .with_max_len(1)
+        .enumerate()
+        .map(|(j, &(p, k, start))| {
+            profile::timed(|| {
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let t = Instant::now();
+                let model = &params[p];
+                let y0 = &pattern_whirl_starts(model, &spec.patterns[k])[start];
+                let g = seed_guess(model, y0, n_harm, &spec.opts.guess, captures_of(p))?;
+                let rot: Vec<bool> = g.winding[model.layout().balls()]
+                    .iter()
+                    .map(|w| *w != 0.0)
+                    .collect();
+                if rot != spec.patterns[k] {
+                    return None;
+                }
+                count(work::SEED_SOLVE);
+                let sol = solve(model, &g, &spec.opts.hb);
+                if !accept(model, &sol, &g, spec) {
+                    return None;
+                }
+                let key = orbit_key(&sol, model.layout().support());
+                let secs = t.elapsed().as_secs_f64();
+                Some((tasks.len() + j, (p, k, sol, key, secs)))
+            })
+        })
+        .unzip();
+    profile::step(profile::SEEDS, t.elapsed(), &whirl_times);
+    let mut cands: Vec<(usize, Candidate)> =
+        cands.into_iter().chain(whirl_cands).flatten().collect();
     cands.sort_unstable_by_key(|c| c.0);
     let cands: Vec<Candidate> = cands.into_iter().map(|c| c.1).collect();
     // finished[i]: None = not analysed yet, Some(None) = refused by `finish`.

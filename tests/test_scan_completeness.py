@@ -1,0 +1,108 @@
+"""Stable R-O motions in scans, and scans whose stable rows do not depend on the grid step.
+
+Issue 31: simulation from random starts reached stable R-O orbits that the scans did not
+list (5 of 16 periodic attractors in one census, all R-O), and whether R-O appeared
+depended on the grid step (23 stable R-O rows at Omega step 0.1, none at 0.05, or the
+reverse). Starts at rest reach these orbits only from a sliver of states: the rotating
+ball turns in the ground frame just below the natural frequency, the disk whirling with
+it at resonant amplitude. Scans now also simulate whirl starts of that shape.
+
+The checks here are independent of ballbal's integrator and harmonic balance: the
+shooting code of ``tests/shooting.py`` (DOP853 on ``tests/reference.py``) and, for the
+grid-step test, the rows of two scans compared at their common points.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import polars as pl
+import pytest
+
+import ballbal
+
+from shooting import monodromy_multipliers, shoot
+
+#: The census' point (seed 31, random point 32): a stable R-O with |mu| 0.757 (omega
+#: 0.4721) that simulation from random starts reached and the three-pattern scans missed.
+CENSUS_RO = ballbal.Balancer(mu=0.243, zeta=0.0497, zeta_b=0.1378, delta=15.927,
+                             Omega=1.4647, eta=(0.9629, 1.3147))
+
+
+def _stable(df: pl.DataFrame, pattern: str) -> pl.DataFrame:
+    return df.filter((pl.col("type") == pattern) & (pl.col("stability") == "stable"))
+
+
+def test_a_one_point_scan_lists_the_census_r_o_orbit() -> None:
+    b = CENSUS_RO
+    df = ballbal.scan(b, Omega=[b.Omega], patterns=["R-R", "O-O", "R-O", "O-R"])
+    rows = _stable(df, "R-O")
+    assert rows.height == 1, df.select("type", "omega", "stability")
+    row = rows.row(0, named=True)
+    # The orbit shot independently from periodic()'s orbit of that frequency.
+    sol = ballbal.periodic(b, "R-O", N=8)
+    assert sol.converged and abs(sol.omega - row["omega"]) < 1e-4
+    y0, T = shoot(b, sol.state(0.0), sol.period, [0, 0, -1, 0], 2)
+    omega = 2 * np.pi / T
+    ev = monodromy_multipliers(b, y0, T)
+    trivial = int(np.argmin(np.abs(ev - 1.0)))
+    lead = float(np.max(np.abs(np.delete(ev, trivial))))
+    assert abs(ev[trivial] - 1.0) < 1e-4
+    # Stable by a wide margin, as the census measured (0.757), and the row's verdict
+    # bound and frequency bound hold.
+    assert lead < 0.8
+    assert abs(row["max_modulus"] - lead) <= row["modulus_error"] + 1e-4
+    assert abs(row["omega"] - omega) <= row["omega_error"] + 1e-8
+
+
+def test_periodic_finds_the_stable_r_o_that_no_start_at_rest_reaches() -> None:
+    # mu 0.2, zeta 0.02, zeta_b 0.1, delta 50 (the issue's first map), Omega 1.4, eta 1.4:
+    # every start at rest settles on the perfect balance or an R-R; periodic() used to
+    # answer no_guess. Its orbit is checked by shooting, which must close on it.
+    b = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50, Omega=1.4, eta=(1.4, 1.4))
+    sol = ballbal.periodic(b, "R-O")
+    assert sol.converged and sol.stability == "stable", (sol.status, sol.stability)
+    y0, T = shoot(b, sol.state(0.0), sol.period, [0, 0, -1, 0], 2)
+    assert abs(2 * np.pi / T - sol.omega) <= sol.omega_error + 1e-8
+    # The ball whirls at the natural frequency in the ground frame: Omega - omega near 1.
+    assert abs(b.Omega - sol.omega - 1.0) < 0.02
+
+
+GRIDS = {
+    # The issue's first map: at Omega step 0.1 no R-O at all, at 0.05 a stable region.
+    "issue_map": (ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50),
+                  (0.8, 2.0), (0.4, 1.6, 0.2)),
+    # The thesis' map with the most R-O (zeta 0.02, zeta_b 0.05).
+    "thesis_map": (ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.05, delta=50),
+                   (1.0, 2.0), (0.4, 1.5, 0.1)),
+}
+
+
+@pytest.mark.parametrize("name", sorted(GRIDS))
+def test_stable_rows_do_not_depend_on_the_grid_step(name: str) -> None:
+    b, (lo, hi), eta = GRIDS[name]
+    pats = ["R-R", "O-O", "R-O"]
+    coarse = ballbal.scan(b, patterns=pats, Omega=(lo, hi, 0.1), eta=eta)
+    fine = ballbal.scan(b, patterns=pats, Omega=(lo, hi, 0.05), eta=eta)
+
+    def stable_sets(df: pl.DataFrame) -> dict[tuple, list[tuple[str, float]]]:
+        out: dict[tuple, list[tuple[str, float]]] = {}
+        for r in df.filter(pl.col("stability") == "stable").iter_rows(named=True):
+            key = (round(r["Omega"], 6), round(r["eta"], 6))
+            out.setdefault(key, []).append((r["type"], r["omega"]))
+        return out
+
+    a = stable_sets(coarse)
+    c = {k: v for k, v in stable_sets(fine).items()
+         if k[0] in {round(x, 6) for x in coarse["Omega"].to_list()}}
+
+    def same(x: list, y: list) -> bool:
+        return len(x) == len(y) and all(
+            any(t == u and abs(w - v) < 1e-6 * max(1.0, w) for u, v in y) for t, w in x)
+
+    differ = [k for k in set(a) | set(c) if not same(a.get(k, []), c.get(k, []))]
+    assert not differ, [(k, a.get(k), c.get(k)) for k in sorted(differ)[:5]]
+    # Both grids list a stable R-O region (the issue's map had none at step 0.1), which
+    # holds the orbit shot above at Omega 1.4, eta 1.4 in the issue's map.
+    assert sum(t == "R-O" for v in a.values() for t, _ in v) >= 10
+    if name == "issue_map":
+        assert any(t == "R-O" for t, _ in a.get((1.4, 1.4), []))
