@@ -41,6 +41,14 @@ FAMILIES = {
                    "R-R", (1.3, 1.4), 2),
     "unequal_RO": (ballbal.Balancer(mu=0.25, zeta=0.08, zeta_b=0.02, delta=20, eta=(1.0, 0.8)),
                    "R-O", (1.4, 1.5), 2),
+    # Random settings (numpy default_rng(2031), parameters rounded; stability changes
+    # found by an N = 8 scan in Omega step 0.05): unequal balls, R-R regaining
+    # stability between Omega 1.6 and 1.65; equal balls, R-O gaining it between 1.4 and
+    # 1.45.
+    "random_RR": (ballbal.Balancer(mu=0.357, zeta=0.076, zeta_b=0.163, delta=11.7,
+                                   eta=(1.019, 0.865)), "R-R", (1.6, 1.65), 2),
+    "random_RO": (ballbal.Balancer(mu=0.262, zeta=0.074, zeta_b=0.035, delta=26.1,
+                                   eta=(0.906, 0.906)), "R-O", (1.4, 1.45), 2),
 }
 # The thesis maps' families (delta = 50) are left out: their stiff ball equations make
 # one shooting point take 40 s here (zeta 0.02, zeta_b 0.2, eta 1.4: R-R crosses at
@@ -61,6 +69,10 @@ def _crossing(b, pattern, lo, hi):
     d|mu|/dOmega there."""
     f_lo, s_lo = _lead(b, pattern, lo)
     f_hi, s_hi = _lead(b, pattern, hi, guess=s_lo)
+    if np.sign(f_lo) == np.sign(f_hi):
+        # The search at `lo` found another orbit of the pattern: start from `hi` instead.
+        f_hi, s_hi = _lead(b, pattern, hi)
+        f_lo, s_lo = _lead(b, pattern, lo, guess=s_hi)
     assert np.sign(f_lo) != np.sign(f_hi), (f_lo, f_hi)
     s = s_lo
     for _ in range(40):
