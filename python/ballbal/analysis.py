@@ -455,7 +455,9 @@ def periodic(
     transients, then up to ``window`` to measure the period). One ball, when no start at
     rest in the ground frame finds the pattern, is also started whirling with the support
     at its natural frequency (its rotating motion past a few tenths above the resonance
-    is reached from rest only from a sliver of ball angles). ``guess`` may be a previous
+    is reached from rest only from a sliver of ball angles); so are the rotating balls of
+    a pattern in which others rest on the disk (R-O, O-R: their stable orbits turn at
+    about the natural frequency in the ground frame, omega close to ``Omega - 1``). ``guess`` may be a previous
     solution (any N; it is truncated or padded) or ``(omega, coeffs)``. ``rtol, atol`` are
     the RK45 tolerances of the monodromy integration, ``max_steps`` its step budget (a
     longer integration ends in ``floquet_error`` and an undetermined verdict); a verdict
