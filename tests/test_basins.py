@@ -338,21 +338,24 @@ def test_periodic_starts_link_to_the_orbit_they_settle_on(omega, maps):
 
 
 def test_a_start_unsettled_at_t_end_is_extended_and_linked():
-    # (b) At Omega 1.2 a separated start is still in its transient at t_end = 200: with
-    # no extension it is not settled (or has no regular period) and is not linked; with
-    # extensions it is simulated on until its two-turn period repeats and is linked to
-    # the (-2, -2) orbit, whose period the independent simulation gives.
+    # (b) At Omega 1.2 a separated start is still in its transient at t_end = 400 (its
+    # turn durations converge to their alternation over about a thousand time units):
+    # with no extension it has no regular period and is not linked; with extensions it
+    # is simulated on, 400 at a time, until its two-turn period repeats, and is linked
+    # to the (-2, -2) orbit, whose period the independent simulation gives.
     m = thesis(1.2)
     b1, b2 = [0.1309], [0.392699]
-    o = BasinOptions(window=100)
-    short = basins(m, b1=b1, b2=b2, t_end=200,
-                   options=BasinOptions(window=100, extend_factor=1)).table.row(0, named=True)
-    assert short["motion"] != "periodic" and short["orbit"] is None
-    assert short["extensions"] == 0 and short["t_stop"] <= 200
-    r = basins(m, b1=b1, b2=b2, t_end=200, options=o)
+    short = basins(m, b1=b1, b2=b2, t_end=400,
+                   options=BasinOptions(extend_factor=1)).table.row(0, named=True)
+    assert short["label"] == "separated_R-R" and short["motion"] == "quasi_periodic"
+    assert short["orbit"] is None and short["period"] is None
+    assert short["extensions"] == 0 and short["t_stop"] <= 400
+    r = basins(m, b1=b1, b2=b2, t_end=400)
     row = r.table.row(0, named=True)
-    assert row["extensions"] >= 1 and 200 < row["t_stop"] <= 8 * 200
+    assert row["extensions"] >= 1 and row["t_stop"] <= 8 * 400
+    assert row["t_stop"] == pytest.approx(400 * (row["extensions"] + 1), abs=400)
     assert row["label"] == "separated_R-R" and row["motion"] == "periodic"
+    assert (row["winding1"], row["winding2"]) == (-2, -2)
     orbit = r.orbits.row(row["orbit"], named=True)
     assert (orbit["winding1"], orbit["winding2"]) == (-2, -2)
     turns, period = _simulated_period(m, b1[0], b2[0])

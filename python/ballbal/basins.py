@@ -190,8 +190,9 @@ class Basins:
     def link(self, *, N: int = 8) -> pl.DataFrame:  # noqa: N803
         """Each class found, linked to the solution it converges to: the perfect balance
         to the ``equilibria()`` entry (omega 0 and its stability), every class with a
-        regular period (merged R-R, R-O, O-O, ...) to ``periodic()`` of its pattern,
-        solved from the series fitted to its first start's own simulated attractor.
+        regular period (merged R-R, separated R-R, R-O, O-O, ...) to ``periodic()`` of
+        its pattern and windings, solved from the series fitted to its first start's own
+        simulated attractor (each start's own orbit: :attr:`orbits`).
         Columns ``label, count, mean_rate`` (the class's mean ball rate), ``kind``,
         ``omega``, ``stability``, ``status`` (null where nothing is linked). ``N``:
         the harmonics of the fitted series and of the solves, in ``[1, 256]``."""
@@ -211,7 +212,9 @@ class Basins:
                     row.update(kind="equilibrium", omega=0.0, stability=eq[0].stability,
                                status="converged")
             elif cls["period"].null_count() < cls.height and label != "not_settled":
-                first = cls.filter(pl.col("period").is_not_null()).row(0, named=True)
+                first = cls.filter(pl.col("period").is_not_null()).sort(
+                    pl.col("motion") != "periodic" if "motion" in cls.columns else pl.lit(0),
+                    maintain_order=True).row(0, named=True)
                 sol = self._periodic_of(first, N, periodic)
                 if sol is not None:
                     row.update(kind=sol.type, omega=sol.omega, stability=sol.stability,
@@ -230,13 +233,20 @@ class Basins:
         y0[d - n:d] = balls
         y0[2 * d - n:] = -m.Omega
         o = self.options
-        got = _native.attractor_series(m, y0, N, o.t_end, max(o.window, 20 * row["period"]),
-                                       o.rtol * 1e-3, o.atol * 1e-3)
+        # Over as many turns per period as the start's windings say (two for the
+        # thesis' separated rotations), after as long as the start was simulated.
+        wind = [row.get(f"winding{i + 1}") for i in range(n)]
+        rot = None if None in wind else [w != 0 for w in wind]
+        turns = next((abs(w) for w in wind if w), 1) if rot is not None else 1
+        got = _native.attractor_series(m, y0, N, min(max(o.t_end, row.get("t_stop") or 0), 1e5),
+                                       max(o.window, 20 * row["period"]),
+                                       o.rtol * 1e-3, o.atol * 1e-3, rot, turns)
         if got is None:
             return None
         omega, coeffs, rotating = got
         pattern = "-".join("R" if r else "O" for r in rotating)
-        return periodic(m, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N)
+        return periodic(m, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N,
+                        windings=wind if rot is not None and any(rot) else None)
 
 
 class _BasinStore:

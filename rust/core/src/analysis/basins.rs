@@ -92,9 +92,9 @@ impl BasinOptions {
             "extend_factor",
             self.extend_factor,
             1.0,
-            true,
+            false,
             MAX_EXTEND_FACTOR,
-            true,
+            false,
         )?;
         Ok(())
     }
@@ -152,9 +152,6 @@ pub struct Outcome {
     /// over its last two periods, the looser test that also passes a slowly
     /// converging orbit or a weakly modulated torus).
     pub period_strict: bool,
-    /// A rotating motion without a regular period that passed the torus test (its
-    /// mean rates and largest gap steady over the window): settled, quasi-periodic.
-    pub torus: bool,
     /// How many extensions of `t_end` the start needed (see
     /// [`BasinOptions::extend_factor`]).
     pub extensions: usize,
@@ -169,15 +166,15 @@ pub struct Outcome {
 impl Outcome {
     /// Whether the motion is not settled yet and is worth simulating further: a
     /// `not_settled` label, or a moving class (rotating or oscillating) whose period
-    /// does not repeat strictly (see [`STRICT_PERIOD_TOL`]), unless it passed the torus
-    /// test after an extension already. The torus test alone is not believed at
-    /// `t_end`: on the thesis' Omega 1.2 grid it passes separated rotations still
-    /// converging to their two-turn orbit at 1000 time units.
+    /// does not repeat strictly (see [`STRICT_PERIOD_TOL`]). A torus is extended too,
+    /// up to the longest time: the torus test (steady mean rates and gap) is no proof,
+    /// on the thesis' Omega 1.2 grid it passes separated rotations still converging to
+    /// their two-turn orbit after 800 time units.
     pub fn needs_more(&self) -> bool {
         match self.label {
             Label::NotSettled => true,
             Label::Failed | Label::PerfectBalance | Label::OtherEquilibrium => false,
-            _ => !self.period_strict && !(self.torus && self.extensions > 0),
+            _ => !self.period_strict,
         }
     }
 
@@ -494,8 +491,7 @@ impl EarlyStop {
             };
             // What looks like a torus may be an orbit of several turns per period
             // still converging (the thesis' separated rotations at Omega 1.2): stop
-            // only once its period repeats; a torus runs on to `t_end`, where the final
-            // window's torus test keeps it from being extended.
+            // only once its period repeats; a torus runs on to `t_end`.
             if self.torus_runs >= TORUS_RUNS && whole.period_strict && torus_is_clear(long, o, opts)
             {
                 cand = whole;
@@ -658,6 +654,8 @@ const MAX_TURNS: usize = 4;
 pub const STRICT_PERIOD_TOL: f64 = 1e-3;
 /// Periods compared by the strict test.
 const STRICT_PERIODS: usize = 3;
+/// Largest distance from a whole number of a rotating ball's turns per period.
+const WINDING_TOL: f64 = 0.1;
 
 /// `(turns per period, period)` of a rotating ball from the times it crossed whole
 /// turns: the fewest turns `m` (up to [`MAX_TURNS`]) after which the last
@@ -767,7 +765,6 @@ fn judge<D: Dynamics + ?Sized>(
         period: None,
         windings: vec![],
         period_strict: false,
-        torus: false,
         extensions: 0,
         t_stop,
         long_label: None,
@@ -815,7 +812,6 @@ fn rest_outcome(y: &[f64], t_stop: f64, n: usize, opts: &BasinOptions) -> Outcom
         period: None,
         windings: vec![],
         period_strict: false,
-        torus: false,
         extensions: 0,
         t_stop,
         long_label: None,
@@ -864,7 +860,6 @@ fn label_window(
         period: None,
         windings: vec![],
         period_strict: false,
-        torus: false,
         extensions: 0,
         t_stop,
         long_label: None,
@@ -914,6 +909,16 @@ fn label_window(
                 period = turn_period(&c).map(|p| p.1);
             }
         }
+        // The period is the first rotating ball's; every other rotating ball must turn
+        // a whole number of times per period too (to `WINDING_TOL`, above the bias of
+        // its rate counted over whole turns rather than whole periods), else the
+        // motion does not repeat with it.
+        let strict = strict.filter(|&(_, p)| {
+            (0..n).filter(|&i| rot2[i]).all(|i| {
+                let w = rates[i].abs() * p / (2.0 * PI);
+                w.round() >= 1.0 && (w - w.round()).abs() <= WINDING_TOL
+            })
+        });
         let period_strict = strict.is_some();
         let mut windings = vec![];
         if let Some((m, p)) = strict {
@@ -958,8 +963,6 @@ fn label_window(
             (2, 1) => Label::RO,
             _ => Label::Other,
         };
-        // Without a regular period, two balls rotating apart may be on a torus.
-        let torus = !period_strict && n == 2 && n_rot == 2 && torus_is_clear(samples, o, opts);
         return Outcome {
             label,
             pattern,
@@ -968,7 +971,6 @@ fn label_window(
             period,
             windings,
             period_strict,
-            torus,
             extensions: 0,
             t_stop,
             long_label: None,
@@ -1009,7 +1011,6 @@ fn label_window(
         period,
         windings: period.map(|_| vec![0; n]).unwrap_or_default(),
         period_strict,
-        torus: false,
         extensions: 0,
         t_stop,
         long_label: None,
@@ -1088,7 +1089,7 @@ mod tests {
         let o = BasinOptions::default();
         let out = classify_start(&p, &ground_rest_start(&p, &[0.1309, 0.392699]), &o).unwrap();
         assert_eq!(out.label, Label::SeparatedRR);
-        assert!(out.period_strict && !out.torus);
+        assert!(out.period_strict);
         assert_eq!(out.windings, vec![-2, -2]);
         let per = out.period.expect("periodic");
         assert!((per - (21.8831 + 32.1102)).abs() < 1e-3 * per, "{per}");
