@@ -383,3 +383,37 @@ def test_repr_names_the_orbits(maps):
     text = repr(maps[1.2])
     assert "orbit 0: separated_R-R windings (-2, -2)" in text
     assert "<pre>" in maps[1.2]._repr_html_()
+
+
+def test_starts_of_one_class_link_to_distinct_orbits_by_period_and_rates(monkeypatch):
+    # The matching alone (no solve: each new orbit's period is its representative's):
+    # R-O starts whose periods agree to within LINK_TOL share an orbit, one 2 % off or
+    # with the other ball rotating gets its own; rests and quasi-periodic motions none.
+    from ballbal import basins as bmod
+
+    solved = []
+
+    def fake(model, r, state, options, N, d, periodic):  # noqa: N803
+        solved.append((r["b1"], r["b2"]))
+        return {k: None for k in bmod.ORBIT_SCHEMA} | {
+            "label": r["label"], "winding1": r["winding1"], "winding2": r["winding2"],
+            "count": 0}, r["period"]
+
+    monkeypatch.setattr(bmod, "_solve_orbit", fake)
+    rows = [  # (label, motion, period, rate1, rate2, winding1, winding2)
+        ("R-O", "periodic", 10.0, 2 * np.pi / 10.0, 0.0, -1, 0),
+        ("R-O", "periodic", 10.05, 2 * np.pi / 10.05, 0.001, -1, 0),  # 0.5 %: the same
+        ("R-O", "periodic", 10.2, 2 * np.pi / 10.2, 0.0, -1, 0),  # 2 %: another
+        ("R-O", "periodic", 10.0, 0.0, 2 * np.pi / 10.0, 0, -1),  # the other ball
+        ("perfect_balance", "rest", None, 0.0, 0.0, None, None),
+        ("separated_R-R", "quasi_periodic", None, 0.23, 0.23, None, None),
+        ("R-O", "periodic", 10.19, 2 * np.pi / 10.19, 0.0, -1, 0),
+    ]
+    t = pl.DataFrame(
+        [dict(zip(("label", "motion", "period", "rate1", "rate2", "winding1", "winding2"),
+                  r, strict=True)) | {"b1": float(i), "b2": 0.0} for i, r in enumerate(rows)])
+    col, orbits = bmod._link_orbits(thesis(1.2), t, [[0.0] * 8] * len(rows),
+                                    BasinOptions(), 8)
+    assert col == [0, 0, 1, 2, None, None, 1]
+    assert orbits["count"].to_list() == [2, 2, 1]
+    assert solved == [(0.0, 0.0), (2.0, 0.0), (3.0, 0.0)]

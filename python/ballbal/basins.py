@@ -638,7 +638,8 @@ def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
 
 
 def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> Any:
-    """A categorical map of the labels over the starts (matplotlib, imported here)."""
+    """A categorical map of the labels over the starts (matplotlib, imported here); the
+    legend names the orbits each class is linked to (:attr:`Basins.orbits`)."""
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
@@ -663,8 +664,14 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
     ax.set_xlabel("b1 (rad)")
     ax.set_ylabel("b2 (rad)")
     ax.set_aspect("equal")
+    def name(lab: str) -> str:
+        # the orbits a class is linked to, with their windings
+        o = result.orbits.filter(pl.col("label") == lab)
+        return lab + "".join(f"\norbit {r['orbit']}: ({r['winding1']}, {r['winding2']}), "
+                             f"{r['stability']}" for r in o.iter_rows(named=True))
+
     ax.legend(handles=[Line2D([], [], marker="s", ls="", mfc=colours[lab], mec="0.6",
-                              label=lab) for lab in present],
+                              label=name(lab)) for lab in present],
               loc="upper left", fontsize="small", framealpha=0.8)
     if title is not None:
         ax.set_title(title)

@@ -1087,7 +1087,9 @@ mod tests {
         // from a simulation at rtol 1e-10): a period of two turns, windings (-2, -2).
         let p = thesis(1.2);
         let o = BasinOptions::default();
-        let out = classify_start(&p, &ground_rest_start(&p, &[0.1309, 0.392699]), &o).unwrap();
+        // the first start of the default 12 x 12 grid
+        let start = ground_rest_start(&p, &[PI / 24.0, PI / 8.0]);
+        let out = classify_start(&p, &start, &o).unwrap();
         assert_eq!(out.label, Label::SeparatedRR);
         assert!(out.period_strict);
         assert_eq!(out.windings, vec![-2, -2]);
