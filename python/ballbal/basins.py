@@ -13,13 +13,15 @@ oscillates or they pass each other), ``R-O``, ``O-O``, ``other`` (not two balls)
 so the table does not depend on the thread count.
 
 A start whose motion is not settled after ``t_end`` (``not_settled``, or a moving class
-without a regular period that is no steady torus) is simulated further, ``t_end`` at a
-time, up to ``extend_factor * t_end`` in all (``extensions`` counts the extensions);
-what is still unsettled then keeps its label. Every periodic class is then linked to its
-orbit: the harmonic balance solved from the series fitted to a representative start's
-own motion (:func:`ballbal.analysis.periodic`, with its windings: the thesis' balls
-rotating separately take two turns per period, windings ``(-2, -2)``), each start
-pointing at it by the ``orbit`` column (see :func:`basins`).
+whose period does not repeat over its last three periods to 1e-3: a torus too, whose
+steady look at 1000 time units was, on the thesis' Omega 1.2 grid, separated rotations
+still converging) is simulated further, ``t_end`` at a time, up to ``extend_factor *
+t_end`` in all (``extensions`` counts the extensions); what is still unsettled then
+keeps its label (``motion``: ``not_settled`` or ``quasi_periodic``). Every periodic
+class is then linked to its orbit: the harmonic balance solved from the series fitted to
+a representative start's own motion (:func:`ballbal.analysis.periodic`, with its
+windings: the thesis' balls rotating separately take two turns per period, windings
+``(-2, -2)``), each start pointing at it by the ``orbit`` column (see :func:`basins`).
 
 The default grid avoids the diagonal ``b1 = b2``: merged balls stay merged in
 simulation (the diagonal is invariant for identical balls), so a start on it says
@@ -566,7 +568,9 @@ def _link_orbits(model: Balancer | Scene, table: pl.DataFrame, states: list[list
     :func:`ballbal.analysis.periodic` of its pattern and windings from that series.
     An orbit's reference period is the solved one where it matches the simulated one,
     else the representative's. Rows in table order, so the result is that of the
-    table. Returns the ``orbit`` column and the orbits' table."""
+    table. The balls' exchange maps an orbit of identical balls onto one of the same
+    period and rates, which shares its index. Returns the ``orbit`` column and the
+    orbits' table."""
     from .analysis import periodic
 
     d = len(model.coordinates)

@@ -148,9 +148,10 @@ pub struct Outcome {
     /// Each ball's whole turns per `period` (negative: lagging the disk, as the
     /// `winding` of a periodic solution); empty without a period.
     pub windings: Vec<i64>,
-    /// The period repeats to [`STRICT_PERIOD_TOL`] over the whole window (not only
-    /// over its last two periods, the looser test that also passes a slowly
-    /// converging orbit or a weakly modulated torus).
+    /// The period repeats over the window's last three periods, each to
+    /// [`STRICT_PERIOD_TOL`], with a whole number of turns of every rotating ball (the
+    /// `period` alone may come from the looser test of the last two turns to 2 %, which
+    /// also passes a slowly converging orbit or a weakly modulated torus).
     pub period_strict: bool,
     /// How many extensions of `t_end` the start needed (see
     /// [`BasinOptions::extend_factor`]).
@@ -1000,8 +1001,8 @@ fn label_window(
         Oscillation::Rest => return rest(&y_end),
         Oscillation::Irregular => None,
     };
-    // The oscillation's own test compares the last periods to 1 %; whether the whole
-    // second half repeats with that period is the strict test.
+    // The oscillation's own test compares the last two periods to 1 %; the strict
+    // test asks the last three for `STRICT_PERIOD_TOL`.
     let period_strict = period.is_some_and(|p| oscillation_repeats(&xs, p));
     Outcome {
         label: if n == 2 { Label::OO } else { Label::Other },
