@@ -270,7 +270,10 @@ def test_early_stop_keeps_the_labels_of_full_runs(omega):
     full = basins(m, n=12, options=BasinOptions(early_stop=False)).table
     assert early["label"].to_list() == full["label"].to_list()
     assert early["t_stop"].mean() < 0.7 * full["t_stop"].mean()
-    assert (full.filter(pl.col("label").is_in(ballbal.basins.ROTATING))["t_stop"] == 1000).all()
+    # full runs stop at t_end, or after whole extensions of it
+    stops = full.filter(pl.col("label").is_in(ballbal.basins.ROTATING))["t_stop"]
+    assert ((stops / 1000) % 1 == 0).all() and (stops >= 1000).all()
+    assert early["motion"].to_list() == full["motion"].to_list()
     rot = early.filter(pl.col("label").is_in(ballbal.basins.ROTATING))
     # a torus' windowed mean rate moves by a few per cent with the window
     assert np.allclose(rot["rate1"], full.filter(
@@ -279,3 +282,138 @@ def test_early_stop_keeps_the_labels_of_full_runs(omega):
     for r in sample.iter_rows(named=True):
         assert r["label"] == _label_by_simulation(m, r["b1"], r["b2"]), r
     assert sample["t_stop"].min() < 1000
+
+
+def _simulated_period(m: ballbal.Balancer, b1: float, b2: float, t0: float = 2000.0,
+                      t1: float = 3000.0) -> tuple[int, float]:
+    """(whole turns per period, period) of ball 1 from ballbal.simulate at tight
+    tolerances, started at rest in the ground frame: the times ball 1 crosses whole
+    turns over [t0, t1] (linear interpolation between samples 0.01 apart), the fewest
+    turns m after which the turn durations repeat to 1e-6, and the mean period over the
+    whole periods seen."""
+    om = m.Omega
+    t = np.arange(t0, t1, 0.01)
+    df = ballbal.simulate(m, [0, 0, b1, b2, 0, 0, -om, -om], t_eval=t, t0=0.0,
+                          rtol=1e-11, atol=1e-13)
+    b = df["b1"].to_numpy()
+    k = np.floor(b / (2 * np.pi))
+    i = np.nonzero(np.diff(k))[0]
+    level = 2 * np.pi * np.maximum(k[i], k[i + 1])
+    c = t[i] + (level - b[i]) / (b[i + 1] - b[i]) * 0.01
+    tau = np.diff(c)
+    turns = next(mm for mm in range(1, 5) if np.allclose(tau[mm:], tau[:-mm], rtol=1e-6))
+    periods = (len(c) - 1) // turns
+    return turns, (c[periods * turns] - c[0]) / periods
+
+
+@pytest.mark.parametrize("omega", [1.2, 1.35])
+def test_periodic_starts_link_to_the_orbit_they_settle_on(omega, maps):
+    # (a) Every periodic start points at an orbit whose harmonic-balance period is the
+    # period measured here from an independent simulation of that start (ball turn
+    # crossings); at 1.2 the balls rotate separately, two turns per period (the old
+    # table gave these starts no period and linked nothing).
+    res = maps[omega]
+    t = res.table
+    per = t.filter(pl.col("motion") == "periodic")
+    assert per.height > 0
+    assert per["orbit"].null_count() == 0
+    assert t.filter(pl.col("motion") != "periodic")["orbit"].null_count() == \
+        t.filter(pl.col("motion") != "periodic").height
+    m = thesis(omega)
+    for o in res.orbits.iter_rows(named=True):
+        assert o["status"] == "converged" and o["stability"] == "stable", o
+        assert o["max_modulus"] < 1
+        assert o["count"] == per.filter(pl.col("orbit") == o["orbit"]).height
+        start = per.filter(pl.col("orbit") == o["orbit"]).row(-1, named=True)
+        turns, period = _simulated_period(m, start["b1"], start["b2"])
+        assert (o["winding1"], o["winding2"]) == (-turns, -turns), (o, turns)
+        assert abs(o["period"] - period) < 1e-5 * period, (o, period)
+    if omega == 1.2:
+        sep = res.orbits.filter(pl.col("label") == "separated_R-R")
+        assert sep.height >= 1
+        assert (sep["winding1"] == -2).all() and (sep["winding2"] == -2).all()
+    else:
+        assert set(res.orbits["label"]) == {"merged_R-R"}
+        assert (res.orbits["winding1"] == -1).all()
+
+
+def test_a_start_unsettled_at_t_end_is_extended_and_linked():
+    # (b) At Omega 1.2 a separated start is still in its transient at t_end = 400 (its
+    # turn durations converge to their alternation over about a thousand time units):
+    # with no extension it has no regular period and is not linked; with extensions it
+    # is simulated on, 400 at a time, until its two-turn period repeats, and is linked
+    # to the (-2, -2) orbit, whose period the independent simulation gives.
+    m = thesis(1.2)
+    b1, b2 = [0.1309], [0.392699]
+    short = basins(m, b1=b1, b2=b2, t_end=400,
+                   options=BasinOptions(extend_factor=1)).table.row(0, named=True)
+    assert short["label"] == "separated_R-R" and short["motion"] == "quasi_periodic"
+    assert short["orbit"] is None and short["period"] is None
+    assert short["extensions"] == 0 and short["t_stop"] <= 400
+    r = basins(m, b1=b1, b2=b2, t_end=400)
+    row = r.table.row(0, named=True)
+    assert row["extensions"] >= 1 and row["t_stop"] <= 8 * 400
+    assert row["t_stop"] == pytest.approx(400 * (row["extensions"] + 1), abs=400)
+    assert row["label"] == "separated_R-R" and row["motion"] == "periodic"
+    assert (row["winding1"], row["winding2"]) == (-2, -2)
+    orbit = r.orbits.row(row["orbit"], named=True)
+    assert (orbit["winding1"], orbit["winding2"]) == (-2, -2)
+    turns, period = _simulated_period(m, b1[0], b2[0])
+    assert turns == 2
+    assert abs(orbit["period"] - period) < 1e-5 * period
+    assert abs(row["period"] - period) < 1e-3 * period
+
+
+def test_link_and_extension_options_are_checked():
+    # (c)
+    m = thesis(1.2)
+    for bad in (0.5, 65.0, float("nan")):
+        with pytest.raises(ParameterError) as e:
+            basins(m, n=2, options=BasinOptions(extend_factor=bad))
+        assert e.value.parameter == "extend_factor"
+    with pytest.raises(ParameterError) as e:
+        basins(m, n=2, N=0)
+    assert e.value.parameter == "N"
+    with pytest.raises(ParameterError) as e:
+        basins(m, n=2, orbits="yes")  # type: ignore[arg-type]
+    assert e.value.parameter == "orbits"
+
+
+def test_repr_names_the_orbits(maps):
+    text = repr(maps[1.2])
+    assert "orbit 0: separated_R-R windings (-2, -2)" in text
+    assert "<pre>" in maps[1.2]._repr_html_()
+
+
+def test_starts_of_one_class_link_to_distinct_orbits_by_period_and_rates(monkeypatch):
+    # The matching alone (no solve: each new orbit's period is its representative's):
+    # R-O starts whose periods agree to within LINK_TOL share an orbit, one 2 % off or
+    # with the other ball rotating gets its own; rests and quasi-periodic motions none.
+    from ballbal import basins as bmod
+
+    solved = []
+
+    def fake(model, r, state, options, N, d, periodic):  # noqa: N803
+        solved.append((r["b1"], r["b2"]))
+        return {k: None for k in bmod.ORBIT_SCHEMA} | {
+            "label": r["label"], "winding1": r["winding1"], "winding2": r["winding2"],
+            "count": 0}, r["period"]
+
+    monkeypatch.setattr(bmod, "_solve_orbit", fake)
+    rows = [  # (label, motion, period, rate1, rate2, winding1, winding2)
+        ("R-O", "periodic", 10.0, 2 * np.pi / 10.0, 0.0, -1, 0),
+        ("R-O", "periodic", 10.05, 2 * np.pi / 10.05, 0.001, -1, 0),  # 0.5 %: the same
+        ("R-O", "periodic", 10.2, 2 * np.pi / 10.2, 0.0, -1, 0),  # 2 %: another
+        ("R-O", "periodic", 10.0, 0.0, 2 * np.pi / 10.0, 0, -1),  # the other ball
+        ("perfect_balance", "rest", None, 0.0, 0.0, None, None),
+        ("separated_R-R", "quasi_periodic", None, 0.23, 0.23, None, None),
+        ("R-O", "periodic", 10.19, 2 * np.pi / 10.19, 0.0, -1, 0),
+    ]
+    t = pl.DataFrame(
+        [dict(zip(("label", "motion", "period", "rate1", "rate2", "winding1", "winding2"),
+                  r, strict=True)) | {"b1": float(i), "b2": 0.0} for i, r in enumerate(rows)])
+    col, orbits = bmod._link_orbits(thesis(1.2), t, [[0.0] * 8] * len(rows),
+                                    BasinOptions(), 8)
+    assert col == [0, 0, 1, 2, None, None, 1]
+    assert orbits["count"].to_list() == [2, 2, 1]
+    assert solved == [(0.0, 0.0), (2.0, 0.0), (3.0, 0.0)]

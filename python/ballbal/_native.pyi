@@ -112,10 +112,12 @@ def basins(
     model: Balancer | Scene, starts: list[list[float]], options: BasinOptions, threads: int,
     chunk: int, chunks: list[int], on_chunk: Callable[[int, dict[str, Any]], None],
 ) -> None: ...
-# (omega, coefficients, rotating) of the attractor reached from y0, or None
+# (omega, coefficients, rotating) of the attractor reached from y0, or None; with
+# rotating, over `turns` whole turns per period
 def attractor_series(
     model: Balancer | Scene, y0: npt.NDArray[np.float64], n_harm: int, settle: float,
-    window: float, rtol: float, atol: float,
+    window: float, rtol: float, atol: float, rotating: list[bool] | None = None,
+    turns: int = 1,
 ) -> tuple[float, npt.NDArray[np.float64], list[bool]] | None: ...
 # (one row of basins' columns, the state reached)
 def classify_state(

@@ -12,6 +12,17 @@ oscillates or they pass each other), ``R-O``, ``O-O``, ``other`` (not two balls)
 1e-7 (the simulation stops there: ``t_stop``). Starts run in parallel, each on its own,
 so the table does not depend on the thread count.
 
+A start whose motion is not settled after ``t_end`` (``not_settled``, or a moving class
+whose period does not repeat over its last three periods to 1e-3: a torus too, whose
+steady look at 1000 time units was, on the thesis' Omega 1.2 grid, separated rotations
+still converging) is simulated further, ``t_end`` at a time, up to ``extend_factor *
+t_end`` in all (``extensions`` counts the extensions); what is still unsettled then
+keeps its label (``motion``: ``not_settled`` or ``quasi_periodic``). Every periodic
+class is then linked to its orbit: the harmonic balance solved from the series fitted to
+a representative start's own motion (:func:`ballbal.analysis.periodic`, with its
+windings: the thesis' balls rotating separately take two turns per period, windings
+``(-2, -2)``), each start pointing at it by the ``orbit`` column (see :func:`basins`).
+
 The default grid avoids the diagonal ``b1 = b2``: merged balls stay merged in
 simulation (the diagonal is invariant for identical balls), so a start on it says
 nothing about its neighbourhood.
@@ -44,6 +55,19 @@ LABELS = ("perfect_balance", "other_equilibrium", "merged_R-R", "separated_R-R",
 REST = ("perfect_balance", "other_equilibrium")
 #: Labels of motions in which a ball rotates.
 ROTATING = ("merged_R-R", "separated_R-R", "R-O")
+#: Relative tolerance of linking a start to an orbit: its simulated period and the mean
+#: rates of its rotating balls within this fraction of the orbit's (the simulated
+#: periods repeat to 1e-3 and agree with the orbits' to about 1e-5; distinct orbits of
+#: one class and winding differ by more). Over it, a new orbit is solved.
+LINK_TOL = 0.01
+#: Columns of :attr:`Basins.orbits`.
+ORBIT_SCHEMA = {
+    "orbit": pl.Int64, "label": pl.Utf8, "pattern": pl.Utf8, "winding1": pl.Int64,
+    "winding2": pl.Int64, "count": pl.Int64, "period_simulated": pl.Float64,
+    "omega": pl.Float64, "period": pl.Float64, "frequency_error": pl.Float64,
+    "status": pl.Utf8, "stability": pl.Utf8, "max_modulus": pl.Float64,
+    "modulus_error": pl.Float64, "N": pl.Int64, "b1": pl.Float64, "b2": pl.Float64,
+}
 
 
 @dataclass(frozen=True)
@@ -58,7 +82,10 @@ class BasinOptions:
     ``t_end`` once its attractor is clear — a periodic orbit whose Poincare section
     (the whole turns of a rotating ball) has converged, or a clean decay to rest —
     with the label the full run gives (``t_stop`` says where it stopped; the settle
-    check's longer run and speed sweeps always run to the end).
+    check's longer run and speed sweeps always run to the end); ``extend_factor``:
+    the longest total time a start is simulated, in units of ``t_end`` (a start not
+    settled after ``t_end`` is extended by ``t_end`` at a time until it is; 1: never;
+    in ``[1, 64]``; speed sweeps never extend).
     """
 
     t_end: float = 1000.0
@@ -69,10 +96,11 @@ class BasinOptions:
     merge_tol: float = 0.5
     settle_factor: float | None = None
     early_stop: bool = True
+    extend_factor: float = 8.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "early_stop", _check.boolean("early_stop", self.early_stop))
-        for n in ("t_end", "window", "rtol", "atol", "rest_tol", "merge_tol"):
+        for n in ("t_end", "window", "rtol", "atol", "rest_tol", "merge_tol", "extend_factor"):
             object.__setattr__(self, n, _check.real(n, getattr(self, n)))
         if self.settle_factor is not None:
             object.__setattr__(self, "settle_factor",
@@ -85,8 +113,26 @@ class Basins:
 
     ``table``: one row per start (``b1, b2, label, pattern, omega`` (mean ball rate of
     the rotating balls), ``period`` (null unless regular), ``rate1, rate2`` (each
-    ball's mean rate), ``t_stop``, and with the settle check ``long_label`` and
+    ball's mean rate), ``t_stop`` (time simulated in all), ``motion`` (``rest``,
+    ``periodic``: a period that repeats over the last three periods to 1e-3,
+    ``quasi_periodic``: moving without one, a torus or a motion that did not repeat
+    within ``extend_factor * t_end``, ``not_settled``, ``failed``), ``winding1,
+    winding2`` (each ball's whole turns per period, negative lagging the disk; null
+    without a period), ``extensions`` (times the start was simulated ``t_end``
+    further), ``orbit`` (the row of :attr:`orbits` a periodic start is linked to, null
+    for every other motion), and with the settle check ``long_label`` and
     ``settled``).
+
+    ``orbits``: one row per distinct periodic orbit the starts reached (columns
+    :data:`ORBIT_SCHEMA`: its class ``label``, ``pattern`` and windings, ``count`` of
+    starts, ``period_simulated`` (its representative start's period), the harmonic
+    balance's ``omega`` and ``period = 2 pi / omega``, ``frequency_error`` (their
+    relative difference from the simulated period), ``status``, ``stability``,
+    ``max_modulus``, ``modulus_error`` and ``N`` of :func:`ballbal.analysis.periodic`,
+    and ``b1, b2``: the representative start). ``status`` ``mismatch``: the solve
+    converged to another orbit (its period more than :data:`LINK_TOL` from the
+    simulated one; no verdict given); empty when linking was not asked for or the call
+    was interrupted.
     """
 
     model: Balancer | Scene
@@ -96,6 +142,32 @@ class Basins:
     #: Ctrl-C stopped the call: ``table`` holds only the finished chunks' starts.
     interrupted: bool = False
     _links: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+    orbits: pl.DataFrame = field(default_factory=lambda: pl.DataFrame(schema=ORBIT_SCHEMA))
+
+    def _summary(self) -> list[str]:
+        """Lines of the short description: the classes' counts and the orbits."""
+        lines = [f"Basins: {self.table.height} starts"
+                 + (" (interrupted)" if self.interrupted else "")]
+        counts = self.table.group_by("label").agg(pl.len()).sort("len", descending=True)
+        lines.append("  " + ", ".join(f"{r[0]} {r[1]}" for r in counts.iter_rows()))
+        if "motion" in self.table.columns:
+            q = self.table.filter(pl.col("motion") == "quasi_periodic").height
+            if q:
+                lines.append(f"  {q} quasi-periodic (no regular period): not linked")
+        for o in self.orbits.iter_rows(named=True):
+            om = "-" if o["omega"] is None else f"{o['omega']:.6g}"
+            lines.append(f"  orbit {o['orbit']}: {o['label']} windings "
+                         f"({o['winding1']}, {o['winding2']}), {o['count']} starts, "
+                         f"omega {om}, {o['status']}, {o['stability']}")
+        return lines
+
+    def __repr__(self) -> str:
+        return "\n".join(self._summary())
+
+    def _repr_html_(self) -> str:
+        import html
+
+        return "<pre>" + html.escape(repr(self)) + "</pre>"
 
     @property
     def fractions(self) -> pl.DataFrame:
@@ -120,8 +192,9 @@ class Basins:
     def link(self, *, N: int = 8) -> pl.DataFrame:  # noqa: N803
         """Each class found, linked to the solution it converges to: the perfect balance
         to the ``equilibria()`` entry (omega 0 and its stability), every class with a
-        regular period (merged R-R, R-O, O-O, ...) to ``periodic()`` of its pattern,
-        solved from the series fitted to its first start's own simulated attractor.
+        regular period (merged R-R, separated R-R, R-O, O-O, ...) to ``periodic()`` of
+        its pattern and windings, solved from the series fitted to its first start's own
+        simulated attractor (each start's own orbit: :attr:`orbits`).
         Columns ``label, count, mean_rate`` (the class's mean ball rate), ``kind``,
         ``omega``, ``stability``, ``status`` (null where nothing is linked). ``N``:
         the harmonics of the fitted series and of the solves, in ``[1, 256]``."""
@@ -141,7 +214,9 @@ class Basins:
                     row.update(kind="equilibrium", omega=0.0, stability=eq[0].stability,
                                status="converged")
             elif cls["period"].null_count() < cls.height and label != "not_settled":
-                first = cls.filter(pl.col("period").is_not_null()).row(0, named=True)
+                first = cls.filter(pl.col("period").is_not_null()).sort(
+                    pl.col("motion") != "periodic" if "motion" in cls.columns else pl.lit(0),
+                    maintain_order=True).row(0, named=True)
                 sol = self._periodic_of(first, N, periodic)
                 if sol is not None:
                     row.update(kind=sol.type, omega=sol.omega, stability=sol.stability,
@@ -160,13 +235,20 @@ class Basins:
         y0[d - n:d] = balls
         y0[2 * d - n:] = -m.Omega
         o = self.options
-        got = _native.attractor_series(m, y0, N, o.t_end, max(o.window, 20 * row["period"]),
-                                       o.rtol * 1e-3, o.atol * 1e-3)
+        # Over as many turns per period as the start's windings say (two for the
+        # thesis' separated rotations), after as long as the start was simulated.
+        wind = [row.get(f"winding{i + 1}") for i in range(n)]
+        rot = None if None in wind else [w != 0 for w in wind]
+        turns = next((abs(w) for w in wind if w), 1) if rot is not None else 1
+        got = _native.attractor_series(m, y0, N, min(max(o.t_end, row.get("t_stop") or 0), 1e5),
+                                       max(o.window, 20 * row["period"]),
+                                       o.rtol * 1e-3, o.atol * 1e-3, rot, turns)
         if got is None:
             return None
         omega, coeffs, rotating = got
         pattern = "-".join("R" if r else "O" for r in rotating)
-        return periodic(m, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N)
+        return periodic(m, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N,
+                        windings=wind if rot is not None and any(rot) else None)
 
 
 class _BasinStore:
@@ -286,6 +368,8 @@ def basins(
     settle_check: bool = False,
     options: BasinOptions | None = None,
     execution: Execution | None = None,
+    orbits: bool = True,
+    N: int = 8,  # noqa: N803 - the harmonics' symbol
 ) -> Basins:
     """Label the starts of a grid (or random sample) of initial ball angles by the
     attractor they reach; two balls.
@@ -306,6 +390,10 @@ def basins(
     chunks as tasks (``threads`` per task, default 1). None of it changes the
     table.
 
+    ``orbits``: link every periodic start to its orbit (:attr:`Basins.orbits`, the
+    table's ``orbit`` column; see :func:`_link_orbits`), solved with ``N`` harmonics
+    (in ``[1, 256]``); not done for an interrupted call.
+
     At most :data:`~ballbal._check.MAX_BASIN_STARTS` starts (``n <= 1000``); ``b1`` and
     ``b2`` are flat lists of finite angles; ``seed`` (a non-negative integer) goes with
     ``samples`` only. Bad arguments raise a
@@ -325,7 +413,9 @@ def basins(
         factor = 3.0
     options = BasinOptions(t_end, window, options.rtol, options.atol, options.rest_tol,
                            options.merge_tol, factor if settle_check else None,
-                           options.early_stop)
+                           options.early_stop, options.extend_factor)
+    link = _check.boolean("orbits", orbits)
+    N = _check.integer("N", N, 1, 256)  # noqa: N806 - the harmonics' symbol
     chunk = 256 if execution.chunk is None else execution.chunk
     if chunk < 1:
         raise ParameterError("chunk", f"must be >= 1, got {chunk}", allowed=">= 1",
@@ -375,7 +465,12 @@ def basins(
             "rate1": pl.Series(cols["rate1"], dtype=pl.Float64),
             "rate2": pl.Series(cols["rate2"], dtype=pl.Float64),
             "t_stop": pl.Series(cols["t_stop"], dtype=pl.Float64),
+            "motion": pl.Series(cols["motion"], dtype=pl.Utf8),
+            "winding1": pl.Series(cols["winding1"], dtype=pl.Int64),
+            "winding2": pl.Series(cols["winding2"], dtype=pl.Int64),
+            "extensions": pl.Series(cols["extensions"], dtype=pl.Int64),
             "long_label": pl.Series(cols["long_label"], dtype=pl.Utf8),
+            "state": pl.Series(cols["state"], dtype=pl.List(pl.Float64)),
         })
 
     store = None
@@ -443,16 +538,112 @@ def basins(
             store.close()
     df = (pl.concat([parts[c] for c in sorted(parts)], how="vertical") if parts
           else frame(0, {k: [] for k in ("label", "pattern", "omega", "period", "rate1",
-                                         "rate2", "t_stop", "long_label")}, 0))
+                                         "rate2", "t_stop", "motion", "winding1",
+                                         "winding2", "extensions", "long_label",
+                                         "state")}, 0))
+    states = df["state"].to_list()
+    df = df.drop("state")
     if settle_check:
         df = df.with_columns((pl.col("label") == pl.col("long_label")).alias("settled"))
     else:
         df = df.drop("long_label")
-    return Basins(model, df, options, random, interrupted)
+    orbit_col: list[int | None] = [None] * df.height
+    orbit_table = pl.DataFrame(schema=ORBIT_SCHEMA)
+    if link and not interrupted:
+        orbit_col, orbit_table = _link_orbits(model, df, states, options, N)
+    df = df.with_columns(pl.Series("orbit", orbit_col, dtype=pl.Int64))
+    return Basins(model, df, options, random, interrupted, orbits=orbit_table)
+
+
+def _link_orbits(model: Balancer | Scene, table: pl.DataFrame, states: list[list[float]],
+                 options: BasinOptions, N: int,  # noqa: N803
+                 ) -> tuple[list[int | None], pl.DataFrame]:
+    """Links every ``periodic`` start of ``table`` to an orbit: the first orbit (in the
+    order they were found) of its label and windings whose period and rotating balls'
+    mean rates are within :data:`LINK_TOL` of its own; when none is, a new orbit is
+    solved from this start (it becomes the orbit's representative): the series fitted
+    to its motion from ``states`` (the state it ended in, on its attractor: settled for
+    ten periods more, observed for twenty at a thousandth of the basin run's
+    tolerances, over as many whole turns per period as its windings say), then
+    :func:`ballbal.analysis.periodic` of its pattern and windings from that series.
+    An orbit's reference period is the solved one where it matches the simulated one,
+    else the representative's. Rows in table order, so the result is that of the
+    table. The balls' exchange maps an orbit of identical balls onto one of the same
+    period and rates, which shares its index. Returns the ``orbit`` column and the
+    orbits' table."""
+    from .analysis import periodic
+
+    d = len(model.coordinates)
+    col: list[int | None] = [None] * table.height
+    found: list[dict[str, Any]] = []
+    refs: list[tuple[float, list[float]]] = []  # (period, rates) matched against
+    for k, r in enumerate(table.iter_rows(named=True)):
+        if r["motion"] != "periodic" or r["period"] is None:
+            continue
+        wind = (r["winding1"], r["winding2"])
+        rates = [r["rate1"], r["rate2"]]
+        hit = None
+        for j, o in enumerate(found):
+            per, ref_rates = refs[j]
+            if (o["label"] == r["label"] and (o["winding1"], o["winding2"]) == wind
+                    and abs(r["period"] - per) <= LINK_TOL * per
+                    and all(abs(a - b) <= LINK_TOL * abs(b)
+                            for a, b, w in zip(rates, ref_rates, wind, strict=True) if w)):
+                hit = j
+                break
+        if hit is None:
+            row, ref = _solve_orbit(model, r, states[k], options, N, d, periodic)
+            row["orbit"] = len(found)
+            found.append(row)
+            refs.append((ref, rates))
+            hit = row["orbit"]
+        found[hit]["count"] += 1
+        col[k] = hit
+    return col, pl.DataFrame(found, schema=ORBIT_SCHEMA)
+
+
+def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
+                 options: BasinOptions, N: int, d: int,  # noqa: N803
+                 periodic: Any) -> tuple[dict[str, Any], float]:
+    """The orbits-table row of the orbit reached by the start ``r`` (ending in
+    ``state``) and the period later starts are matched against."""
+    wind = [int(r["winding1"]), int(r["winding2"])]
+    rotating = [w != 0 for w in wind]
+    turns = next((abs(w) for w in wind if w), 1)
+    per = float(r["period"])
+    row: dict[str, Any] = {
+        "label": r["label"], "pattern": "-".join("R" if x else "O" for x in rotating),
+        "winding1": wind[0], "winding2": wind[1], "count": 0, "period_simulated": per,
+        "omega": None, "period": None, "frequency_error": None, "status": "no_guess",
+        "stability": None, "max_modulus": None, "modulus_error": None, "N": None,
+        "b1": r["b1"], "b2": r["b2"]}
+    cap = 1e5  # GuessOptions' longest settle and window
+    got = _native.attractor_series(
+        model, np.asarray(state, dtype=np.float64), N, min(10 * per, cap),
+        min(max(options.window, 20 * per), cap), options.rtol * 1e-3, options.atol * 1e-3,
+        rotating, turns)
+    if got is None:
+        return row, per
+    omega, coeffs, _ = got
+    sol = periodic(model, row["pattern"], guess=(omega, coeffs.reshape(d, -1)),
+                   windings=wind if any(rotating) else None, N=N)
+    row.update(status=sol.status, omega=sol.omega, N=sol.N)
+    if sol.omega is None:
+        return row, per
+    period = 2 * math.pi / sol.omega
+    err = abs(period - per) / per
+    row.update(period=period, frequency_error=err)
+    if err > LINK_TOL:
+        row.update(status="mismatch")
+        return row, per
+    row.update(stability=sol.stability, max_modulus=sol.max_modulus,
+               modulus_error=sol.modulus_error)
+    return row, period if sol.status == "converged" else per
 
 
 def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> Any:
-    """A categorical map of the labels over the starts (matplotlib, imported here)."""
+    """A categorical map of the labels over the starts (matplotlib, imported here); the
+    legend names the orbits each class is linked to (:attr:`Basins.orbits`)."""
     import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
@@ -477,8 +668,14 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
     ax.set_xlabel("b1 (rad)")
     ax.set_ylabel("b2 (rad)")
     ax.set_aspect("equal")
+    def name(lab: str) -> str:
+        # the orbits a class is linked to, with their windings
+        o = result.orbits.filter(pl.col("label") == lab)
+        return lab + "".join(f"\norbit {r['orbit']}: ({r['winding1']}, {r['winding2']}), "
+                             f"{r['stability']}" for r in o.iter_rows(named=True))
+
     ax.legend(handles=[Line2D([], [], marker="s", ls="", mfc=colours[lab], mec="0.6",
-                              label=lab) for lab in present],
+                              label=name(lab)) for lab in present],
               loc="upper left", fontsize="small", framealpha=0.8)
     if title is not None:
         ax.set_title(title)

@@ -3,7 +3,7 @@
 use crate::convert::{dispatch, slice, ModelArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::{guarded, run_polled};
-use ballbal_core::analysis::attractors::{classify, Attractor, GuessOptions};
+use ballbal_core::analysis::attractors::{classify, guess_with_turns, Attractor, GuessOptions};
 use ballbal_core::analysis::basins::{basin_starts, BasinOptions, Outcome};
 use ballbal_core::periodic::require_autonomous;
 use ballbal_core::{cancel, Dynamics, Error};
@@ -22,6 +22,7 @@ pub struct BasinArgs {
     merge_tol: f64,
     settle_factor: Option<f64>,
     early_stop: bool,
+    extend_factor: f64,
 }
 
 impl BasinArgs {
@@ -35,6 +36,7 @@ impl BasinArgs {
             merge_tol: self.merge_tol,
             settle_factor: self.settle_factor,
             early_stop: self.early_stop,
+            extend_factor: self.extend_factor,
         }
     }
 }
@@ -62,6 +64,19 @@ fn columns<'py>(py: Python<'py>, rows: &[Outcome], n: usize) -> PyResult<Bound<'
     d.set_item("period", rows.iter().map(|r| r.period).collect::<Vec<_>>())?;
     d.set_item("t_stop", rows.iter().map(|r| r.t_stop).collect::<Vec<_>>())?;
     d.set_item(
+        "motion",
+        rows.iter().map(|r| r.motion()).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "extensions",
+        rows.iter().map(|r| r.extensions).collect::<Vec<_>>(),
+    )?;
+    // The state reached: where a class's orbit is fitted from.
+    d.set_item(
+        "state",
+        rows.iter().map(|r| r.y_end.clone()).collect::<Vec<_>>(),
+    )?;
+    d.set_item(
         "long_label",
         rows.iter()
             .map(|r| r.long_label.map(|l| l.as_str()))
@@ -71,6 +86,12 @@ fn columns<'py>(py: Python<'py>, rows: &[Outcome], n: usize) -> PyResult<Bound<'
         d.set_item(
             format!("rate{}", i + 1),
             rows.iter().map(|r| r.rates[i]).collect::<Vec<_>>(),
+        )?;
+        d.set_item(
+            format!("winding{}", i + 1),
+            rows.iter()
+                .map(|r| r.windings.get(i).copied())
+                .collect::<Vec<_>>(),
         )?;
     }
     Ok(d)
@@ -152,9 +173,11 @@ type Series<'py> = (f64, Bound<'py, PyArray1<f64>>, Vec<bool>);
 /// The series of the attractor reached from `y0` (settle for `settle`, then observe for
 /// up to `window`: `attractors::classify`), as `(omega, coefficients, rotating)`, or
 /// `None` when the motion is not periodic. A harmonic-balance start for the solution a
-/// basin class converges to.
+/// basin class converges to. With `rotating` (which balls rotate) the period is
+/// measured over `turns` whole turns of the first rotating ball
+/// (`attractors::guess_with_turns`: an orbit of several turns per period).
 #[pyfunction]
-#[pyo3(signature = (model, y0, n_harm, settle, window, rtol, atol))]
+#[pyo3(signature = (model, y0, n_harm, settle, window, rtol, atol, rotating=None, turns=1))]
 #[allow(clippy::too_many_arguments)]
 pub fn attractor_series<'py>(
     py: Python<'py>,
@@ -165,6 +188,8 @@ pub fn attractor_series<'py>(
     window: f64,
     rtol: f64,
     atol: f64,
+    rotating: Option<Vec<bool>>,
+    turns: usize,
 ) -> PyResult<Option<Series<'py>>> {
     let m = build(&model)?;
     let y0 = slice(&y0, "y0")?.to_vec();
@@ -181,6 +206,29 @@ pub fn attractor_series<'py>(
     let dim = dispatch!(&m, d => 2 * d.ndof());
     if y0.len() != dim || y0.iter().any(|v| !v.is_finite()) {
         return Err(Error::param("y0", format!("needs {dim} finite values"))).py();
+    }
+    let n = dispatch!(&m, d => d.ndof() - d.first_ball());
+    if let Some(r) = &rotating {
+        if r.len() != n {
+            return Err(Error::param(
+                "rotating",
+                format!("needs {n} values, got {}", r.len()),
+            ))
+            .py();
+        }
+    }
+    if !(1..=16).contains(&turns) {
+        return Err(Error::param(
+            "turns",
+            format!("must be in [1, 16], got {turns}"),
+        ))
+        .py();
+    }
+    if let Some(r) = rotating {
+        let s = guarded(py, || {
+            Ok(dispatch!(&m, d => guess_with_turns(d, &y0, &r, turns, n_harm, &g)))
+        })?;
+        return Ok(s.map(|s| (s.omega, PyArray1::from_vec(py, s.coeffs.clone()), r)));
     }
     let a = guarded(py, || Ok(dispatch!(&m, d => classify(d, &y0, n_harm, &g))))?;
     Ok(match a {
@@ -208,6 +256,7 @@ pub fn classify_state<'py>(
     // A sweep carries the state after the whole dwell on to its next step.
     let opts = BasinOptions {
         early_stop: false,
+        extend_factor: 1.0,
         ..options.to_core()
     };
     opts.validate().py()?;

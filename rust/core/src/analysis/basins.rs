@@ -10,11 +10,14 @@
 //! whose rotation pattern or mean ball rates differ between the two halves of the
 //! window, or whose oscillation still grows; `failed` an integration that failed.
 //!
-//! The periods come from [`super::attractors`]' detectors (whole-turn crossings of a
-//! rotating ball, mean crossings of `x` otherwise); a motion without a regular period
-//! (a torus: two separated balls whose gap is modulated) keeps its label and has no
-//! period. Every start is simulated on its own, so the labels do not depend on the
-//! thread count or on which other starts run.
+//! The periods come from whole-turn crossings of a rotating ball (one to
+//! [`MAX_TURNS`] turns per period: the thesis' balls rotating separately take two)
+//! and from mean crossings of `x` otherwise ([`super::attractors`]' detector); a motion
+//! without a regular period (a torus: two separated balls whose gap is modulated) keeps
+//! its label and has no period. A start that is not settled after `t_end` (see
+//! [`Outcome::needs_more`]) is simulated further, `t_end` at a time, up to
+//! `extend_factor * t_end`. Every start is simulated on its own, so the labels do not
+//! depend on the thread count or on which other starts run.
 
 use super::attractors::{oscillation_period, turn_period, Oscillation};
 use crate::cancel;
@@ -47,6 +50,11 @@ pub struct BasinOptions {
     /// converged periodic orbit, a clean decay to rest); the label is the one the full
     /// run gives. A speed sweep turns it off: its state must be the one after the dwell.
     pub early_stop: bool,
+    /// Longest total time a start is simulated, in units of `t_end`: a start whose
+    /// motion is not settled after `t_end` (see [`Outcome::needs_more`]) is simulated
+    /// further, `t_end` at a time, from where it stopped, until it is or this total is
+    /// reached. 1: no extension.
+    pub extend_factor: f64,
 }
 
 impl Default for BasinOptions {
@@ -60,9 +68,14 @@ impl Default for BasinOptions {
             merge_tol: 0.5,
             settle_factor: None,
             early_stop: true,
+            extend_factor: 8.0,
         }
     }
 }
+
+/// Largest `extend_factor`: a start that has not settled in 64 times the thesis' 1000
+/// time units is a torus or chaos, not a slow transient.
+pub const MAX_EXTEND_FACTOR: f64 = 64.0;
 
 impl BasinOptions {
     pub fn validate(&self) -> Result<()> {
@@ -75,6 +88,14 @@ impl BasinOptions {
         if let Some(f) = self.settle_factor {
             check_range("settle_factor", f, 1.0, true, 100.0, false)?;
         }
+        check_range(
+            "extend_factor",
+            self.extend_factor,
+            1.0,
+            false,
+            MAX_EXTEND_FACTOR,
+            false,
+        )?;
         Ok(())
     }
 }
@@ -124,12 +145,53 @@ pub struct Outcome {
     pub rates: Vec<f64>,
     /// Period of a periodic motion, when regular.
     pub period: Option<f64>,
-    /// Time simulated (less than `t_end` when the start came to rest early).
+    /// Each ball's whole turns per `period` (negative: lagging the disk, as the
+    /// `winding` of a periodic solution); empty without a period.
+    pub windings: Vec<i64>,
+    /// The period repeats over the window's last three periods, each to
+    /// [`STRICT_PERIOD_TOL`], with a whole number of turns of every rotating ball (the
+    /// `period` alone may come from the looser test of the last two turns to 2 %, which
+    /// also passes a slowly converging orbit or a weakly modulated torus).
+    pub period_strict: bool,
+    /// How many extensions of `t_end` the start needed (see
+    /// [`BasinOptions::extend_factor`]).
+    pub extensions: usize,
+    /// Time simulated in all (less than `t_end` when the start came to rest early).
     pub t_stop: f64,
     /// With the settle check: the label after the longer run.
     pub long_label: Option<Label>,
     /// The state at `t_stop` (a speed sweep carries it on to the next step).
     pub y_end: Vec<f64>,
+}
+
+impl Outcome {
+    /// Whether the motion is not settled yet and is worth simulating further: a
+    /// `not_settled` label, or a moving class (rotating or oscillating) whose period
+    /// does not repeat strictly (see [`STRICT_PERIOD_TOL`]). A torus is extended too,
+    /// up to the longest time: the torus test (steady mean rates and gap) is no proof,
+    /// on the thesis' Omega 1.2 grid it passes separated rotations still converging to
+    /// their two-turn orbit after 800 time units.
+    pub fn needs_more(&self) -> bool {
+        match self.label {
+            Label::NotSettled => true,
+            Label::Failed | Label::PerfectBalance | Label::OtherEquilibrium => false,
+            _ => !self.period_strict,
+        }
+    }
+
+    /// What kind of motion the start ended on: `rest`, `periodic` (a regular period: a
+    /// periodic orbit to link), `quasi_periodic` (moving without a regular period: a
+    /// torus, or a motion that did not repeat within the longest time allowed),
+    /// `not_settled` or `failed`.
+    pub fn motion(&self) -> &'static str {
+        match self.label {
+            Label::NotSettled => "not_settled",
+            Label::Failed => "failed",
+            Label::PerfectBalance | Label::OtherEquilibrium => "rest",
+            _ if self.period.is_some() => "periodic",
+            _ => "quasi_periodic",
+        }
+    }
 }
 
 /// The thesis' start: at rest in the ground frame (`x = y = x' = y' = 0`,
@@ -161,6 +223,18 @@ pub fn classify_start<D: Dynamics + ?Sized>(
     opts: &BasinOptions,
 ) -> Result<Outcome> {
     let mut out = judge(model, y0, opts.t_end, opts, opts.early_stop)?;
+    // Extensions continue from the state reached, each judged as a start of its own (a
+    // fresh integrator; autonomous equations, so only the time origin moves).
+    let mut total = out.t_stop;
+    let longest = opts.extend_factor * opts.t_end;
+    while out.needs_more() && total + opts.t_end <= longest * (1.0 + 1e-12) {
+        let y = std::mem::take(&mut out.y_end);
+        let mut next = judge(model, &y, opts.t_end, opts, opts.early_stop)?;
+        next.extensions = out.extensions + 1;
+        total += next.t_stop;
+        out = next;
+    }
+    out.t_stop = total;
     if let Some(f) = opts.settle_factor {
         out.long_label = Some(judge(model, y0, f * opts.t_end, opts, false)?.label);
     }
@@ -242,7 +316,11 @@ impl Window<'_> {
 /// - or it is a rest label, at this and the previous checkpoint, with the velocities
 ///   over the second half of the window below `REST_DECAY` times those of the first
 ///   (the final window's test is 0.8), no ball turning, and `|x + i y|` clear of
-///   `rest_tol` by twice its spread over the second half.
+///   `rest_tol` by twice its spread over the second half;
+/// - or two balls rotate apart, read so over a whole final window at `TORUS_RUNS`
+///   checkpoints in a row with steady rates and gap ([`torus_is_clear`]), and that
+///   window's turns repeat with a regular period of several turns (a torus, with no
+///   period, runs on to `t_end`).
 ///
 /// Anything else (not settled, O-O, a slow decay) runs to `t_end` as without early
 /// stopping. The tests compare the labels with full runs (and with long simulations).
@@ -392,7 +470,10 @@ impl EarlyStop {
                 Label::MergedRR | Label::SeparatedRR | Label::RO | Label::Other
                     if cand.pattern.contains('R') =>
                 {
-                    self.orbit_is_clear(&cand, t - self.check, win, d, o, opts)
+                    // A converged section is the stronger test of a regular period.
+                    let c = self.orbit_is_clear(&cand, t - self.check, win, d, o, opts);
+                    cand.period_strict |= c && cand.period.is_some();
+                    c
                 }
                 _ => false,
             };
@@ -409,7 +490,11 @@ impl EarlyStop {
             } else {
                 0
             };
-            if self.torus_runs >= TORUS_RUNS && torus_is_clear(long, o, opts) {
+            // What looks like a torus may be an orbit of several turns per period
+            // still converging (the thesis' separated rotations at Omega 1.2): stop
+            // only once its period repeats; a torus runs on to `t_end`.
+            if self.torus_runs >= TORUS_RUNS && whole.period_strict && torus_is_clear(long, o, opts)
+            {
                 cand = whole;
                 clear = true;
             }
@@ -561,6 +646,67 @@ fn torus_is_clear(win: Window<'_>, o: usize, opts: &BasinOptions) -> bool {
     g2 > 1.2 * opts.merge_tol && (g2 - g1).abs() < TORUS_GAP * g2 && z2 > 0.95 * z1
 }
 
+/// Most whole turns of a rotating ball per period looked for (the thesis' separated
+/// rotations take two).
+const MAX_TURNS: usize = 4;
+/// Relative agreement of the durations of one period with the next that calls a
+/// period regular: far above the crossing times' interpolation error (about 1e-5 of a
+/// turn), far below the few per cent a torus modulates a turn by.
+pub const STRICT_PERIOD_TOL: f64 = 1e-3;
+/// Periods compared by the strict test.
+const STRICT_PERIODS: usize = 3;
+/// Largest distance from a whole number of a rotating ball's turns per period.
+const WINDING_TOL: f64 = 0.1;
+
+/// `(turns per period, period)` of a rotating ball from the times it crossed whole
+/// turns: the fewest turns `m` (up to [`MAX_TURNS`]) after which the last
+/// [`STRICT_PERIODS`] periods' turn durations repeat, each to [`STRICT_PERIOD_TOL`].
+fn strict_turn_period(crossings: &[f64]) -> Option<(usize, f64)> {
+    let tau: Vec<f64> = crossings.windows(2).map(|w| w[1] - w[0]).collect();
+    let k = crossings.len();
+    (1..=MAX_TURNS)
+        .take_while(|&m| tau.len() >= STRICT_PERIODS * m)
+        .find(|&m| {
+            (tau.len() - (STRICT_PERIODS - 1) * m..tau.len())
+                .all(|j| (tau[j] - tau[j - m]).abs() <= STRICT_PERIOD_TOL * tau[j])
+        })
+        .map(|m| (m, crossings[k - 1] - crossings[k - 1 - m]))
+}
+
+/// Whether the upward crossings of `x` through its mean over the second half of the
+/// samples `(t, x, x')` repeat with the period `p` over the last [`STRICT_PERIODS`]
+/// periods, each to [`STRICT_PERIOD_TOL`].
+fn oscillation_repeats(xs: &[(f64, f64, f64)], p: f64) -> bool {
+    let half = xs.len() / 2;
+    let tail = &xs[half..];
+    if tail.len() < 2 {
+        return false;
+    }
+    let mean = tail.iter().map(|q| q.1).sum::<f64>() / tail.len() as f64;
+    let ups: Vec<f64> = tail
+        .windows(2)
+        .filter(|w| w[0].1 < mean && w[1].1 >= mean)
+        .map(|w| w[0].0 + (mean - w[0].1) / (w[1].1 - w[0].1) * (w[1].0 - w[0].0))
+        .collect();
+    let Some(&last) = ups.last() else {
+        return false;
+    };
+    // The crossing one period before each of the last periods' ends.
+    let back = |t: f64| {
+        ups.iter()
+            .copied()
+            .find(|&u| (t - u - p).abs() <= STRICT_PERIOD_TOL * p)
+    };
+    let mut t = last;
+    for _ in 0..STRICT_PERIODS {
+        match back(t) {
+            Some(u) => t = u,
+            None => return false,
+        }
+    }
+    true
+}
+
 fn judge<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
@@ -618,6 +764,9 @@ fn judge<D: Dynamics + ?Sized>(
         omega: f64::NAN,
         rates: vec![f64::NAN; n],
         period: None,
+        windings: vec![],
+        period_strict: false,
+        extensions: 0,
         t_stop,
         long_label: None,
         y_end: vec![],
@@ -662,6 +811,9 @@ fn rest_outcome(y: &[f64], t_stop: f64, n: usize, opts: &BasinOptions) -> Outcom
         omega: 0.0,
         rates: vec![0.0; n],
         period: None,
+        windings: vec![],
+        period_strict: false,
+        extensions: 0,
         t_stop,
         long_label: None,
         y_end: y.to_vec(),
@@ -707,6 +859,9 @@ fn label_window(
         omega: f64::NAN,
         rates: rates.clone(),
         period: None,
+        windings: vec![],
+        period_strict: false,
+        extensions: 0,
         t_stop,
         long_label: None,
         y_end: y_end.clone(),
@@ -743,15 +898,56 @@ fn label_window(
         };
         let mut rates = rates.clone();
         let mut period = None;
+        let mut strict = None;
         for i in (0..n).filter(|&i| rot2[i]) {
             let c = crossings_of(i);
             if c.len() >= 2 {
                 let turns = (c.len() - 1) as f64 * 2.0 * PI;
                 rates[i] = rates[i].signum() * turns / (c[c.len() - 1] - c[0]);
             }
-            if period.is_none() {
+            if period.is_none() && strict.is_none() {
+                strict = strict_turn_period(&c);
                 period = turn_period(&c).map(|p| p.1);
             }
+        }
+        // The period is the first rotating ball's; every other rotating ball must turn
+        // a whole number of times per period too (to `WINDING_TOL`, above the bias of
+        // its rate counted over whole turns rather than whole periods), else the
+        // motion does not repeat with it.
+        let strict = strict.filter(|&(_, p)| {
+            (0..n).filter(|&i| rot2[i]).all(|i| {
+                let w = rates[i].abs() * p / (2.0 * PI);
+                w.round() >= 1.0 && (w - w.round()).abs() <= WINDING_TOL
+            })
+        });
+        let period_strict = strict.is_some();
+        let mut windings = vec![];
+        if let Some((m, p)) = strict {
+            period = Some(p);
+            if m > 1 {
+                // A period of several turns: the mean rates over whole periods, free of
+                // the unequal turns' bias a count of whole turns has.
+                let first = (0..n).find(|&i| rot2[i]).unwrap_or(0);
+                for i in (0..n).filter(|&i| rot2[i]) {
+                    let w = if i == first {
+                        m as f64
+                    } else {
+                        (rates[i].abs() * p / (2.0 * PI)).round()
+                    };
+                    rates[i] = rates[i].signum() * w * 2.0 * PI / p;
+                }
+            }
+        }
+        if let Some(p) = period {
+            windings = (0..n)
+                .map(|i| {
+                    if rot2[i] {
+                        -(rates[i] * p / (2.0 * PI)).round() as i64
+                    } else {
+                        0
+                    }
+                })
+                .collect();
         }
         let omega = (0..n).filter(|&i| rot2[i]).map(|i| rates[i]).sum::<f64>() / n_rot as f64;
         let label = match (n, n_rot) {
@@ -774,6 +970,9 @@ fn label_window(
             omega,
             rates,
             period,
+            windings,
+            period_strict,
+            extensions: 0,
             t_stop,
             long_label: None,
             y_end,
@@ -802,12 +1001,18 @@ fn label_window(
         Oscillation::Rest => return rest(&y_end),
         Oscillation::Irregular => None,
     };
+    // The oscillation's own test compares the last two periods to 1 %; the strict
+    // test asks the last three for `STRICT_PERIOD_TOL`.
+    let period_strict = period.is_some_and(|p| oscillation_repeats(&xs, p));
     Outcome {
         label: if n == 2 { Label::OO } else { Label::Other },
         pattern,
         omega: 0.0,
         rates,
         period,
+        windings: period.map(|_| vec![0; n]).unwrap_or_default(),
+        period_strict,
+        extensions: 0,
         t_stop,
         long_label: None,
         y_end,
@@ -877,6 +1082,42 @@ mod tests {
     }
 
     #[test]
+    fn separated_rotations_take_two_turns_per_period() {
+        // Omega 1.2 (figure 4-15): balls started apart rotate separately, with turns
+        // that alternate between two durations (about 21.9 and 32.1 time units, measured
+        // from a simulation at rtol 1e-10): a period of two turns, windings (-2, -2).
+        let p = thesis(1.2);
+        let o = BasinOptions::default();
+        // the first start of the default 12 x 12 grid
+        let start = ground_rest_start(&p, &[PI / 24.0, PI / 8.0]);
+        let out = classify_start(&p, &start, &o).unwrap();
+        assert_eq!(out.label, Label::SeparatedRR);
+        assert!(out.period_strict);
+        assert_eq!(out.windings, vec![-2, -2]);
+        let per = out.period.expect("periodic");
+        assert!((per - (21.8831 + 32.1102)).abs() < 1e-3 * per, "{per}");
+        assert_eq!(out.motion(), "periodic");
+    }
+
+    #[test]
+    fn strict_periods_need_three_repeats() {
+        // turns alternating 2 and 3 time units: two turns per period of 5
+        let mut c = vec![0.0];
+        for k in 0..8 {
+            let last = *c.last().unwrap();
+            c.push(last + if k % 2 == 0 { 2.0 } else { 3.0 });
+        }
+        assert_eq!(strict_turn_period(&c), Some((2, 5.0)));
+        // durations drifting by 1 % a turn (a torus, say) repeat with no period
+        let drift: Vec<f64> = (0..12)
+            .map(|k| f64::from(k) * (1.0 + 0.01 * f64::from(k)))
+            .collect();
+        assert_eq!(strict_turn_period(&drift), None);
+        // too few turns to see three periods of two
+        assert_eq!(strict_turn_period(&c[..6]), None);
+    }
+
+    #[test]
     fn a_cancelled_grid_stops() {
         let p = thesis(1.2);
         let tok = cancel::Token::new();
@@ -897,6 +1138,16 @@ mod tests {
         };
         let e = basin_starts(&p, &[vec![0.0, 1.0]], &o).unwrap_err();
         assert!(matches!(e, Error::InvalidParameter { ref name, .. } if name == "window"));
+        for f in [0.5, 65.0, f64::NAN] {
+            let o = BasinOptions {
+                extend_factor: f,
+                ..Default::default()
+            };
+            let e = basin_starts(&p, &[vec![0.0, 1.0]], &o).unwrap_err();
+            assert!(
+                matches!(e, Error::InvalidParameter { ref name, .. } if name == "extend_factor")
+            );
+        }
         let e = basin_starts(&p, &[vec![0.0]], &BasinOptions::default()).unwrap_err();
         assert!(matches!(e, Error::InvalidParameter { ref name, .. } if name == "starts"));
     }
