@@ -107,8 +107,9 @@ def periodic_branch(
     ``modulus_error`` and ``modulus_error_source`` (the bound on the leading non-trivial
     modulus' error the verdict was judged against, and the two series it compares, as in
     :func:`ballbal.scan`; None without a Floquet verdict), multipliers, certificates, test
-    functions, ``event``: the events located between the previous row and this one), ``events`` (type, parameter, the located solution's summary, the test
-    function's value, ``index``: the row after it), ``solutions`` and
+    functions, ``event``: the events located between the previous row and this one),
+    ``events`` (type, parameter, the located solution's summary, the test function's
+    value, ``index``: the row after it), ``solutions`` and
     ``event_solutions`` (:class:`~ballbal.PeriodicSolution` objects with the model at
     their parameter value, row for row and event for event).
     """
