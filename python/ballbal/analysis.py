@@ -280,7 +280,9 @@ class PeriodicSolution:
     separation_error: float | None = None
     #: Bound on the error of ``max_modulus`` that ``stability`` was judged against: twice
     #: its difference to the same multiplier of a series with more harmonics, plus that
-    #: series' own error measures (see :func:`periodic`). ``None`` without a monodromy.
+    #: series' own error measures (see :func:`periodic`). ``None`` without a monodromy,
+    #: and on a branch, curve or switched orbit (which keep their ``N``) where the trivial
+    #: multiplier's error already leaves the verdict undetermined.
     modulus_error: float | None = None
     #: Which series the bound compares: ``"N 3 vs 5"``.
     modulus_error_source: str | None = None

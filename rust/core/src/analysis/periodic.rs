@@ -739,18 +739,22 @@ fn finish_inner<D: Dynamics + ?Sized>(
             (fl, fl_err) = run_floquet(&sol);
         }
     }
-    match (bound, &opts.floquet, fl.as_mut()) {
-        (Bound::Refining, Some(fo), Some(_)) => {
-            let f = fl.take().expect("matched Some");
-            let b = bound_verdict(p, sol, f, closure, fo, opts);
-            (sol, fl, closure, omega_error) = (b.sol, Some(b.floquet), b.closure, b.omega_error);
-            if let Some(why) = b.unbounded {
-                fl_err.get_or_insert(why);
+    match (bound, &opts.floquet) {
+        (Bound::Refining, Some(fo)) => {
+            if let Some(f) = fl.take() {
+                let b = bound_verdict(p, sol, f, closure, fo, opts);
+                (sol, fl, closure, omega_error) =
+                    (b.sol, Some(b.floquet), b.closure, b.omega_error);
+                if let Some(why) = b.unbounded {
+                    fl_err.get_or_insert(why);
+                }
             }
         }
-        (Bound::OwnHarmonics, Some(fo), Some(f)) => {
-            if let Err(why) = bound_on_branch(p, &sol, f, fo, &opts.hb) {
-                fl_err.get_or_insert(why);
+        (Bound::OwnHarmonics, Some(fo)) => {
+            if let Some(f) = fl.as_mut() {
+                if let Err(why) = bound_on_branch(p, &sol, f, fo, &opts.hb) {
+                    fl_err.get_or_insert(why);
+                }
             }
         }
         _ => {}
