@@ -30,11 +30,14 @@ DECIDED = ("stable", "unstable")
 def _truth_at(sol: ballbal.PeriodicSolution) -> float:
     """The leading non-trivial modulus of the orbit at the row's parameters, by shooting
     from the N = 12 series there; its own error (the trivial multiplier's) must be far
-    below the modulus' distance from 1."""
+    below the modulus' distance from 1. Where the row has a frequency bound, the shot
+    frequency lies within it."""
     ref = ballbal.periodic(sol.balancer, "R-R", N=12, guess=sol)
     assert ref.converged
-    lead, accuracy = _truth(sol.balancer, "R-R", ref, 2)
+    lead, accuracy, omega = _truth(sol.balancer, "R-R", ref, 2, with_omega=True)
     assert accuracy < 0.05 * abs(lead - 1.0), (sol.balancer.Omega, lead, accuracy)
+    if sol.omega_error is not None:
+        assert abs(sol.omega - omega) <= sol.omega_error, (sol.omega, omega, sol.omega_error)
     return lead
 
 
@@ -50,6 +53,7 @@ def _check_rows(br: ballbal.continuation.Branch) -> None:
             assert e < abs(r["max_modulus"] - 1.0), r
             assert r["modulus_error_source"] == "N 3 vs 5", r
             assert br.solutions[k].modulus_error == e
+            assert r["omega_error"] is not None and np.isfinite(r["omega_error"]), r
 
 
 @cache

@@ -38,6 +38,7 @@ def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
         "max_modulus": d["max_modulus"] if d["max_modulus"] is not None or mod is None
         else float(np.sort(mod)[-2] if len(mod) > 1 else mod[0]),
         "modulus_error": d["modulus_error"], "modulus_error_source": d["modulus_error_source"],
+        "omega_error": d["omega_error"],
         "mult_re": re_, "mult_im": im,
         "trivial_error": d["trivial_error"], "closure": d["closure"], "tail": d["tail"],
         "separation_error": d["separation_error"], "residual": d["residual"],
@@ -51,7 +52,7 @@ def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
 def _schema(parameter: str) -> dict[str, Any]:
     f, s, lf = pl.Float64, pl.Utf8, pl.List(pl.Float64)
     return {parameter: f, "omega": f, "period": f, "status": s, "stability": s,
-            "max_modulus": f, "modulus_error": f, "modulus_error_source": s,
+            "max_modulus": f, "modulus_error": f, "modulus_error_source": s, "omega_error": f,
             "mult_re": lf, "mult_im": lf, "trivial_error": f,
             "closure": f, "tail": f, "separation_error": f, "residual": f, "dp_ds": f,
             "det_sign": f, "test_LP": f, "test_BP": f, "test_BP_multipliers": f,
@@ -106,8 +107,9 @@ def periodic_branch(
     per point: the parameter, omega, period, status, stability, max modulus,
     ``modulus_error`` and ``modulus_error_source`` (the bound on the leading non-trivial
     modulus' error the verdict was judged against, and the two series it compares, as in
-    :func:`ballbal.scan`; None without a Floquet verdict), multipliers, certificates, test
-    functions, ``event``: the events located between the previous row and this one),
+    :func:`ballbal.scan`; None without a Floquet verdict), ``omega_error`` (the bound on
+    omega's error from the same pair), multipliers, certificates, test functions,
+    ``event``: the events located between the previous row and this one),
     ``events`` (type, parameter, the located solution's summary, the test function's
     value, ``index``: the row after it), ``solutions`` and
     ``event_solutions`` (:class:`~ballbal.PeriodicSolution` objects with the model at

@@ -324,9 +324,9 @@ pub struct Periodic {
     /// The series' tail relative to the support's motion ([`HbSolution::tail_ratio_on`]
     /// the model's layout).
     pub tail: f64,
-    /// A bound on the error of `sol.omega`, from the series [`bound_verdict`] compares
-    /// with (twice the two frequencies' difference, as the modulus' bound); `None`
-    /// without that comparison. Near the infinite-period end of a rotating branch the
+    /// A bound on the error of `sol.omega`, from the series [`bound_verdict`] (on a
+    /// branch or curve, [`bound_on_branch`]) compares with (twice the two frequencies'
+    /// difference, as the modulus' bound); `None` without that comparison. Near the infinite-period end of a rotating branch the
     /// trivial multiplier's error says little about the frequency's, this does.
     pub omega_error: Option<f64>,
 }
@@ -752,8 +752,13 @@ fn finish_inner<D: Dynamics + ?Sized>(
         }
         (Bound::OwnHarmonics, Some(fo)) => {
             if let Some(f) = fl.as_mut() {
-                if let Err(why) = bound_on_branch(p, &sol, f, fo, &opts.hb) {
-                    fl_err.get_or_insert(why);
+                match bound_on_branch(p, &sol, f, fo, &opts.hb) {
+                    Ok(finer_omega) => {
+                        omega_error = finer_omega.map(|w| 2.0 * (sol.omega - w).abs());
+                    }
+                    Err(why) => {
+                        fl_err.get_or_insert(why);
+                    }
                 }
             }
         }
@@ -921,24 +926,26 @@ fn judge_against_finer<D: Dynamics + ?Sized>(
 /// A verdict the trivial multiplier's error (or the separation check, or the margin)
 /// already leaves undetermined gets no finer series: the bound only widens the margin,
 /// so it could not settle it, and skipping it saves the finer solve and its multipliers
-/// (`modulus_error` is then `None`). `Err` says why there is no bound where the finer
-/// series fails (the verdict is then undetermined).
+/// (`modulus_error` is then `None`). Returns the finer series' frequency (`None`
+/// without it), from which the point's [`Periodic::omega_error`] follows as
+/// `periodic()`'s does; `Err` says why there is no bound where the finer series fails
+/// (the verdict is then undetermined).
 pub fn bound_on_branch<D: Dynamics + ?Sized>(
     p: &D,
     sol: &HbSolution,
     fl: &mut Floquet,
     fo: &FloquetOptions,
     hb: &HbOptions,
-) -> std::result::Result<(), String> {
+) -> std::result::Result<Option<f64>, String> {
     if fl.stability == Stability::Undetermined {
-        return Ok(());
+        return Ok(None);
     }
     let m = finer_harmonics(sol.n_harm);
     let hb = HbOptions {
         samples: hb.samples.map(|s| s.max(default_samples(m))),
         ..hb.clone()
     };
-    judge_against_finer(p, sol, fl, m, fo, &hb).map(|_| ())
+    judge_against_finer(p, sol, fl, m, fo, &hb).map(|(fine, _)| Some(fine.omega))
 }
 
 /// [`bound_verdict`]'s finer series with `m` harmonics, solved from `sol` with `hb`'s
