@@ -9,7 +9,10 @@
 * points per second of natural-parameter (scan) and pseudo-arclength (branch)
   continuation, with and without the per-point Floquet analysis;
 * a 100-point two-parameter curve (the branch point of the band's upper end in
-  (Omega, eta)), with and without Floquet multipliers per point (required: seconds).
+  (Omega, eta)), with and without Floquet multipliers per point (required: seconds);
+* the slow end of a branch: the merged R-R orbit at zeta_b 0.1 continued down in Omega to
+  its infinite-period end (periods up to ~400, where the multipliers dominate a point's
+  cost, and with them the finer series that bounds each verdict's error).
 
     python benchmarks/bench_po_continuation.py
 """
@@ -64,6 +67,21 @@ def curve(br: ballbal.continuation.Branch, opts: ballbal.PeriodicOptions, label:
           f" stop {c.stop}, codim-2 {c.points['type'].to_list()}")
 
 
+def infinite_period_end(opts: ballbal.PeriodicOptions) -> None:
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, Omega=1.0, eta=(1.0, 1.0))
+    start = ballbal.periodic(b, "R-R", options=opts)
+    t = time.perf_counter()
+    br = periodic_branch(start, "Omega", range=(0.5, 1.0), periodic_options=opts,
+                         options=Continuation(ds=0.01, ds_max=0.03, forward=False,
+                                              max_points=200))
+    dt = time.perf_counter() - t
+    n = br.table.height
+    decided = br.table.filter(br.table["stability"] != "undetermined").height
+    print(f"[Floquet] branch to the infinite-period end: {n} points in {dt:.2f} s "
+          f"({n / dt:.1f} points/s), {decided} with a verdict, stop {br.stop}, "
+          f"events {br.events['type'].to_list()}")
+
+
 def main() -> None:
     with_floquet = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8))
     bare = replace(with_floquet, floquet=ballbal.Floquet(monodromy=False, hill=False))
@@ -71,6 +89,7 @@ def main() -> None:
     branch_vs_scan(bare, "no Floquet")
     curve(br, bare, "no Floquet")
     curve(br, with_floquet, "Floquet")
+    infinite_period_end(with_floquet)
 
 
 if __name__ == "__main__":

@@ -37,6 +37,8 @@ def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
         "status": d["status"], "stability": d["stability"],
         "max_modulus": d["max_modulus"] if d["max_modulus"] is not None or mod is None
         else float(np.sort(mod)[-2] if len(mod) > 1 else mod[0]),
+        "modulus_error": d["modulus_error"], "modulus_error_source": d["modulus_error_source"],
+        "omega_error": d["omega_error"],
         "mult_re": re_, "mult_im": im,
         "trivial_error": d["trivial_error"], "closure": d["closure"], "tail": d["tail"],
         "separation_error": d["separation_error"], "residual": d["residual"],
@@ -50,7 +52,8 @@ def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
 def _schema(parameter: str) -> dict[str, Any]:
     f, s, lf = pl.Float64, pl.Utf8, pl.List(pl.Float64)
     return {parameter: f, "omega": f, "period": f, "status": s, "stability": s,
-            "max_modulus": f, "mult_re": lf, "mult_im": lf, "trivial_error": f,
+            "max_modulus": f, "modulus_error": f, "modulus_error_source": s, "omega_error": f,
+            "mult_re": lf, "mult_im": lf, "trivial_error": f,
             "closure": f, "tail": f, "separation_error": f, "residual": f, "dp_ds": f,
             "det_sign": f, "test_LP": f, "test_BP": f, "test_BP_multipliers": f,
             "test_PD": f, "test_NS": f, "event": s}
@@ -89,11 +92,26 @@ def periodic_branch(
     ``T = C / sqrt|p - p*| + D``, the period law near a saddle-node on the invariant
     circle).
 
+    Every verdict is bounded as :func:`ballbal.periodic`'s is, but at the branch's own
+    ``N`` (a branch keeps one truncation): the point's series is solved again from itself
+    with more harmonics (``N 3 vs 5``, ``N 8 vs 12``), and ``modulus_error`` (twice the
+    difference of the leading non-trivial moduli, plus the finer series' own integration
+    error) must be smaller than the modulus' distance to 1 for a verdict; otherwise, or
+    where that finer series fails (the reason is in ``floquet_error`` of the point's
+    solution), the point is ``undetermined`` (its harmonics are not raised along a
+    branch). A point the trivial multiplier's error already leaves undetermined gets no
+    finer series (``modulus_error`` None). The bifurcations are located on the
+    multipliers at ``N``, with or without the bound.
+
     Returns a :class:`~ballbal._branch.Branch` of kind ``"periodic"``: ``table`` (one row
-    per point: the parameter, omega, period, status, stability, max modulus, multipliers,
-    certificates, test functions, ``event``: the events located between the previous row
-    and this one), ``events`` (type, parameter, the located solution's summary, the test
-    function's value, ``index``: the row after it), ``solutions`` and
+    per point: the parameter, omega, period, status, stability, max modulus,
+    ``modulus_error`` and ``modulus_error_source`` (the bound on the leading non-trivial
+    modulus' error the verdict was judged against, and the two series it compares, as in
+    :func:`ballbal.scan`; None without a Floquet verdict), ``omega_error`` (the bound on
+    omega's error from the same pair), multipliers, certificates, test functions,
+    ``event``: the events located between the previous row and this one),
+    ``events`` (type, parameter, the located solution's summary, the test function's
+    value, ``index``: the row after it), ``solutions`` and
     ``event_solutions`` (:class:`~ballbal.PeriodicSolution` objects with the model at
     their parameter value, row for row and event for event).
     """

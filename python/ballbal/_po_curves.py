@@ -60,7 +60,12 @@ def periodic_curve(
     continued with its balls merged.
 
     ``table``: one row per point (the two parameters, ``omega``, ``period``, status,
-    stability and multipliers with ``periodic_options``, ``test`` (the curve's own test
+    stability and multipliers with ``periodic_options``, ``modulus_error`` and
+    ``modulus_error_source`` (the bound on the leading non-trivial modulus' error that the
+    verdict was judged against, from a series with more harmonics, as on a
+    :func:`~ballbal.continuation.periodic_branch`; the point keeps its ``N``, and a
+    verdict the bound leaves open is undetermined; ``omega_error`` from the same pair),
+    ``test`` (the curve's own test
     function, ~0), ``test_*`` (the other kinds' determinants, whose sign changes are the
     codimension-two points), ``flag`` (the codimension-two points located since the
     previous row: the bare label when its multipliers confirm it, ``"LPPD?"`` when they
@@ -136,14 +141,17 @@ def periodic_curve(
             p1: p["p1"], p2: p["p2"], "omega": om,
             "period": None if om is None else 2 * np.pi / om,
             "status": p["status"], "stability": p["stability"],
-            "max_modulus": p["max_modulus"], "mult_re": re_, "mult_im": im,
+            "max_modulus": p["max_modulus"], "modulus_error": p["modulus_error"],
+            "modulus_error_source": p["modulus_error_source"], "omega_error": p["omega_error"],
+            "mult_re": re_, "mult_im": im,
             "trivial_error": p["trivial_error"], "closure": p["closure"],
             "test": p["test"], **({"theta": p["theta"]} if ns else {}),
             **{t: p.get(t) for t in tests}, "flag": flag,
         })
     f, s_, lf = pl.Float64, pl.Utf8, pl.List(pl.Float64)
     schema: dict[str, Any] = {p1: f, p2: f, "omega": f, "period": f, "status": s_,
-                              "stability": s_, "max_modulus": f, "mult_re": lf,
+                              "stability": s_, "max_modulus": f, "modulus_error": f,
+                              "modulus_error_source": s_, "omega_error": f, "mult_re": lf,
                               "mult_im": lf, "trivial_error": f, "closure": f, "test": f,
                               **({"theta": f} if ns else {}), **{t: f for t in tests},
                               "flag": s_}

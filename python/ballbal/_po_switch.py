@@ -51,7 +51,10 @@ def switch(
     critical direction (in the series' coefficients), the parameter left free: near a
     pitchfork, period doubling or Hopf point ``|p - p*|`` grows like the amplitude
     squared. The result is an ordinary :class:`~ballbal.PeriodicSolution` (certificates,
-    multipliers) of the model at the parameter value found; ``info`` holds
+    multipliers) of the model at the parameter value found, at the harmonics it was found
+    with: its verdict's ``modulus_error`` comes from a series with more harmonics, as on
+    a branch, but a verdict that bound leaves open stays undetermined (``N`` is not
+    raised); ``info`` holds
     ``switched_from`` (the kind), ``parameter``, ``value`` and ``critical`` (the
     multiplier, or at a Hopf point the eigenvalue, switched along). ``options`` and the
     keywords as in :func:`~ballbal.periodic` (``N`` sets the harmonics of a Hopf orbit;

@@ -280,13 +280,16 @@ class PeriodicSolution:
     separation_error: float | None = None
     #: Bound on the error of ``max_modulus`` that ``stability`` was judged against: twice
     #: its difference to the same multiplier of a series with more harmonics, plus that
-    #: series' own error measures (see :func:`periodic`). ``None`` without a monodromy.
+    #: series' own error measures (see :func:`periodic`). ``None`` without a monodromy,
+    #: and on a branch, curve or switched orbit (which keep their ``N``) where the trivial
+    #: multiplier's error already leaves the verdict undetermined.
     modulus_error: float | None = None
     #: Which series the bound compares: ``"N 3 vs 5"``.
     modulus_error_source: str | None = None
     #: Bound on the error of ``omega`` from the same comparison (twice the two series'
-    #: frequencies' difference); ``None`` without it. Near the infinite-period end of a
-    #: rotating branch the trivial multiplier's error says little about the frequency's.
+    #: frequencies' difference); ``None`` without it (as ``modulus_error``). Near the
+    #: infinite-period end of a rotating branch the trivial multiplier's error says little
+    #: about the frequency's.
     omega_error: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
 
@@ -457,8 +460,9 @@ def periodic(
     at its natural frequency (its rotating motion past a few tenths above the resonance
     is reached from rest only from a sliver of ball angles); so are the rotating balls of
     a pattern in which others rest on the disk (R-O, O-R: their stable orbits turn at
-    about the natural frequency in the ground frame, omega close to ``Omega - 1``). ``guess`` may be a previous
-    solution (any N; it is truncated or padded) or ``(omega, coeffs)``. ``rtol, atol`` are
+    about the natural frequency in the ground frame, omega close to ``Omega - 1``).
+    ``guess`` may be a previous solution (any N; it is truncated or padded) or
+    ``(omega, coeffs)``. ``rtol, atol`` are
     the RK45 tolerances of the monodromy integration, ``max_steps`` its step budget (a
     longer integration ends in ``floquet_error`` and an undetermined verdict); a verdict
     needs the largest non-trivial modulus further than ``max(margin, trivial_error)``

@@ -8,7 +8,7 @@ use crate::floquet::{
     bounded_verdict, floquet, hill, hill_verdict, judge, Floquet, FloquetOptions, HillTarget,
     Stability, HILL_MAX, HILL_TOL, HILL_VERDICT_ROOM,
 };
-use crate::hb::{defect_closure, solve, HbOptions, HbSolution, Status};
+use crate::hb::{default_samples, defect_closure, solve, HbOptions, HbSolution, Status};
 use crate::model::{first_order_rhs, Dynamics};
 use crate::numerics::problem::Parametric;
 use crate::ode::{solve_at, Options};
@@ -324,9 +324,9 @@ pub struct Periodic {
     /// The series' tail relative to the support's motion ([`HbSolution::tail_ratio_on`]
     /// the model's layout).
     pub tail: f64,
-    /// A bound on the error of `sol.omega`, from the series [`bound_verdict`] compares
-    /// with (twice the two frequencies' difference, as the modulus' bound); `None`
-    /// without that comparison. Near the infinite-period end of a rotating branch the
+    /// A bound on the error of `sol.omega`, from the series [`bound_verdict`] (on a
+    /// branch or curve, [`bound_on_branch`]) compares with (twice the two frequencies'
+    /// difference, as the modulus' bound); `None` without that comparison. Near the infinite-period end of a rotating branch the
     /// trivial multiplier's error says little about the frequency's, this does.
     pub omega_error: Option<f64>,
 }
@@ -633,17 +633,40 @@ pub fn finish<D: Dynamics + ?Sized>(p: &D, sol: HbSolution, opts: &PeriodicOptio
     finish_certified(p, sol, opts, None)
 }
 
-/// [`finish`] at the series' own harmonics, for the points of a branch or curve, whose
-/// continuation needs one truncation throughout: no [`bound_verdict`] (it would refine a
-/// point to more harmonics, and double the multipliers' cost along the branch). Their
-/// verdicts are judged by the trivial multiplier's error as before, and their
-/// `modulus_error` is `None`.
+/// [`finish`] at the series' own harmonics, for the points of a branch or curve (and a
+/// switched branch's first point), whose continuation needs one truncation throughout.
+/// The verdict is bounded as `periodic()`'s is, but against one finer series only
+/// ([`bound_on_branch`]): the point keeps its harmonics, and a verdict the bound leaves
+/// open stays undetermined.
 pub fn finish_on_branch<D: Dynamics + ?Sized>(
     p: &D,
     sol: HbSolution,
     opts: &PeriodicOptions,
 ) -> Periodic {
-    finish_inner(p, sol, opts, None, false)
+    finish_inner(p, sol, opts, None, Bound::OwnHarmonics)
+}
+
+/// [`finish_on_branch`] without the verdict's bound: the multipliers of a trial point
+/// that only a bifurcation's test function reads (its verdict is not reported). Their
+/// verdicts are judged by the trivial multiplier's error alone and `modulus_error` is
+/// `None`.
+pub fn multipliers_on_branch<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: HbSolution,
+    opts: &PeriodicOptions,
+) -> Periodic {
+    finish_inner(p, sol, opts, None, Bound::Unbounded)
+}
+
+/// How [`finish_inner`] bounds the verdict's error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Bound {
+    /// [`bound_verdict`]: refining the series where the bound leaves the verdict open.
+    Refining,
+    /// [`bound_on_branch`]: the series' own harmonics.
+    OwnHarmonics,
+    /// No bound (multipliers for test functions only).
+    Unbounded,
 }
 
 /// [`finish`] of a series whose [`certify`] (with these options) already passed and
@@ -654,7 +677,7 @@ pub fn finish_certified<D: Dynamics + ?Sized>(
     opts: &PeriodicOptions,
     passed: Option<f64>,
 ) -> Periodic {
-    finish_inner(p, sol, opts, passed, true)
+    finish_inner(p, sol, opts, passed, Bound::Refining)
 }
 
 fn finish_inner<D: Dynamics + ?Sized>(
@@ -662,7 +685,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
     sol: HbSolution,
     opts: &PeriodicOptions,
     passed: Option<f64>,
-    bounded: bool,
+    bound: Bound,
 ) -> Periodic {
     let mut sol = sol;
     let mut target_met = None;
@@ -720,14 +743,30 @@ fn finish_inner<D: Dynamics + ?Sized>(
             (fl, fl_err) = run_floquet(&sol);
         }
     }
-    if let (true, Some(fo)) = (bounded, &opts.floquet) {
-        if let Some(f) = fl.take() {
-            let b = bound_verdict(p, sol, f, closure, fo, opts);
-            (sol, fl, closure, omega_error) = (b.sol, Some(b.floquet), b.closure, b.omega_error);
-            if let Some(why) = b.unbounded {
-                fl_err.get_or_insert(why);
+    match (bound, &opts.floquet) {
+        (Bound::Refining, Some(fo)) => {
+            if let Some(f) = fl.take() {
+                let b = bound_verdict(p, sol, f, closure, fo, opts);
+                (sol, fl, closure, omega_error) =
+                    (b.sol, Some(b.floquet), b.closure, b.omega_error);
+                if let Some(why) = b.unbounded {
+                    fl_err.get_or_insert(why);
+                }
             }
         }
+        (Bound::OwnHarmonics, Some(fo)) => {
+            if let Some(f) = fl.as_mut() {
+                match bound_on_branch(p, &sol, f, fo, &opts.hb) {
+                    Ok(finer_omega) => {
+                        omega_error = finer_omega.map(|w| 2.0 * (sol.omega - w).abs());
+                    }
+                    Err(why) => {
+                        fl_err.get_or_insert(why);
+                    }
+                }
+            }
+        }
+        _ => {}
     }
     let hill = if opts.hill
         && sol.status == Status::Converged
@@ -820,25 +859,11 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
     let mut omega_error = None;
     let unbounded = loop {
         let m = finer_harmonics(sol.n_harm);
-        let (fine, ff) = match finer_floquet(p, &sol, m, fo, opts) {
+        let (fine, ff) = match judge_against_finer(p, &sol, &mut fl, m, fo, &opts.hb) {
             Ok(pair) => pair,
-            Err(why) => {
-                fl.stability = Stability::Undetermined;
-                break Some(format!("no error bound: {why}"));
-            }
+            Err(why) => break Some(why),
         };
-        let own = ff.trivial_error.max(ff.method_error.unwrap_or(0.0));
-        let err = 2.0 * (fl.max_modulus - ff.max_modulus).abs() + own;
         omega_error = Some(2.0 * (sol.omega - fine.omega).abs());
-        fl.modulus_error = Some(err);
-        fl.modulus_error_against = Some(m);
-        fl.stability = bounded_verdict(
-            &fl.multipliers,
-            fo,
-            fl.method_error,
-            fl.separation_error,
-            err,
-        );
         // Whatever left the verdict open (the bound, or a trivial multiplier off by more
         // than `max_trivial`: both shrink with the truncation error), more harmonics may
         // settle it; a modulus at 1 to round-off stops at `BOUND_N_MAX`.
@@ -861,15 +886,81 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
     }
 }
 
-/// [`bound_verdict`]'s finer series with `m` harmonics, solved from `sol`, and its
-/// multipliers; why not, if it exceeds the size bound, fails to converge (or converges
-/// to another winding) or its multipliers cannot be computed.
+/// [`bound_verdict`]'s one step: `fl` (the multipliers of `sol`) judged against the
+/// series with `m` harmonics solved from `sol` with `hb`'s settings, which is returned
+/// with its multipliers. The bound is twice the leading non-trivial modulus' difference
+/// to that series' plus the latter's own error measures (its trivial multiplier's error
+/// and Magnus' estimate), and the verdict [`bounded_verdict`]'s. Without the finer series
+/// the verdict is undetermined, and the error says why.
+fn judge_against_finer<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: &HbSolution,
+    fl: &mut Floquet,
+    m: usize,
+    fo: &FloquetOptions,
+    hb: &HbOptions,
+) -> std::result::Result<(HbSolution, Floquet), String> {
+    let (fine, ff) = finer_floquet(p, sol, m, fo, hb).map_err(|why| {
+        fl.stability = Stability::Undetermined;
+        format!("no error bound: {why}")
+    })?;
+    let own = ff.trivial_error.max(ff.method_error.unwrap_or(0.0));
+    let err = 2.0 * (fl.max_modulus - ff.max_modulus).abs() + own;
+    fl.modulus_error = Some(err);
+    fl.modulus_error_against = Some(m);
+    fl.stability = bounded_verdict(
+        &fl.multipliers,
+        fo,
+        fl.method_error,
+        fl.separation_error,
+        err,
+    );
+    Ok((fine, ff))
+}
+
+/// The verdict of a branch or curve point (`fl`, the multipliers of `sol`), bounded as
+/// [`bound_verdict`] bounds `periodic()`'s, against the series with
+/// [`finer_harmonics`], but without refining: the point keeps its harmonics (the
+/// continuation needs one truncation throughout), the finer series only measures the
+/// error, and a verdict the bound leaves open is undetermined. `hb` are the branch's
+/// harmonic-balance settings; the finer series gets at least its own default samples
+/// (a branch fixes the samples for its own harmonics), as `periodic()`'s finer series
+/// has by default.
+///
+/// A verdict the trivial multiplier's error (or the separation check, or the margin)
+/// already leaves undetermined gets no finer series: the bound only widens the margin,
+/// so it could not settle it, and skipping it saves the finer solve and its multipliers
+/// (`modulus_error` is then `None`). Returns the finer series' frequency (`None`
+/// without it), from which the point's [`Periodic::omega_error`] follows as
+/// `periodic()`'s does; `Err` says why there is no bound where the finer series fails
+/// (the verdict is then undetermined).
+pub fn bound_on_branch<D: Dynamics + ?Sized>(
+    p: &D,
+    sol: &HbSolution,
+    fl: &mut Floquet,
+    fo: &FloquetOptions,
+    hb: &HbOptions,
+) -> std::result::Result<Option<f64>, String> {
+    if fl.stability == Stability::Undetermined {
+        return Ok(None);
+    }
+    let m = finer_harmonics(sol.n_harm);
+    let hb = HbOptions {
+        samples: hb.samples.map(|s| s.max(default_samples(m))),
+        ..hb.clone()
+    };
+    judge_against_finer(p, sol, fl, m, fo, &hb).map(|(fine, _)| Some(fine.omega))
+}
+
+/// [`bound_verdict`]'s finer series with `m` harmonics, solved from `sol` with `hb`'s
+/// settings, and its multipliers; why not, if it exceeds the size bound, fails to
+/// converge (or converges to another winding) or its multipliers cannot be computed.
 fn finer_floquet<D: Dynamics + ?Sized>(
     p: &D,
     sol: &HbSolution,
     m: usize,
     fo: &FloquetOptions,
-    opts: &PeriodicOptions,
+    hb: &HbOptions,
 ) -> std::result::Result<(HbSolution, Floquet), String> {
     if p.ndof() * (2 * m + 1) + 1 > MAX_HB_UNKNOWNS {
         return Err(format!(
@@ -878,7 +969,7 @@ fn finer_floquet<D: Dynamics + ?Sized>(
     }
     let hb = HbOptions {
         n_harm: m,
-        ..opts.hb.clone()
+        ..hb.clone()
     };
     let fine = solve(p, sol, &hb);
     if fine.status != Status::Converged || fine.winding != sol.winding {

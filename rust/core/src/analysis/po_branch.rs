@@ -1,9 +1,11 @@
 //! Branches of periodic solutions in one model parameter: pseudo-arclength continuation
 //! ([`crate::continuation::Arclength`]) of the harmonic-balance problem
 //! ([`HbProblem`], unknowns the coefficients and omega), every point certified and
-//! judged exactly as [`crate::periodic::periodic`] does it ([`finish`]: closure and
-//! tail certificates, Floquet multipliers, trivial and separation checks), with the
-//! bifurcations located between points:
+//! judged as [`crate::periodic::periodic`] does it ([`finish_on_branch`]: closure and
+//! tail certificates, Floquet multipliers, trivial and separation checks, the verdict's
+//! error bounded against a finer series while the point keeps the branch's harmonics),
+//! with the bifurcations located between points (on the multipliers at the branch's
+//! harmonics; a trial point of a location gets no bound, its verdict being unused):
 //!
 //! * fold `LP`: the tangent's parameter component `dp/ds` changes sign;
 //! * branch point `BP`: the bordered determinant `det [[F_x, F_p], [t^T]]` changes sign
@@ -33,7 +35,7 @@ use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
 use crate::numerics::problem::{ModelAt, Parametric, Problem};
-use crate::periodic::{finish_on_branch, Periodic, PeriodicOptions};
+use crate::periodic::{finish_on_branch, multipliers_on_branch, Periodic, PeriodicOptions};
 use nalgebra::DMatrix;
 
 /// Settings of [`periodic_branch`].
@@ -209,10 +211,18 @@ impl<D: Parametric> Ctx<'_, D> {
         }
     }
 
-    /// Certificates and multipliers of the point, as `periodic()` gives them.
+    /// Certificates and multipliers of the point, as `periodic()` gives them (the
+    /// verdict bounded at the branch's harmonics: [`finish_on_branch`]).
     fn judge(&self, pt: &ArcPoint) -> Result<Periodic> {
         let m = self.base.with_param(self.name, pt.p)?;
         Ok(finish_on_branch(&m, self.series(pt), &self.popts))
+    }
+
+    /// The multipliers of a trial point of an event's location: its test function
+    /// reads only them, so its verdict is not bounded ([`multipliers_on_branch`]).
+    fn trial(&self, pt: &ArcPoint) -> Result<Periodic> {
+        let m = self.base.with_param(self.name, pt.p)?;
+        Ok(multipliers_on_branch(&m, self.series(pt), &self.popts))
     }
 
     fn point<P: Problem + ?Sized>(&self, prob: &mut P, pt: &ArcPoint) -> Result<PoPoint> {
@@ -528,7 +538,7 @@ fn between<P: Problem + ?Sized, D: Parametric>(
     // Multiplier test functions: evaluated (monodromy or Hill) at each trial point.
     let on_multipliers = |which: usize| {
         move |_: &mut P, pt: &ArcPoint| -> Result<f64> {
-            let r = ctx.judge(pt)?;
+            let r = ctx.trial(pt)?;
             let m = match (&r.floquet, &r.hill) {
                 (Some(f), _) => f.multipliers.clone(),
                 (None, Some((m, _))) => m.clone(),

@@ -1330,7 +1330,8 @@ impl Default for PoCurveOptions {
 #[derive(Debug, Clone)]
 pub struct PoCurvePoint {
     pub p: [f64; 2],
-    /// The series, certified and judged as `periodic()` does.
+    /// The series, certified and judged as `periodic()` does, its verdict bounded at the
+    /// curve's harmonics ([`finish_on_branch`]).
     pub result: Periodic,
     /// The curve's own test function (normalised; for `NS` the modulus of the complex
     /// one), zero to the corrector's tolerance.

@@ -152,9 +152,12 @@ pub struct Floquet {
     pub method_error: Option<f64>,
     /// The bound on `max_modulus`'s error that the verdict was judged against (see
     /// [`crate::periodic::bound_verdict`]): twice its difference to the same multiplier of
-    /// a series with more harmonics, plus that series' own integration measures. `None`
-    /// where no such series was computed: then the verdict is undetermined, except for a
-    /// bare [`floquet`] call, which judges by the trivial multiplier alone.
+    /// a series with more harmonics, plus that series' own integration measures (on a
+    /// branch or curve, [`crate::periodic::bound_on_branch`]: the point keeps its
+    /// harmonics). `None` where no such series was computed: then the verdict is
+    /// undetermined, except for a bare [`floquet`] call and a branch's trial point of an
+    /// event's location ([`crate::periodic::multipliers_on_branch`], whose verdict is not
+    /// reported), which judge by the trivial multiplier alone.
     pub modulus_error: Option<f64>,
     /// The harmonics of the series that [`Floquet::modulus_error`] compares with.
     pub modulus_error_against: Option<usize>,
