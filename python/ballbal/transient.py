@@ -65,15 +65,19 @@ def disturbance_response(
 
     ``model`` may be an autonomous scene (ball springs, a tilting disk): it starts at
     its stable balanced state (:func:`balanced_state`), and ``final_r`` is then that of
-    the balanced state at ``to``, not 0, where springs leave a residual whirl."""
+    the balanced state at ``to``, not 0, where springs leave a residual whirl.
+
+    ``dt`` (the output step) must be at most ``t_end - start``, so that some samples
+    follow the change; ``rtol`` (the integrator's) must be in (0, 1)."""
     _check.model("model", model)
     to = _check.real("to", to, 0.0, lo_open=True)
     start = _check.real("start", start, 0.0)
     duration = _check.real("duration", duration, 0.0, lo_open=True)
     t_end = _check.real("t_end", t_end, start + duration, lo_open=True)
     band = _check.real("band", band, 0.0, lo_open=True)
-    dt = _check.real("dt", dt, 0.0, lo_open=True)
-    rtol = _check.real("rtol", rtol)
+    # At least one sample after the change starts: the peak is read from those.
+    dt = _check.real("dt", dt, 0.0, t_end - start, lo_open=True)
+    rtol = _check.real("rtol", rtol, 0.0, 1.0, lo_open=True, hi_open=True)
     _check.samples_count(t_end, dt, duration_name="t_end")
     q = _balanced_start(model)
     y0 = np.concatenate([q, np.zeros(q.size)])
