@@ -1,7 +1,7 @@
 //! Natural-parameter continuation on a grid: every solution found is continued to its
-//! grid neighbours in all directions (with the secant predictor where the solution
-//! itself came from the neighbour on the opposite side), wave after wave, until no new
-//! solution appears. Each wave reads only what earlier waves produced and runs its
+//! grid neighbours in all directions (from the solution itself; where it came from the
+//! neighbour on the opposite side and that step fails or lands off the branch, from the
+//! secant prediction as well), wave after wave, until no new solution appears. Each wave reads only what earlier waves produced and runs its
 //! points in parallel, so the result does not depend on the thread count.
 
 use super::{Corrector, Secant};
@@ -75,6 +75,18 @@ pub trait Waves: Corrector<At = usize> {
         parent: (usize, usize),
         started: Instant,
     ) -> Option<Self::Found>;
+    /// Whether `corrected`, reached from `from`'s own solution as the guess, left the
+    /// branch that the secant prediction `predicted` follows (it converged nearer to
+    /// another solution). The waves then also try the prediction itself. By default
+    /// never.
+    fn left_the_branch(
+        &self,
+        _predicted: &Self::Point,
+        _corrected: &Self::Point,
+        _from: &Self::Point,
+    ) -> bool {
+        false
+    }
     /// Told after every wave: how long its parallel part took, the duration of every
     /// target point's task and the pool thread it ran on, and how long the serial work
     /// around it took (its targets, the merge of its results). For a caller that
@@ -214,7 +226,14 @@ fn wave_at<W: Waves, L: Lattice>(
     let mut new: Vec<W::Found> = vec![];
     let mut tries = vec![0usize; classes];
     let mut secs = vec![0.0f64; classes];
-    for (p, far) in lattice.neighbours(q) {
+    for (p, _) in lattice.neighbours(q) {
+        // The point beyond `p` on the line from `q` through it: a solution at `p`
+        // continued from there has a secant prediction at `q`.
+        let behind = lattice
+            .neighbours(p)
+            .into_iter()
+            .find(|&(n, _)| n == q)
+            .and_then(|(_, f)| f);
         for &s in &fresh_at[p] {
             if cancel.load(Ordering::Relaxed) {
                 return (new, tries, secs);
@@ -229,41 +248,52 @@ fn wave_at<W: Waves, L: Lattice>(
             }
             let k = W::class(src);
             let t = Instant::now();
-            let previous = match (far, W::parent(src)) {
+            let previous = match (behind, W::parent(src)) {
                 (Some(f), Some((pp, ps))) if pp == f => Some(W::point(&known[pp][ps])),
                 _ => None,
             };
-            // `natural_step`'s guesses (the secant, then the source itself), the last
-            // one told what is known here.
+            // The source itself as the guess, told what is known here. Where it fails,
+            // or converges off the branch the secant through the source's parent
+            // predicts (a step that jumps to a neighbouring branch: what it reaches is
+            // kept), the secant prediction is tried as well, so that the branch is
+            // followed too.
             let current = W::point(src);
-            let secant = previous.map(|b| current.secant(b));
-            let mut point = None;
-            for (i, guess) in secant.iter().chain(Some(current)).enumerate() {
-                tries[k] += 1;
-                let last = (i == usize::from(secant.is_some())).then_some(Known {
-                    class: k,
-                    have: &known[q],
-                    new: &new,
-                });
-                point = w.attempt(q, guess, current, last);
-                if point.is_some() {
-                    break;
+            tries[k] += 1;
+            let last = Known {
+                class: k,
+                have: &known[q],
+                new: &new,
+            };
+            let mut points: Vec<W::Corrected> = w
+                .attempt(q, current, current, Some(last))
+                .into_iter()
+                .collect();
+            if let Some(b) = previous {
+                let predicted = current.secant(b);
+                let off = points
+                    .first()
+                    .is_none_or(|c| w.left_the_branch(&predicted, W::corrected(c), current));
+                if off {
+                    tries[k] += 1;
+                    points.extend(w.attempt(q, &predicted, current, None));
                 }
             }
-            let Some(sol) = point else {
-                secs[k] += t.elapsed().as_secs_f64();
-                continue;
-            };
-            let key = w.key(W::corrected(&sol));
-            // Before completing (e.g. a Floquet analysis), which a known solution does
-            // not need.
-            if !w.admit(&known[q], k, &key) || !w.admit(&new, k, &key) {
+            if points.is_empty() {
                 secs[k] += t.elapsed().as_secs_f64();
                 continue;
             }
-            match w.complete(q, sol, k, key, (p, s), t) {
-                Some(f) => new.push(f),
-                None => secs[k] += t.elapsed().as_secs_f64(),
+            for sol in points {
+                let key = w.key(W::corrected(&sol));
+                // Before completing (e.g. a Floquet analysis), which a known solution
+                // does not need.
+                if !w.admit(&known[q], k, &key) || !w.admit(&new, k, &key) {
+                    secs[k] += t.elapsed().as_secs_f64();
+                    continue;
+                }
+                match w.complete(q, sol, k, key, (p, s), t) {
+                    Some(f) => new.push(f),
+                    None => secs[k] += t.elapsed().as_secs_f64(),
+                }
             }
         }
     }

@@ -13,8 +13,8 @@
 //!    initial states; each attractor's rotation pattern is read off the simulation and
 //!    the harmonic balance is solved from it for every requested type at once.
 //! 2. *Continuation*: every solution found is continued to its grid neighbours in all
-//!    directions (secant predictor where the solution itself came from the opposite
-//!    neighbour), wave after wave, until no new solution appears. This reaches unstable
+//!    directions (from the solution itself, and from the secant prediction where that
+//!    fails or jumps to another branch), wave after wave, until no new solution appears. This reaches unstable
 //!    solutions that no simulation finds, and coexisting ones from different seeds.
 //!
 //! Each wave reads only what earlier waves produced and runs its points in parallel,

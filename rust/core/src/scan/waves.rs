@@ -115,6 +115,17 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
             seconds: started.elapsed().as_secs_f64(),
         })
     }
+    fn left_the_branch(
+        &self,
+        predicted: &HbSolution,
+        corrected: &HbSolution,
+        from: &HbSolution,
+    ) -> bool {
+        // Off by more than half the frequency change the secant predicts (and more
+        // than Newton's tolerance): nearer another branch than the predicted one.
+        let step = (predicted.omega - from.omega).abs();
+        (corrected.omega - predicted.omega).abs() > 0.5 * step + 1e-9 * from.omega.abs()
+    }
     fn wave_times(&self, parallel: Duration, tasks: &[profile::Task], serial: Duration) {
         profile::step(profile::WAVES, parallel, tasks);
         profile::serial(profile::GLUE, serial);
