@@ -65,26 +65,16 @@ pub(super) fn seed_tasks<D: Family>(
     (tasks, starts, seeds)
 }
 
-/// The requested patterns in which some balls rotate and others do not (R-O, O-R).
-fn mixed_patterns<D: Family>(spec: &ScanSpec<'_, D>) -> Vec<usize> {
-    (0..spec.patterns.len())
-        .filter(|&k| {
-            let r = &spec.patterns[k];
-            r.iter().any(|x| *x) && !r.iter().all(|x| *x)
-        })
-        .collect()
-}
-
-/// Whirl starts at the lattice points: for every mixed pattern, each start of
-/// [`pattern_whirl_starts`] at each point, as (point, pattern, start). Simulated like
-/// the starts at rest; a start counts only if it settles on its own pattern, so that
-/// asking for R-O adds no row of another pattern.
+/// Whirl starts at the lattice points: for every requested pattern, each start of
+/// [`pattern_whirl_starts`] (none but for patterns in which some balls rotate and others
+/// rest, R-O, O-R) at each point, as (point, pattern, start). Simulated like the starts
+/// at rest; a start counts only if it settles on its own pattern, so that asking for R-O
+/// adds no row of another pattern.
 pub(super) fn whirl_tasks<D: Family>(
     spec: &ScanSpec<'_, D>,
     lattice: &[usize],
 ) -> Vec<(usize, usize, usize)> {
-    let per: Vec<(usize, usize)> = mixed_patterns(spec)
-        .into_iter()
+    let per: Vec<(usize, usize)> = (0..spec.patterns.len())
         .map(|k| (k, pattern_whirl_starts(spec.base, &spec.patterns[k]).len()))
         .collect();
     lattice
@@ -94,6 +84,35 @@ pub(super) fn whirl_tasks<D: Family>(
                 .flat_map(move |&(k, n)| (0..n).map(move |j| (p, k, j)))
         })
         .collect()
+}
+
+/// The candidate a simulated start `y0` gives at the point of `model`: the attractor it
+/// settles on (or stops at on reaching one of `captures`), if periodic and of a
+/// requested pattern (pattern `only`, where given), solved from its fitted series and
+/// accepted ([`accept`]): its pattern's index, the series and its orbit key.
+fn simulated_candidate<D: Family>(
+    spec: &ScanSpec<'_, D>,
+    model: &D,
+    y0: &[f64],
+    captures: &[Capture],
+    only: Option<usize>,
+) -> Option<(usize, HbSolution, Vec<f64>)> {
+    let g = seed_guess(model, y0, spec.opts.hb.n_harm, &spec.opts.guess, captures)?;
+    let rot: Vec<bool> = g.winding[model.layout().balls()]
+        .iter()
+        .map(|w| *w != 0.0)
+        .collect();
+    let k = match only {
+        Some(k) => (spec.patterns[k] == rot).then_some(k)?,
+        None => spec.patterns.iter().position(|r| *r == rot)?,
+    };
+    count(work::SEED_SOLVE);
+    let sol = solve(model, &g, &spec.opts.hb);
+    if !accept(model, &sol, &g, spec) {
+        return None;
+    }
+    let key = orbit_key(&sol, model.layout().support());
+    Some((k, sol, key))
 }
 
 /// A seed's solved series before its Floquet analysis: (point, type, series, key,
@@ -118,7 +137,6 @@ pub(super) fn run_seeds<D: Family>(
     pb: &[(bool, bool)],
     cancel: &AtomicBool,
 ) -> (Vec<Vec<Found>>, Vec<(usize, usize)>) {
-    let n_harm = spec.opts.hb.n_harm;
     // Starts where the perfect balance is not stable first: they are the long ones
     // (simulations that never settle run the whole window), and a long task started
     // last leaves the other threads idle. Only the schedule changes: the candidates
@@ -153,18 +171,7 @@ pub(super) fn run_seeds<D: Family>(
                 let model = &params[p];
                 // This point's own states: "at rest in the ground frame" depends on its spin.
                 let y0 = &initial_states(model)[starts[s]];
-                let g = seed_guess(model, y0, n_harm, &spec.opts.guess, captures_of(p))?;
-                let rot: Vec<bool> = g.winding[model.layout().balls()]
-                    .iter()
-                    .map(|w| *w != 0.0)
-                    .collect();
-                let k = spec.patterns.iter().position(|r| *r == rot)?;
-                count(work::SEED_SOLVE);
-                let sol = solve(model, &g, &spec.opts.hb);
-                if !accept(model, &sol, &g, spec) {
-                    return None;
-                }
-                let key = orbit_key(&sol, model.layout().support());
+                let (k, sol, key) = simulated_candidate(spec, model, y0, captures_of(p), None)?;
                 Some((i, (p, k, sol, key, t.elapsed().as_secs_f64())))
             })
         })
@@ -183,20 +190,7 @@ pub(super) fn run_seeds<D: Family>(
                 let t = Instant::now();
                 let model = &params[p];
                 let y0 = &pattern_whirl_starts(model, &spec.patterns[k])[start];
-                let g = seed_guess(model, y0, n_harm, &spec.opts.guess, captures_of(p))?;
-                let rot: Vec<bool> = g.winding[model.layout().balls()]
-                    .iter()
-                    .map(|w| *w != 0.0)
-                    .collect();
-                if rot != spec.patterns[k] {
-                    return None;
-                }
-                count(work::SEED_SOLVE);
-                let sol = solve(model, &g, &spec.opts.hb);
-                if !accept(model, &sol, &g, spec) {
-                    return None;
-                }
-                let key = orbit_key(&sol, model.layout().support());
+                let (k, sol, key) = simulated_candidate(spec, model, y0, captures_of(p), Some(k))?;
                 let secs = t.elapsed().as_secs_f64();
                 Some((tasks.len() + j, (p, k, sol, key, secs)))
             })
