@@ -326,8 +326,9 @@ pub struct Periodic {
     pub tail: f64,
     /// A bound on the error of `sol.omega`, from the series [`bound_verdict`] (on a
     /// branch or curve, [`bound_on_branch`]) compares with (twice the two frequencies'
-    /// difference, as the modulus' bound); `None` without that comparison. Near the infinite-period end of a rotating branch the
-    /// trivial multiplier's error says little about the frequency's, this does.
+    /// difference, as the modulus' bound); `None` without that comparison. Near the
+    /// infinite-period end of a rotating branch the trivial multiplier's error says
+    /// little about the frequency's, this does.
     pub omega_error: Option<f64>,
 }
 
@@ -519,8 +520,7 @@ pub fn whirl_starts<D: Parametric>(p: &D) -> Vec<Vec<f64>> {
 /// ball at angle `beta` (four angles) turning at ground rate `s = 1` (the natural
 /// frequency), the other rotating balls spread evenly behind it at the same rate, the
 /// resting balls on the disk a quarter turn ahead of `beta`, and the disk on the linear
-/// response to all of
-/// them and the imbalance: `mu eta_j s^2 e^(i beta_j) / (1 - s^2 + 2 i zeta s)` per
+/// response to all of them and the imbalance: `mu eta_j s^2 e^(i beta_j) / (1 - s^2 + 2 i zeta s)` per
 /// rotating ball, `mu eta_j Omega^2 e^(i gamma_j) / (1 - Omega^2 + 2 i zeta Omega)` per
 /// resting one and `mu Omega^2 / (1 - Omega^2 + 2 i zeta Omega)` (ground frame at
 /// `t = 0`). Empty unless the pattern mixes rotating and resting balls, without damping
@@ -552,42 +552,41 @@ pub fn pattern_whirl_starts<D: Parametric>(p: &D, rotating: &[bool]) -> Vec<Vec<
     let spin_gain = om * om / (1.0 - om * om + 2.0 * i * z * om);
     let n_rot = rotating.iter().filter(|r| **r).count();
     let s = 1.0;
+    // The resting balls a quarter turn ahead: a quarter turn behind found no stable R-O
+    // that ahead missed on the nine thesis maps, the map and the census' point,
+    // at twice the starts' cost.
+    const AHEAD: f64 = PI / 2.0;
     let mut out = vec![];
     let whirl_gain = s * s / (1.0 - s * s + 2.0 * i * z * s);
     for k in 0..4 {
         let beta = -PI + (k as f64 + 0.1) * PI / 2.0;
-        // The other side (a quarter turn behind) found no stable R-O that this one
-        // missed on the nine thesis maps, the map and the census' point, and
-        // doubled the starts' cost.
-        for side in [0.5] {
-            let mut y = vec![0.0; 2 * d];
-            // The disk's response to what turns with it (imbalance, resting balls)
-            // and to what whirls at `s` (rotating balls).
-            let (mut with_disk, mut whirling) = (mu * spin_gain, Complex::new(0.0, 0.0));
-            let mut kr = 0;
-            for j in 0..n {
-                let angle = if rotating[j] {
-                    kr += 1;
-                    let a = beta + 2.0 * PI * (kr - 1) as f64 / n_rot as f64;
-                    whirling += mu * eta[j] * whirl_gain * Complex::from_polar(1.0, a);
-                    y[d + o + j] = s - om;
-                    a
-                } else {
-                    let a = beta + side * PI;
-                    with_disk += mu * eta[j] * spin_gain * Complex::from_polar(1.0, a);
-                    a
-                };
-                y[o + j] = angle;
-            }
-            let zz = with_disk + whirling;
-            // rotating-frame velocity: the ground velocity less the frame's turn
-            let dz = i * om * with_disk + i * s * whirling - i * om * zz;
-            y[0] = zz.re;
-            y[1] = zz.im;
-            y[d] = dz.re;
-            y[d + 1] = dz.im;
-            out.push(y);
+        let mut y = vec![0.0; 2 * d];
+        // The disk's response to what turns with it (imbalance, resting balls)
+        // and to what whirls at `s` (rotating balls).
+        let (mut with_disk, mut whirling) = (mu * spin_gain, Complex::new(0.0, 0.0));
+        let mut kr = 0;
+        for j in 0..n {
+            let angle = if rotating[j] {
+                kr += 1;
+                let a = beta + 2.0 * PI * (kr - 1) as f64 / n_rot as f64;
+                whirling += mu * eta[j] * whirl_gain * Complex::from_polar(1.0, a);
+                y[d + o + j] = s - om;
+                a
+            } else {
+                let a = beta + AHEAD;
+                with_disk += mu * eta[j] * spin_gain * Complex::from_polar(1.0, a);
+                a
+            };
+            y[o + j] = angle;
         }
+        let zz = with_disk + whirling;
+        // rotating-frame velocity: the ground velocity less the frame's turn
+        let dz = i * om * with_disk + i * s * whirling - i * om * zz;
+        y[0] = zz.re;
+        y[1] = zz.im;
+        y[d] = dz.re;
+        y[d + 1] = dz.im;
+        out.push(y);
     }
     out
 }
@@ -757,9 +756,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
         (Bound::OwnHarmonics, Some(fo)) => {
             if let Some(f) = fl.as_mut() {
                 match bound_on_branch(p, &sol, f, fo, &opts.hb) {
-                    Ok(finer_omega) => {
-                        omega_error = finer_omega.map(|w| 2.0 * (sol.omega - w).abs());
-                    }
+                    Ok(bound) => omega_error = bound,
                     Err(why) => {
                         fl_err.get_or_insert(why);
                     }
@@ -859,11 +856,11 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
     let mut omega_error = None;
     let unbounded = loop {
         let m = finer_harmonics(sol.n_harm);
-        let (fine, ff) = match judge_against_finer(p, &sol, &mut fl, m, fo, &opts.hb) {
-            Ok(pair) => pair,
+        let (fine, ff, w_err) = match judge_against_finer(p, &sol, &mut fl, m, fo, &opts.hb) {
+            Ok(judged) => judged,
             Err(why) => break Some(why),
         };
-        omega_error = Some(2.0 * (sol.omega - fine.omega).abs());
+        omega_error = Some(w_err);
         // Whatever left the verdict open (the bound, or a trivial multiplier off by more
         // than `max_trivial`: both shrink with the truncation error), more harmonics may
         // settle it; a modulus at 1 to round-off stops at `BOUND_N_MAX`.
@@ -888,7 +885,8 @@ pub fn bound_verdict<D: Dynamics + ?Sized>(
 
 /// [`bound_verdict`]'s one step: `fl` (the multipliers of `sol`) judged against the
 /// series with `m` harmonics solved from `sol` with `hb`'s settings, which is returned
-/// with its multipliers. The bound is twice the leading non-trivial modulus' difference
+/// with its multipliers and the bound on `sol.omega`'s error it gives (twice the two
+/// frequencies' difference, [`Periodic::omega_error`]). The bound is twice the leading non-trivial modulus' difference
 /// to that series' plus the latter's own error measures (its trivial multiplier's error
 /// and Magnus' estimate), and the verdict [`bounded_verdict`]'s. Without the finer series
 /// the verdict is undetermined, and the error says why.
@@ -899,7 +897,7 @@ fn judge_against_finer<D: Dynamics + ?Sized>(
     m: usize,
     fo: &FloquetOptions,
     hb: &HbOptions,
-) -> std::result::Result<(HbSolution, Floquet), String> {
+) -> std::result::Result<(HbSolution, Floquet, f64), String> {
     let (fine, ff) = finer_floquet(p, sol, m, fo, hb).map_err(|why| {
         fl.stability = Stability::Undetermined;
         format!("no error bound: {why}")
@@ -915,7 +913,8 @@ fn judge_against_finer<D: Dynamics + ?Sized>(
         fl.separation_error,
         err,
     );
-    Ok((fine, ff))
+    let omega_error = 2.0 * (sol.omega - fine.omega).abs();
+    Ok((fine, ff, omega_error))
 }
 
 /// The verdict of a branch or curve point (`fl`, the multipliers of `sol`), bounded as
@@ -930,10 +929,9 @@ fn judge_against_finer<D: Dynamics + ?Sized>(
 /// A verdict the trivial multiplier's error (or the separation check, or the margin)
 /// already leaves undetermined gets no finer series: the bound only widens the margin,
 /// so it could not settle it, and skipping it saves the finer solve and its multipliers
-/// (`modulus_error` is then `None`). Returns the finer series' frequency (`None`
-/// without it), from which the point's [`Periodic::omega_error`] follows as
-/// `periodic()`'s does; `Err` says why there is no bound where the finer series fails
-/// (the verdict is then undetermined).
+/// (`modulus_error` is then `None`). Returns the point's [`Periodic::omega_error`] from
+/// the finer series, as `periodic()`'s (`None` without it); `Err` says why there is no
+/// bound where the finer series fails (the verdict is then undetermined).
 pub fn bound_on_branch<D: Dynamics + ?Sized>(
     p: &D,
     sol: &HbSolution,
@@ -949,7 +947,7 @@ pub fn bound_on_branch<D: Dynamics + ?Sized>(
         samples: hb.samples.map(|s| s.max(default_samples(m))),
         ..hb.clone()
     };
-    judge_against_finer(p, sol, fl, m, fo, &hb).map(|(fine, _)| Some(fine.omega))
+    judge_against_finer(p, sol, fl, m, fo, &hb).map(|(_, _, omega_error)| Some(omega_error))
 }
 
 /// [`bound_verdict`]'s finer series with `m` harmonics, solved from `sol` with `hb`'s

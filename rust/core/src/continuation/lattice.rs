@@ -1,8 +1,9 @@
 //! Natural-parameter continuation on a grid: every solution found is continued to its
 //! grid neighbours in all directions (from the solution itself; where it came from the
 //! neighbour on the opposite side and that step fails or lands off the branch, from the
-//! secant prediction as well), wave after wave, until no new solution appears. Each wave reads only what earlier waves produced and runs its
-//! points in parallel, so the result does not depend on the thread count.
+//! secant prediction as well), wave after wave, until no new solution appears. Each
+//! wave reads only what earlier waves produced and runs its points in parallel, so the
+//! result does not depend on the thread count.
 
 use super::{Corrector, Secant};
 use crate::error::{Error, Result};
