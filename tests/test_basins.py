@@ -393,7 +393,7 @@ def test_starts_of_one_class_link_to_distinct_orbits_by_period_and_rates(monkeyp
 
     solved = []
 
-    def fake(model, r, state, options, N, d, periodic):  # noqa: N803
+    def fake(model, r, state, options, N, periodic):  # noqa: N803
         solved.append((r["b1"], r["b2"]))
         return {k: None for k in bmod.ORBIT_SCHEMA} | {
             "label": r["label"], "winding1": r["winding1"], "winding2": r["winding2"],

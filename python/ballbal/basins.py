@@ -235,20 +235,33 @@ class Basins:
         y0[d - n:d] = balls
         y0[2 * d - n:] = -m.Omega
         o = self.options
-        # Over as many turns per period as the start's windings say (two for the
-        # thesis' separated rotations), after as long as the start was simulated.
+        # After as long as the start was simulated.
         wind = [row.get(f"winding{i + 1}") for i in range(n)]
-        rot = None if None in wind else [w != 0 for w in wind]
-        turns = next((abs(w) for w in wind if w), 1) if rot is not None else 1
-        got = _native.attractor_series(m, y0, N, min(max(o.t_end, row.get("t_stop") or 0), 1e5),
-                                       max(o.window, 20 * row["period"]),
-                                       o.rtol * 1e-3, o.atol * 1e-3, rot, turns)
-        if got is None:
-            return None
-        omega, coeffs, rotating = got
-        pattern = "-".join("R" if r else "O" for r in rotating)
-        return periodic(m, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N,
-                        windings=wind if rot is not None and any(rot) else None)
+        return _fitted_orbit(m, y0, None if None in wind else wind,
+                             min(max(o.t_end, row.get("t_stop") or 0), 1e5),
+                             max(o.window, 20 * row["period"]), o, N, periodic)
+
+
+def _fitted_orbit(model: Balancer | Scene, y0: Any, wind: Sequence[Any] | None, settle: float,
+                  window: float, options: BasinOptions, N: int,  # noqa: N803
+                  periodic: Any) -> Any:
+    """:func:`ballbal.analysis.periodic` of the attractor reached from ``y0``: the series
+    fitted to it after ``settle`` time units, observed for ``window`` at a thousandth of
+    the basin run's tolerances over as many whole turns per period as the windings
+    ``wind`` say (two for the thesis' separated rotations; any pattern without them),
+    solved with its pattern and those windings. ``None`` when no series is fitted."""
+    d = len(model.coordinates)
+    rot = None if wind is None else [w != 0 for w in wind]
+    turns = next((abs(w) for w in wind if w), 1) if wind is not None else 1
+    got = _native.attractor_series(model, np.asarray(y0, dtype=np.float64), N, settle,
+                                   window, options.rtol * 1e-3, options.atol * 1e-3, rot,
+                                   turns)
+    if got is None:
+        return None
+    omega, coeffs, rotating = got
+    pattern = "-".join("R" if r else "O" for r in rotating)
+    return periodic(model, pattern, guess=(omega, coeffs.reshape(d, -1)), N=N,
+                    windings=wind if rot is not None and any(rot) else None)
 
 
 class _BasinStore:
@@ -573,7 +586,6 @@ def _link_orbits(model: Balancer | Scene, table: pl.DataFrame, states: list[list
     orbits' table."""
     from .analysis import periodic
 
-    d = len(model.coordinates)
     col: list[int | None] = [None] * table.height
     found: list[dict[str, Any]] = []
     refs: list[tuple[float, list[float]]] = []  # (period, rates) matched against
@@ -592,7 +604,7 @@ def _link_orbits(model: Balancer | Scene, table: pl.DataFrame, states: list[list
                 hit = j
                 break
         if hit is None:
-            row, ref = _solve_orbit(model, r, states[k], options, N, d, periodic)
+            row, ref = _solve_orbit(model, r, states[k], options, N, periodic)
             row["orbit"] = len(found)
             found.append(row)
             refs.append((ref, rates))
@@ -603,13 +615,12 @@ def _link_orbits(model: Balancer | Scene, table: pl.DataFrame, states: list[list
 
 
 def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
-                 options: BasinOptions, N: int, d: int,  # noqa: N803
+                 options: BasinOptions, N: int,  # noqa: N803
                  periodic: Any) -> tuple[dict[str, Any], float]:
     """The orbits-table row of the orbit reached by the start ``r`` (ending in
     ``state``) and the period later starts are matched against."""
     wind = [int(r["winding1"]), int(r["winding2"])]
     rotating = [w != 0 for w in wind]
-    turns = next((abs(w) for w in wind if w), 1)
     per = float(r["period"])
     row: dict[str, Any] = {
         "label": r["label"], "pattern": "-".join("R" if x else "O" for x in rotating),
@@ -618,15 +629,10 @@ def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
         "stability": None, "max_modulus": None, "modulus_error": None, "N": None,
         "b1": r["b1"], "b2": r["b2"]}
     cap = 1e5  # GuessOptions' longest settle and window
-    got = _native.attractor_series(
-        model, np.asarray(state, dtype=np.float64), N, min(10 * per, cap),
-        min(max(options.window, 20 * per), cap), options.rtol * 1e-3, options.atol * 1e-3,
-        rotating, turns)
-    if got is None:
+    sol = _fitted_orbit(model, state, wind, min(10 * per, cap),
+                        min(max(options.window, 20 * per), cap), options, N, periodic)
+    if sol is None:
         return row, per
-    omega, coeffs, _ = got
-    sol = periodic(model, row["pattern"], guess=(omega, coeffs.reshape(d, -1)),
-                   windings=wind if any(rotating) else None, N=N)
     row.update(status=sol.status, omega=sol.omega, N=sol.N)
     if sol.omega is None:
         return row, per
