@@ -39,10 +39,12 @@ How:
   infinite-period end, periods of thousands) gets doubling windows up to ``--t-slow``
   (cheap: the integrator's steps are long there).
 * ballbal is then run as a user would, at default options and with every pattern of the
-  ball count, on a 1-point grid at the point and, separately, on a small grid holding it
-  (5 Omega values 0.05 apart times 3 eta values 0.1 apart; ``eta[0]`` for unequal
-  balls). A periodic attractor is *listed* by a scan when a row at the point has its
-  pattern (up to relabelling identical balls), ``stability == "stable"`` and
+  ball count and the period doubling of each (``"R-R[-2,-2]"``, ``"O-R[0,-2]"``: every
+  rotating ball two turns per period), on a 1-point grid at the point and, separately,
+  on a small grid holding it (5 Omega values 0.05 apart times 3 eta values 0.1 apart;
+  ``eta[0]`` for unequal balls). A periodic attractor is *listed* by a scan when a row
+  at the point has its type (pattern, with the windings for one that turns more than
+  once per period, up to relabelling identical balls), ``stability == "stable"`` and
   ``|omega_row - omega_sim| <= max(3 trivial_error, 1e-3 omega)`` plus the simulation's
   own uncertainty: issue 31 measured the scan's frequency error below 1.36
   ``trivial_error``, and 1e-3 is far below the spacing of coexisting orbits of one
@@ -508,8 +510,28 @@ def issue_points() -> list[Point]:
 
 
 def all_patterns(n: int) -> list[str]:
-    """Every rotation pattern of ``n`` balls, ballbal's ball order."""
-    return ["-".join(c) for c in itertools.product("RO", repeat=n)]
+    """Every rotation pattern of ``n`` balls, ballbal's ball order, and the period
+    doubling of each with a rotating ball (``"R-O[-2,0]"``: every rotating ball two
+    turns per period), as scan types."""
+    plain = ["-".join(c) for c in itertools.product("RO", repeat=n)]
+    doubled = [type_name(q, tuple(-2 if c == "R" else 0 for c in q.split("-")))
+               for q in plain if "R" in q]
+    return plain + doubled
+
+
+def type_name(pattern: str, windings: Sequence[int]) -> str:
+    """ballbal's scan type of an orbit: its pattern, with the windings in brackets when
+    some ball turns more than once per period."""
+    if all(abs(w) <= 1 for w in windings):
+        return pattern
+    return f"{pattern}[{','.join(str(w) for w in windings)}]"
+
+
+def _parse_type(kind: str) -> tuple[list[str], list[int] | None]:
+    """Letters and (for a wound type) windings of a scan type name."""
+    pattern, _, rest = kind.partition("[")
+    wind = [int(w) for w in rest.rstrip("]").split(",")] if rest else None
+    return pattern.split("-"), wind
 
 
 @dataclass
@@ -523,7 +545,8 @@ class ScanResult:
 
 
 def scan_point(p: Point) -> ScanResult:
-    """``ballbal.scan`` at default options, every pattern, as a user would call it."""
+    """``ballbal.scan`` at default options, every pattern and its period doubling, as a
+    user would call it."""
     b = p.balancer()
     pats = all_patterns(p.n)
     t = time.perf_counter()
@@ -561,9 +584,14 @@ def _canonical(p: Point, o: Outcome) -> tuple[str, tuple[int, ...]]:
     return min(forms)
 
 
-def _relabelled_patterns(p: Point, pattern: str) -> set[str]:
-    letters = pattern.split("-")
-    return {"-".join(letters[i] for i in perm) for perm in p.relabellings()}
+def _relabelled_types(p: Point, kind: str) -> set[str]:
+    """A scan type's names under every relabelling of identical balls."""
+    letters, wind = _parse_type(kind)
+    out = set()
+    for perm in p.relabellings():
+        pattern = "-".join(letters[i] for i in perm)
+        out.add(pattern if wind is None else type_name(pattern, [wind[i] for i in perm]))
+    return out
 
 
 def group(p: Point, outcomes: Sequence[Outcome]) -> tuple[list[Attractor], list[Outcome]]:
@@ -618,7 +646,7 @@ def listed(p: Point, a: Attractor, rows: pl.DataFrame,
         ok = any(e.stability == "stable" for e in near)
         return ok, "" if ok else ("equilibria(): " + (", ".join(
             f"{e.kind} {e.stability}" for e in near) or "none there"))
-    pats = _relabelled_patterns(p, o.pattern)
+    pats = _relabelled_types(p, type_name(o.pattern, o.windings))
     cand = rows.filter(pl.col("type").is_in(sorted(pats)) & pl.col("omega").is_not_null())
     for r in cand.iter_rows(named=True):
         if (r["stability"] == "stable"
@@ -626,7 +654,7 @@ def listed(p: Point, a: Attractor, rows: pl.DataFrame,
                                                       o.unc)):
             return True, f"d_omega {abs(r['omega'] - o.omega):.1e}"
     if cand.height == 0:
-        return False, f"no {o.pattern} row"
+        return False, f"no {type_name(o.pattern, o.windings)} row"
     r = min(cand.iter_rows(named=True), key=lambda r: abs(r["omega"] - o.omega))
     return False, (f"nearest {r['type']} row: omega {r['omega']:.6f} {r['stability']} "
                    f"|mu| {r['max_modulus']}")
@@ -639,8 +667,9 @@ def unreached(p: Point, atts: list[Attractor], rows: pl.DataFrame) -> list[str]:
             a.kind == "perfect_balance" for a in atts):
         out.append("perfect balance (pb_stable)")
     for r in rows.filter(pl.col("stability") == "stable").iter_rows(named=True):
-        pats = _relabelled_patterns(p, r["type"])
-        hit = any(a.kind == "periodic" and a.example.pattern in pats
+        pats = _relabelled_types(p, r["type"])
+        hit = any(a.kind == "periodic"
+                  and type_name(a.example.pattern, a.example.windings) in pats
                   and abs(r["omega"] - a.example.omega)
                   <= _tol(a.example.omega, r["trivial_error"], a.example.unc)
                   for a in atts)

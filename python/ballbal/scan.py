@@ -649,6 +649,17 @@ def scan(  # noqa: E302 - overloads above
     ``grid`` mapping (needed for ``"eta[0]"``); each is a sequence, ``(start, stop, step)``
     or ``"start:stop:step"``. Any number of axes; the first varies fastest in the table.
 
+    ``patterns``: the solution types, each a rotation pattern (one letter per ball, ``R``
+    turning round the track, ``O`` oscillating, joined by ``-``: ``"R-R"``, ``"R-O"``) or
+    a pattern followed by the balls' whole turns per period in brackets, for orbits that
+    wind more than once per period: ``"R-R[-2,-2]"`` (each ball makes two turns per
+    period, as balls rotating separately do when their turns alternate in length),
+    ``"O-R[0,-2]"`` (a period-doubled O-R orbit). The ``type`` column holds the name as
+    given. A type's rows do not depend on which other types are asked for. Seeds are
+    observed over as many turns as the most wound type asks for, and a series that is a
+    shorter orbit written several times (a wound branch at its period doubling) is
+    neither reported nor continued.
+
     ``options``: a :class:`~ballbal.ScanOptions` (what is computed; default
     :data:`ballbal.options.SCAN_DEFAULTS`, whose tolerances and guess search differ from
     :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`). The flat keywords

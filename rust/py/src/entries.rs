@@ -13,7 +13,7 @@ use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{
-    closure_error, parse_pattern, parse_windings, periodic_searched, require_autonomous,
+    closure_error, parse_solution_type, parse_windings, periodic_searched, require_autonomous,
     PeriodicOptions,
 };
 use ballbal_core::scan::{Family, ScanRow, ScanSpec};
@@ -366,7 +366,7 @@ pub fn scan(
     let m = autonomous(&model, always_scene, "scan")?;
     let rots = patterns
         .iter()
-        .map(|s| parse_pattern(s, m.n_balls()))
+        .map(|s| parse_solution_type(s, m.n_balls()))
         .collect::<Result<Vec<_>, _>>()
         .py()?;
     let opts = args.to_core_for(&m)?;

@@ -183,14 +183,29 @@ pub fn guess_with_turns<D: Dynamics + ?Sized>(
 ///
 /// `rests`: equilibria of `model` known to attract their neighbourhood (see
 /// [`Capture`]); a motion that enters one's capture radius stops there as at rest.
+///
+/// `max_turns`: a rotating motion whose turns do not repeat one by one is tried over
+/// 2, ..., `max_turns` turns per period (the first that repeats is the series' period),
+/// for scans that ask for orbits winding more than once (a period-doubled orbit's turns
+/// alternate in length). With 1, such a motion gives no guess.
 pub fn seed_guess<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
     n_harm: usize,
     g: &GuessOptions,
     rests: &[Capture],
+    max_turns: usize,
 ) -> Option<HbSolution> {
-    classify_with(model, y0, None, 1, n_harm, g, Some(rests)).into_series()
+    classify_with(
+        model,
+        y0,
+        None,
+        1..=max_turns.max(1),
+        n_harm,
+        g,
+        Some(rests),
+    )
+    .into_series()
 }
 
 /// A linearly stable equilibrium (every eigenvalue's real part at most `-rate`) with a
@@ -429,7 +444,7 @@ fn classify_as<D: Dynamics + ?Sized>(
     n_harm: usize,
     g: &GuessOptions,
 ) -> Attractor {
-    classify_with(model, y0, want, turns, n_harm, g, None)
+    classify_with(model, y0, want, turns..=turns, n_harm, g, None)
 }
 
 /// [`classify_as`]; `quick` (`Some(rests)`): as for [`seed_guess`].
@@ -437,7 +452,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
     want: Option<&[bool]>,
-    turns: usize,
+    turns: std::ops::RangeInclusive<usize>,
     n_harm: usize,
     g: &GuessOptions,
     rests: Option<&[Capture]>,
@@ -488,7 +503,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     let mut end_b = start_b.clone();
     let mut xs: Vec<(f64, f64, f64)> = vec![]; // (t, x, x') for oscillating detection
     let mut tmp = vec![0.0; 2 * d];
-    let need = 6.max(2 * turns + 2);
+    let need = 6.max(2 * turns.end() + 2);
     let mut watch = RestWatch::new(g.settle);
     let mut rested = false;
     let mut solver = Dopri5::new(2 * d);
@@ -545,7 +560,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     }
     let r = detected.iter().position(|&b| b);
     let (t_c, period) = if let Some(r) = r {
-        match turns_period(&crossings[r], turns) {
+        match turns.clone().find_map(|m| turns_period(&crossings[r], m)) {
             Some(p) => p,
             None => return NotSettled,
         }
@@ -791,7 +806,7 @@ mod tests {
         let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
         let y0 = &initial_states(&p)[0];
         let a = guess_from_state(&p, y0, None, 3, &g).unwrap();
-        let b = seed_guess(&p, y0, 3, &g, &[]).unwrap();
+        let b = seed_guess(&p, y0, 3, &g, &[], 1).unwrap();
         // The seed stops settling once its turns return to 1e-5: its guess differs by
         // the transient left then, and the harmonic balance makes one orbit of both.
         assert!((a.omega - b.omega).abs() < 1e-5 * a.omega);
@@ -818,7 +833,7 @@ mod tests {
         y1[2] += 0.05;
         y1[3] -= 0.05;
         assert!(matches!(
-            classify_with(&q, &y1, None, 1, 3, &g, Some(&[])),
+            classify_with(&q, &y1, None, 1..=1, 3, &g, Some(&[])),
             Attractor::Rest
         ));
     }
@@ -939,8 +954,8 @@ mod tests {
                     .collect();
                 assert!(!caps.is_empty(), "om {om} eta {eta}");
                 for y0 in initial_states(&p).iter().step_by(4) {
-                    let full = classify_with(&p, y0, None, 1, 3, &g, Some(&[]));
-                    let fast = classify_with(&p, y0, None, 1, 3, &g, Some(&caps));
+                    let full = classify_with(&p, y0, None, 1..=1, 3, &g, Some(&[]));
+                    let fast = classify_with(&p, y0, None, 1..=1, 3, &g, Some(&caps));
                     match (&full, &fast) {
                         (
                             Attractor::Periodic { series: a, .. },

@@ -65,10 +65,7 @@ pub fn parse_windings(
 ) -> crate::Result<Vec<f64>> {
     let rotating = parse_pattern(pattern, n_balls)?;
     let Some(w) = windings else {
-        return Ok(rotating
-            .iter()
-            .map(|&r| if r { -1.0 } else { 0.0 })
-            .collect());
+        return Ok(plain_windings(&rotating));
     };
     let allowed = format!(
         "{n_balls} integers, non-zero (|w| <= {MAX_WINDING}) for each R ball of the pattern and 0 for each O ball"
@@ -99,6 +96,77 @@ pub fn parse_windings(
         }
     }
     Ok(w.iter().map(|&v| v as f64).collect())
+}
+
+/// The balls' windings of the usual orbit of a pattern: `-1` per rotating ball (one
+/// turn per period, lagging the disk), 0 per oscillating one.
+pub fn plain_windings(rotating: &[bool]) -> Vec<f64> {
+    rotating
+        .iter()
+        .map(|&r| if r { -1.0 } else { 0.0 })
+        .collect()
+}
+
+/// A solution type as a scan asks for it: a pattern (`"R-R"`), or a pattern with the
+/// balls' windings in brackets (`"R-R[-2,-2]"`, the period-doubled R-R orbit;
+/// `"O-R[0,-2]"`), checked as [`parse_windings`] checks them. Returns the balls'
+/// windings. Windings equal to the pattern's own (`"R-R[-1,-1]"`) are refused with the
+/// short form, so that one type has one name.
+pub fn parse_solution_type(spec: &str, n_balls: usize) -> crate::Result<Vec<f64>> {
+    let Some((pattern, rest)) = spec.split_once('[') else {
+        return Ok(plain_windings(&parse_pattern(spec, n_balls)?));
+    };
+    let allowed = format!(
+        "a pattern, optionally followed by {n_balls} windings in brackets, e.g. \"{}[{}]\"",
+        vec!["R"; n_balls.max(1)].join("-"),
+        vec!["-2"; n_balls.max(1)].join(",")
+    );
+    let rotating = parse_pattern(pattern, n_balls)?;
+    let inner = rest.strip_suffix(']').ok_or_else(|| {
+        crate::Error::param_range("pattern", format!("{spec:?} must end with ']'"), &allowed)
+    })?;
+    let w: Vec<i64> = inner
+        .split(',')
+        .map(|x| x.trim().parse::<i64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| {
+            crate::Error::param_range(
+                "pattern",
+                format!("{spec:?}: the windings must be integers separated by ','"),
+                &allowed,
+            )
+        })?;
+    let wound = parse_windings(pattern, Some(&w), n_balls)?;
+    if wound == plain_windings(&rotating) {
+        return Err(crate::Error::param_range(
+            "pattern",
+            format!("write {spec:?} as \"{pattern}\" (these are its usual windings)"),
+            allowed,
+        ));
+    }
+    Ok(wound)
+}
+
+/// How many times a series with these windings could repeat within its period: the
+/// greatest common divisor of the balls' turns (1 when no ball turns).
+pub fn repetitions(winding: &[f64]) -> usize {
+    fn gcd(a: u64, b: u64) -> u64 {
+        if b == 0 {
+            a
+        } else {
+            gcd(b, a % b)
+        }
+    }
+    let g = winding.iter().fold(0u64, |g, w| gcd(g, w.abs() as u64));
+    g.max(1) as usize
+}
+
+/// Whether the series is an orbit of a shorter period written several times over its
+/// own (its windings allow it: [`repetitions`]), as a period-doubled branch becomes at
+/// its period doubling.
+pub fn is_repeated(sol: &HbSolution) -> bool {
+    let m = repetitions(&sol.winding);
+    m > 1 && repeats(sol, m)
 }
 
 /// Whether the series repeats `m` times per period (only harmonics that are multiples
@@ -362,11 +430,7 @@ pub fn periodic<D: Dynamics + ?Sized>(
     guess: Option<&HbSolution>,
     opts: &PeriodicOptions,
 ) -> Periodic {
-    let ball_winding: Vec<f64> = rotating
-        .iter()
-        .map(|&r| if r { -1.0 } else { 0.0 })
-        .collect();
-    periodic_wound(p, &ball_winding, guess, opts)
+    periodic_wound(p, &plain_windings(rotating), guess, opts)
 }
 
 /// [`periodic`] with the balls' windings per period given ([`parse_windings`]). With a
@@ -1268,7 +1332,10 @@ mod tests {
             base: &base,
             names: vec!["Omega".into(), "eta".into()],
             values: vec![om.clone(), eta.clone()],
-            patterns: vec![vec![true, true], vec![false, false], vec![true, false]],
+            patterns: [[true, true], [false, false], [true, false]]
+                .iter()
+                .map(|r| plain_windings(r))
+                .collect(),
             opts: PeriodicOptions {
                 floquet: Some(scan_floquet_default()),
                 guess: GuessOptions {
@@ -1315,6 +1382,37 @@ mod tests {
             );
         }
         println!("grid worst defect {worst_defect:.3e}");
+    }
+
+    #[test]
+    fn solution_types_carry_windings_in_brackets() {
+        assert_eq!(parse_solution_type("R-O", 2).unwrap(), vec![-1.0, 0.0]);
+        assert_eq!(
+            parse_solution_type("R-R[-2,-2]", 2).unwrap(),
+            vec![-2.0, -2.0]
+        );
+        assert_eq!(
+            parse_solution_type("O-R[0, -2]", 2).unwrap(),
+            vec![0.0, -2.0]
+        );
+        for (bad, name) in [
+            ("R-R[-1,-1]", "pattern"),
+            ("R-R[-2,-2", "pattern"),
+            ("R-R[x,-2]", "pattern"),
+            ("R-R[-2]", "windings"),
+            ("R-O[-2,-2]", "windings"),
+            ("RR[-2,-2]", "pattern"),
+        ] {
+            let e = parse_solution_type(bad, 2).unwrap_err();
+            assert!(
+                matches!(&e, crate::Error::InvalidParameter { name: n, .. } if n == name),
+                "{bad:?}: {e}"
+            );
+        }
+        assert_eq!(repetitions(&[0.0, 0.0, -2.0, -2.0]), 2);
+        assert_eq!(repetitions(&[0.0, 0.0, -2.0, -1.0]), 1);
+        assert_eq!(repetitions(&[0.0, 0.0, 0.0, -3.0]), 3);
+        assert_eq!(repetitions(&[0.0, 0.0, 0.0, 0.0]), 1);
     }
 
     #[test]

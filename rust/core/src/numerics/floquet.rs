@@ -1731,7 +1731,10 @@ mod tests {
                 (0..=n).map(|i| lo + step * i as f64).collect()
             };
             let spec = ScanSpec {
-                patterns: pats.iter().map(|x| x.1.clone()).collect(),
+                patterns: pats
+                    .iter()
+                    .map(|x| crate::periodic::plain_windings(&x.1))
+                    .collect(),
                 seeds: 4,
                 block: 8,
                 chunk: 8,

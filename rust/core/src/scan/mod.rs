@@ -248,7 +248,7 @@ pub(crate) mod tests {
             base,
             names: vec!["Omega".into(), "eta".into()],
             values: vec![om.to_vec(), eta.to_vec()],
-            patterns: vec![vec![true, true]],
+            patterns: vec![vec![-1.0, -1.0]],
             opts: PeriodicOptions {
                 hb: HbOptions::default(),
                 floquet: Some(scan_floquet_default()),

@@ -5,7 +5,7 @@ use super::grid::Local;
 use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
 use super::{count, profile, work, Family, Found, Origin, ScanSpec};
 use crate::analysis::attractors::{seed_guess, Capture};
-use crate::analysis::periodic::pattern_whirl_starts;
+use crate::analysis::periodic::{pattern_whirl_starts, plain_windings, repetitions};
 use crate::continuation::Lattice;
 use crate::hb::{solve, HbSolution, Status};
 use crate::periodic::{finish, initial_states};
@@ -75,7 +75,7 @@ pub(super) fn whirl_tasks<D: Family>(
     lattice: &[usize],
 ) -> Vec<(usize, usize, usize)> {
     let per: Vec<(usize, usize)> = (0..spec.patterns.len())
-        .map(|k| (k, pattern_whirl_starts(spec.base, &spec.patterns[k]).len()))
+        .map(|k| (k, whirl_starts_of(spec.base, &spec.patterns[k]).len()))
         .collect();
     lattice
         .iter()
@@ -86,10 +86,32 @@ pub(super) fn whirl_tasks<D: Family>(
         .collect()
 }
 
+/// The whirl starts of a solution type: [`pattern_whirl_starts`] of its pattern for the
+/// usual windings, none for an orbit winding more than once per period.
+fn whirl_starts_of<D: Family>(model: &D, winding: &[f64]) -> Vec<Vec<f64>> {
+    let rotating: Vec<bool> = winding.iter().map(|w| *w != 0.0).collect();
+    if *winding != plain_windings(&rotating) {
+        return vec![];
+    }
+    pattern_whirl_starts(model, &rotating)
+}
+
+/// Whether a seed's series with the balls' windings `w` is of the requested type with
+/// windings `want`: the same windings for a type that winds more than once per period;
+/// the same pattern, winding once, for a plain type (a ball that turns forwards is
+/// still an R ball).
+fn of_type(w: &[f64], want: &[f64]) -> bool {
+    let rotating: Vec<bool> = want.iter().map(|x| *x != 0.0).collect();
+    if *want != plain_windings(&rotating) {
+        return w == want;
+    }
+    repetitions(w) == 1 && w.iter().zip(&rotating).all(|(a, r)| (*a != 0.0) == *r)
+}
+
 /// The candidate a simulated start `y0` gives at the point of `model`: the attractor it
 /// settles on (or stops at on reaching one of `captures`), if periodic and of a
-/// requested pattern (pattern `only`, where given), solved from its fitted series and
-/// accepted ([`accept`]): its pattern's index, the series and its orbit key.
+/// requested type (type `only`, where given), solved from its fitted series and
+/// accepted ([`accept`]): its type's index, the series and its orbit key.
 fn simulated_candidate<D: Family>(
     spec: &ScanSpec<'_, D>,
     model: &D,
@@ -97,14 +119,25 @@ fn simulated_candidate<D: Family>(
     captures: &[Capture],
     only: Option<usize>,
 ) -> Option<(usize, HbSolution, Vec<f64>)> {
-    let g = seed_guess(model, y0, spec.opts.hb.n_harm, &spec.opts.guess, captures)?;
-    let rot: Vec<bool> = g.winding[model.layout().balls()]
+    // Observed over as many turns as the most wound type asks for.
+    let max_turns = spec
+        .patterns
         .iter()
-        .map(|w| *w != 0.0)
-        .collect();
+        .map(|w| repetitions(w))
+        .max()
+        .unwrap_or(1);
+    let g = seed_guess(
+        model,
+        y0,
+        spec.opts.hb.n_harm,
+        &spec.opts.guess,
+        captures,
+        max_turns,
+    )?;
+    let w = &g.winding[model.layout().balls()];
     let k = match only {
-        Some(k) => (spec.patterns[k] == rot).then_some(k)?,
-        None => spec.patterns.iter().position(|r| *r == rot)?,
+        Some(k) => of_type(w, &spec.patterns[k]).then_some(k)?,
+        None => spec.patterns.iter().position(|want| of_type(w, want))?,
     };
     count(work::SEED_SOLVE);
     let sol = solve(model, &g, &spec.opts.hb);
@@ -189,7 +222,7 @@ pub(super) fn run_seeds<D: Family>(
                 }
                 let t = Instant::now();
                 let model = &params[p];
-                let y0 = &pattern_whirl_starts(model, &spec.patterns[k])[start];
+                let y0 = &whirl_starts_of(model, &spec.patterns[k])[start];
                 let (k, sol, key) = simulated_candidate(spec, model, y0, captures_of(p), Some(k))?;
                 let secs = t.elapsed().as_secs_f64();
                 Some((tasks.len() + j, (p, k, sol, key, secs)))

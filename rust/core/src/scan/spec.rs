@@ -11,8 +11,11 @@ pub struct ScanSpec<'a, D: Family> {
     pub base: &'a D,
     pub names: Vec<String>,
     pub values: Vec<Vec<f64>>,
-    /// Rotation pattern per requested solution type.
-    pub patterns: Vec<Vec<bool>>,
+    /// The balls' windings per requested solution type
+    /// ([`crate::periodic::parse_solution_type`]): `-1` per rotating and 0 per
+    /// oscillating ball for a plain pattern, more turns for an orbit that winds more
+    /// than once per period (`[-2, -2]`: the period-doubled R-R orbit).
+    pub patterns: Vec<Vec<f64>>,
     pub opts: PeriodicOptions,
     /// Seed points per parameter over the whole grid (their spacing in grid steps is
     /// `ceil(len / seeds)`); every chunk gets at least one seed line.

@@ -6,7 +6,7 @@ use super::{count, profile, work, Family, Found, Origin, ScanSpec};
 use crate::continuation::lattice::Known;
 use crate::continuation::{Corrector, Waves};
 use crate::hb::{solve, HbSolution, Status};
-use crate::periodic::finish_certified;
+use crate::periodic::{finish_certified, is_repeated};
 use std::time::{Duration, Instant};
 
 /// Most solutions of one type kept at one point: a guard against a duplicate test
@@ -145,7 +145,9 @@ pub(super) fn accept<D: Family>(
     resolved(model, s, guess, spec) && certified(model, &mut s.clone(), spec).is_some()
 }
 
-/// [`accept`]'s first part: converged, of the guess's pattern, resolved.
+/// [`accept`]'s first part: converged, of the guess's pattern, resolved, and not an
+/// orbit of a shorter period written several times (a period-doubled branch continued
+/// to its period doubling becomes the single orbit twice over, which is its own type's).
 fn resolved<D: Family>(
     model: &D,
     s: &HbSolution,
@@ -155,6 +157,7 @@ fn resolved<D: Family>(
     s.status == Status::Converged
         && s.winding == guess.winding
         && s.tail_ratio_on(model.layout().support()) <= spec.max_tail
+        && !is_repeated(s)
 }
 
 /// [`accept`]'s second part: the orbit-closure certificate (with N = "auto" only after
