@@ -100,3 +100,23 @@ def test_bad_wound_types_are_refused(kind: str, needle: str) -> None:
     with pytest.raises(ParameterError, match="pattern|windings") as e:
         ballbal.scan(SEPARATED, Omega=[1.2], patterns=[kind])
     assert needle in f"{e.value} {e.value.allowed}"
+
+
+def test_periodic_names_the_single_orbit_written_twice() -> None:
+    # The single-turn R-R orbit at the point, written over two of its periods (harmonic
+    # k becomes 2k, half the frequency): a solution of the (-2, -2) equations that is
+    # not a period-doubled orbit. Newton started on it stays there, and periodic() says
+    # so instead of calling it converged.
+    b = SEPARATED
+    single = ballbal.periodic(b, "R-R", N=3)
+    assert single.converged
+    c = single.coeffs
+    doubled = np.zeros((c.shape[0], 2 * (c.shape[1] - 1) + 1))
+    doubled[:, 0] = c[:, 0]
+    for k in range(1, (c.shape[1] - 1) // 2 + 1):
+        doubled[:, 4 * k - 1] = c[:, 2 * k - 1]
+        doubled[:, 4 * k] = c[:, 2 * k]
+    out = ballbal.periodic(b, "R-R", windings=(-2, -2), guess=(single.omega / 2, doubled),
+                           N=6)
+    assert out.status == "repeated"
+    assert out.stability == "undetermined"

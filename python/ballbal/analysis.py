@@ -513,6 +513,10 @@ def periodic(
     * A series without winding whose harmonics are at round-off (below 1e-9 of its
       size) is an equilibrium, which solves the equations at any ``omega``: status
       ``equilibrium`` (no orbit, no frequency).
+    * With ``windings`` of several turns, a series whose only non-zero harmonics are
+      multiples of the balls' common winding is the orbit of a shorter period written
+      several times (a period-doubled orbit's solve can fall back to the orbit it
+      doubled): status ``repeated``, no verdict.
     * ``trivial_error``: no stability verdict (``undetermined``) unless the trivial
       multiplier is within ``max_trivial`` of 1; the same for ``hill_stability``.
     * ``separation_error`` (merged balls, i.e. identical balls on the same motion, only):
@@ -533,7 +537,7 @@ def periodic(
       (``"N 5 vs 8"``). The same comparison bounds the frequency: ``omega_error`` is
       twice the two series' frequencies' difference.
 
-    A ``not_closed``, ``truncated`` or ``equilibrium`` result keeps ``coeffs`` (and,
+    A ``not_closed``, ``truncated``, ``equilibrium`` or ``repeated`` result keeps ``coeffs`` (and,
     but for an equilibrium, ``omega``) for inspection but has no multipliers and no
     verdict. A solve that fails is returned with
     its ``status`` (``diverged``, ``singular``, ``max_iterations``, ``no_guess``) and

@@ -352,7 +352,8 @@ fn defect_points(sol: &HbSolution) -> usize {
 }
 
 /// Certifies a converged series: its status becomes `Equilibrium` if it does not move
-/// ([`HbSolution::is_still`]), `Truncated` if the highest harmonic exceeds `max_tail`,
+/// ([`HbSolution::is_still`]), `Repeated` if it is a shorter orbit written several
+/// times ([`is_repeated`]), `Truncated` if the highest harmonic exceeds `max_tail`,
 /// `NotClosed` if the integrated defect exceeds `max_closure`.
 /// Returns the integrated defect (`None` for a series that did not converge).
 pub fn certify<D: Dynamics + ?Sized>(
@@ -366,6 +367,8 @@ pub fn certify<D: Dynamics + ?Sized>(
     let closure = crate::hb::timed_certificate(|| defect_closure(p, sol, defect_points(sol)));
     if sol.is_still() {
         sol.status = Status::Equilibrium;
+    } else if is_repeated(sol) {
+        sol.status = Status::Repeated;
     } else if !(sol.tail_ratio_on(p.layout().support()) <= opts.max_tail) {
         sol.status = Status::Truncated;
     } else if !(closure <= opts.max_closure) {
@@ -437,7 +440,7 @@ pub fn periodic<D: Dynamics + ?Sized>(
 /// winding of more than one turn and no guess, the simulated starts are observed over
 /// as many turns of the first rotating ball; a start whose series turns out to repeat
 /// within the period (an orbit of a shorter period, written several times) is kept only
-/// if no start gives a genuine one.
+/// if no start gives a genuine one, with status `Repeated` (as [`certify`] marks it).
 pub fn periodic_wound<D: Dynamics + ?Sized>(
     p: &D,
     ball_winding: &[f64],
@@ -664,7 +667,7 @@ fn wound_search<D: Dynamics + ?Sized>(
     opts: &PeriodicOptions,
 ) -> HbSolution {
     let o = p.first_ball();
-    // Converged and genuine; converged but repeating; the first failure.
+    // Converged and genuine; converged on a repeated orbit; the first failure.
     let mut repeating: Option<HbSolution> = None;
     let mut failed: Option<HbSolution> = None;
     for y0 in initial_states(p) {
@@ -678,10 +681,11 @@ fn wound_search<D: Dynamics + ?Sized>(
         if opts.auto.is_none() {
             certify(p, &mut s, opts);
         }
-        if s.status == Status::Converged {
-            if !repeats(&s, turns) {
-                return s;
-            }
+        if s.status == Status::Converged && !repeats(&s, turns) {
+            return s;
+        }
+        if matches!(s.status, Status::Converged | Status::Repeated) {
+            s.status = Status::Repeated;
             repeating.get_or_insert(s);
         } else {
             failed.get_or_insert(s);
@@ -798,7 +802,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
                 Status::Converged if passed.is_some() => passed,
                 Status::Converged => certify(p, &mut sol, opts),
                 // Already certified (and refused) by `periodic`'s search: keep its measure.
-                Status::NotClosed | Status::Truncated | Status::Equilibrium => {
+                Status::NotClosed | Status::Truncated | Status::Equilibrium | Status::Repeated => {
                     Some(defect_closure(p, &sol, defect_points(&sol)))
                 }
                 _ => None,

@@ -190,6 +190,11 @@ pub enum Status {
     /// is an equilibrium, which solves the equations at any `omega` — no periodic orbit
     /// and no frequency.
     Equilibrium,
+    /// Newton converged on an orbit of a shorter period written several times over the
+    /// period asked for (only its harmonics that are multiples of the balls' common
+    /// winding are non-zero): the orbit the windings asked for, e.g. a period-doubled
+    /// one, is not this ([`crate::periodic::is_repeated`]).
+    Repeated,
 }
 
 impl Status {
@@ -203,6 +208,7 @@ impl Status {
             Status::NotClosed => "not_closed",
             Status::Truncated => "truncated",
             Status::Equilibrium => "equilibrium",
+            Status::Repeated => "repeated",
         }
     }
 }
