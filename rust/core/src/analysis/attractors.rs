@@ -187,7 +187,8 @@ pub fn guess_with_turns<D: Dynamics + ?Sized>(
 /// `max_turns`: a rotating motion whose turns do not repeat one by one is tried over
 /// 2, ..., `max_turns` turns per period (the first that repeats is the series' period),
 /// for scans that ask for orbits winding more than once (a period-doubled orbit's turns
-/// alternate in length). With 1, such a motion gives no guess.
+/// alternate in length); its series then has `n_harm` harmonics per turn. With 1, such
+/// a motion gives no guess.
 pub fn seed_guess<D: Dynamics + ?Sized>(
     model: &D,
     y0: &[f64],
@@ -559,8 +560,11 @@ fn classify_with<D: Dynamics + ?Sized>(
         }
     }
     let r = detected.iter().position(|&b| b);
-    let (t_c, period) = if let Some(r) = r {
-        match turns.clone().find_map(|m| turns_period(&crossings[r], m)) {
+    let (m, t_c, period) = if let Some(r) = r {
+        match turns
+            .clone()
+            .find_map(|m| turns_period(&crossings[r], m).map(|(t, p)| (m, t, p)))
+        {
             Some(p) => p,
             None => return NotSettled,
         }
@@ -568,8 +572,16 @@ fn classify_with<D: Dynamics + ?Sized>(
         match oscillation_period(&xs) {
             Oscillation::Rest => return Rest,
             Oscillation::Irregular => return NotSettled,
-            Oscillation::Period(t, p) => (t, p),
+            Oscillation::Period(t, p) => (1, t, p),
         }
+    };
+    // A scan's seeds (`quick`) ask for `n_harm` harmonics per turn: an orbit of two
+    // turns written with the harmonics of one is half as resolved (at N = 3 the census'
+    // period-doubled O-R fell back to the single orbit twice over; at 8 it did not).
+    let n_harm = if quick && *turns.start() < *turns.end() {
+        n_harm * m
+    } else {
+        n_harm
     };
     // Re-simulate one period at collocation times for the fit.
     let s = crate::hb::default_samples(n_harm) * 2;

@@ -140,7 +140,7 @@ fn simulated_candidate<D: Family>(
         None => spec.patterns.iter().position(|want| of_type(w, want))?,
     };
     count(work::SEED_SOLVE);
-    let sol = solve(model, &g, &spec.opts.hb);
+    let sol = solve(model, &g, &spec.hb_for(&g.winding));
     if !accept(model, &sol, &g, spec) {
         return None;
     }

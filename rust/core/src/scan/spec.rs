@@ -99,6 +99,19 @@ impl<D: Family> ScanSpec<'_, D> {
         Ok(())
     }
 
+    /// The harmonic balance's settings for a type with the balls' windings `winding`:
+    /// `opts.hb`'s harmonics (and samples, where set) per turn of an orbit that winds
+    /// several times per period ([`crate::periodic::repetitions`]), so that a
+    /// period-doubled orbit is as resolved as the single one.
+    pub fn hb_for(&self, winding: &[f64]) -> crate::hb::HbOptions {
+        let m = crate::periodic::repetitions(winding);
+        crate::hb::HbOptions {
+            n_harm: self.opts.hb.n_harm * m,
+            samples: self.opts.hb.samples.map(|s| s * m),
+            ..self.opts.hb.clone()
+        }
+    }
+
     /// Chunk length actually used: `chunk` rounded up to whole blocks, so that no block
     /// is ever split between chunks (a split block would continue less).
     pub fn chunk_len(&self) -> usize {

@@ -71,7 +71,7 @@ impl<D: Family> Waves for BlockWaves<'_, '_, D> {
     ) -> Option<Certified> {
         let model = &self.params[at];
         count(work::WAVE_SOLVE);
-        let mut r = solve(model, guess, &self.spec.opts.hb);
+        let mut r = solve(model, guess, &self.spec.hb_for(&guess.winding));
         if !resolved(model, &r, from, self.spec) {
             return None;
         }
