@@ -120,3 +120,41 @@ def test_periodic_names_the_single_orbit_written_twice() -> None:
                            N=6)
     assert out.status == "repeated"
     assert out.stability == "undetermined"
+
+
+#: The census' random point 32 (seed 31): one start of 16 settled on a stable
+#: period-doubled O-R orbit (O ball 1, ball 2 two turns per period) that no scan listed.
+CENSUS_PD = ballbal.Balancer(mu=0.243, zeta=0.0497, zeta_b=0.1378, delta=15.927,
+                             Omega=1.4647, eta=(0.9629, 1.3147))
+#: That start's state after 8000 time units of the census' DOP853 simulation (rtol
+#: 1e-10), at the section where it was judged settled; period about 2 pi / 0.243414.
+CENSUS_PD_STATE = [1.33056099, -2.75394134, -10.4973164, -1200.08839, -1.18997956,
+                   -0.760057006, -0.169119643, -0.515343085]
+
+
+def test_period_doubled_orbits_are_seeded_from_the_orbits_they_double() -> None:
+    b = CENSUS_PD
+    y0, T = shoot(b, np.array(CENSUS_PD_STATE), 2 * np.pi / 0.243414, [0, 0, 0, -2], 3)
+    ev = monodromy_multipliers(b, y0, T)
+    trivial = int(np.argmin(np.abs(ev - 1.0)))
+    lead = float(np.max(np.abs(np.delete(ev, trivial))))
+    assert abs(ev[trivial] - 1.0) < 1e-4 and 0.85 < lead < 0.95
+    grid = {"Omega": [b.Omega + d * 0.05 for d in (-2, -1, 0, 1, 2)],
+            "eta[0]": [0.8629, 0.9629, 1.0629]}
+    alone = ballbal.scan(b, grid=grid, patterns=["O-R[0,-2]"])
+    both = ballbal.scan(b, grid=grid, patterns=["O-R", "O-R[0,-2]"])
+    # The single-turn O-R orbits are solved either way (unreported when not asked
+    # for), so the doubled type's rows are the same.
+    key = ["Omega", "eta[0]", "solution"]
+    a = alone.sort(key).select(*key, "status", "stability", "origin")
+    c = both.filter(pl.col("type") == "O-R[0,-2]").sort(key).select(*key, "status",
+                                                                    "stability", "origin")
+    assert a.equals(c)
+    at = _rows(alone, "O-R[0,-2]").filter((pl.col("Omega") == b.Omega)
+                                           & (pl.col("eta[0]") == 0.9629))
+    assert at.height == 1, alone.filter(pl.col("status") == "converged")
+    row = at.row(0, named=True)
+    assert row["origin"] == "period_doubling" and row["N"] == 6
+    assert abs(row["omega"] - 2 * np.pi / T) <= row["omega_error"] + 1e-8
+    assert row["stability"] == "stable"
+    assert abs(row["max_modulus"] - lead) <= row["modulus_error"] + 1e-4

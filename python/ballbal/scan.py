@@ -655,10 +655,15 @@ def scan(  # noqa: E302 - overloads above
     wind more than once per period: ``"R-R[-2,-2]"`` (each ball makes two turns per
     period, as balls rotating separately do when their turns alternate in length),
     ``"O-R[0,-2]"`` (a period-doubled O-R orbit). The ``type`` column holds the name as
-    given. A type's rows do not depend on which other types are asked for. Seeds are
-    observed over as many turns as the most wound type asks for, and a series that is a
-    shorter orbit written several times (a wound branch at its period doubling) is
-    neither reported nor continued.
+    given. A type's rows do not depend on which other types are asked for. A wound
+    type's series has ``N`` harmonics per turn (``N`` column: 6 for ``"R-R[-2,-2]"`` at
+    ``N=3``). Seeds are observed over as many turns as the most wound type asks for; a
+    period-doubled type is also started from every orbit of the type it doubles that has
+    a real multiplier below -1 (past a period doubling), displaced along that
+    multiplier's mode (``origin`` ``period_doubling``), and that type is solved,
+    unreported, where it was not asked for. A series that is a shorter orbit written
+    several times (a doubled branch at its period doubling) is neither reported nor
+    continued.
 
     ``options``: a :class:`~ballbal.ScanOptions` (what is computed; default
     :data:`ballbal.options.SCAN_DEFAULTS`, whose tolerances and guess search differ from
@@ -687,7 +692,8 @@ def scan(  # noqa: E302 - overloads above
     response to them), since such stable orbits are reached from rest only from a
     sliver of starts; then every solution is continued to its grid neighbours until
     nothing new appears. ``origin`` says how a row's solution was reached: ``seed``
-    (simulated start at that point), ``continuation`` (from a neighbour), ``none`` (no
+    (simulated start at that point), ``continuation`` (from a neighbour),
+    ``period_doubling`` (from the orbit it doubles, see ``patterns``), ``none`` (no
     solution). Continuation does not cross block edges, so
     ``block`` is a numerical option (smaller blocks find fewer continued solutions);
     the table depends on it and on nothing else of the layout. Coexisting solutions of

@@ -402,6 +402,45 @@ pub fn switch_periodic<D: Parametric>(
     }
 }
 
+/// Starts for an orbit born in a period doubling of `sol`, at `sol`'s own parameters
+/// (no continuation in a parameter, as a scan needs at a grid point): the orbit written
+/// over two periods ([`repeated`]) displaced along the critical mode (the series of
+/// `Phi(t) e` over two periods, `e` the monodromy's eigenvector of its real multiplier
+/// nearest -1, scaled to unit norm) by each of `amplitudes`. Past a supercritical period
+/// doubling (that multiplier below -1) the doubled orbit lies at a distance that grows
+/// like the square root of the distance from the bifurcation, so several amplitudes are
+/// tried. `None` when the orbit has no real negative multiplier or the mode's series
+/// cannot be integrated.
+pub fn period_doubling_starts<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    fo: &FloquetOptions,
+    amplitudes: &[f64],
+) -> Option<Vec<HbSolution>> {
+    let (_, e) = critical_mode(model, sol, Switch::PeriodDoubling, fo).ok()?;
+    let base = repeated(sol, 2);
+    let dir = variational_series(model, sol, &e, 2, base.n_harm, fo).ok()?;
+    let norm = dir.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(norm > 0.0 && norm.is_finite()) {
+        return None;
+    }
+    Some(
+        amplitudes
+            .iter()
+            .map(|a| HbSolution {
+                coeffs: base
+                    .coeffs
+                    .iter()
+                    .zip(&dir)
+                    .map(|(c, v)| c + a * v / norm)
+                    .collect(),
+                status: Status::NoGuess,
+                ..base.clone()
+            })
+            .collect(),
+    )
+}
+
 /// The Jacobian (row-major `2d x 2d`) of the first-order equations at the equilibrium
 /// `q` (at rest relative to the disk), by central differences.
 pub fn equilibrium_jacobian<D: Dynamics + ?Sized>(model: &D, q: &[f64]) -> Vec<f64> {

@@ -26,6 +26,7 @@
 //! [`crate::continuation`]'s neighbour waves) and [`rows`]. The scan sees models only
 //! through [`Family`].
 
+mod doubling;
 mod grid;
 pub mod profile;
 pub mod rows;
@@ -159,7 +160,21 @@ fn scan_chunk<D: Family>(
     let glue = std::time::Instant::now();
     let geo = Local::new(spec, &range);
     let npts = geo.size();
+    // The reported types; period-doubled ones are seeded from the orbits they double,
+    // which are solved as unreported types where not asked for, so that a type's rows
+    // do not depend on which other types were asked for.
     let np = spec.patterns.len();
+    let parents = doubling::parents_needed(&spec.patterns);
+    let extended;
+    let spec = if parents.is_empty() {
+        spec
+    } else {
+        extended = ScanSpec {
+            patterns: spec.patterns.iter().cloned().chain(parents).collect(),
+            ..spec.clone()
+        };
+        &extended
+    };
     let params: Vec<D> = (0..npts)
         .map(|p| {
             let idx = geo.index(p);
@@ -202,15 +217,24 @@ fn scan_chunk<D: Family>(
     add_stage(1, t);
     check()?;
 
-    let mut tally = Tally::new(npts, np);
+    let mut tally = Tally::new(npts, spec.patterns.len());
     let block = waves::BlockWaves {
         spec,
         params: &params,
     };
     let t = std::time::Instant::now();
     continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
+    // Period-doubled orbits from the orbits they double, continued in turn.
+    let mut frontier = vec![];
+    for (p, f) in doubling::doubling_seeds(spec, &params, &sols, cancel) {
+        sols[p].push(f);
+        frontier.push((p, sols[p].len() - 1));
+    }
+    check()?;
+    continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
     add_stage(2, t);
     let t = std::time::Instant::now();
+    let whirls: Vec<(usize, usize, usize)> = whirls.into_iter().filter(|w| w.1 < np).collect();
     let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &whirls, &pb);
     profile::serial(profile::ROWS, t.elapsed());
     add_stage(3, t);

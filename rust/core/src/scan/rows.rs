@@ -13,6 +13,9 @@ pub enum Origin {
     Seed,
     /// Continued from a neighbouring point.
     Continuation,
+    /// Started at this point from an orbit of the single-turn type it doubles, displaced
+    /// along that orbit's period-doubling mode.
+    PeriodDoubling,
     /// No solution of this type was found here.
     None,
 }
@@ -23,6 +26,7 @@ impl Origin {
         match self {
             Origin::Seed => "seed",
             Origin::Continuation => "continuation",
+            Origin::PeriodDoubling => "period_doubling",
             Origin::None => "none",
         }
     }
