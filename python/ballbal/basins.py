@@ -105,6 +105,7 @@ class BasinOptions:
         if self.settle_factor is not None:
             object.__setattr__(self, "settle_factor",
                                _check.real("settle_factor", self.settle_factor))
+        _native.validate_basin_options(self)
 
 
 @dataclass(frozen=True)
