@@ -201,7 +201,7 @@ def test_grid_limits() -> None:
 def test_balance_map_limits_and_axes() -> None:
     raises(ParameterError, "Omgea", bb.balance_map, B, Omgea=[1.0])
     raises(ParameterError, "a", bb.balance_map, B, a=[1.0])
-    raises(ParameterTypeError, "Omega", bb.balance_map, B, Omega="1.0")
+    raises(ParameterError, "Omega", bb.balance_map, B, Omega="1.0")  # a string is a range
     big = np.linspace(1.0, 2.0, 3000)
     raises(ParameterError, "Omega", bb.balance_map, B, Omega=big, eta=big)
 

@@ -1,4 +1,5 @@
-"""Fuzzing the command line (issue 13): whatever the arguments, ``ballbal`` exits 0, or
+"""Fuzzing the command line (issue 13): whatever the arguments, ``ballbal`` exits 0 (1 when
+the solution asked for is not found), or
 2 with one ``ballbal: error: <parameter>: ...`` line on stderr, and never prints a
 traceback or a Rust panic. Valid settings are kept cheap (few balls, one-point scans)."""
 
@@ -36,7 +37,11 @@ def check(args: list[str], cwd: Path, typed: set[str]) -> None:
     r = run(args, cwd)
     assert "Traceback" not in r.stderr, (args, r.stderr)
     assert "panicked" not in r.stderr and "PanicException" not in r.stderr, (args, r.stderr)
-    assert r.returncode in (0, 2), (args, r.returncode, r.stderr)
+    assert r.returncode in (0, 1, 2), (args, r.returncode, r.stderr)
+    if r.returncode == 1:  # only a solution not found, said in one line
+        lines = [x for x in r.stderr.splitlines() if x.strip()]
+        assert len(lines) == 1 and re.match(r"ballbal: no \S+ solution found", lines[0]), (
+            args, r.stderr)
     if r.returncode == 2:
         lines = [x for x in r.stderr.splitlines() if x.strip()]
         assert len(lines) == 1, (args, r.stderr)

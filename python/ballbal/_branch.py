@@ -13,7 +13,7 @@ from typing import Any
 
 import polars as pl
 
-from ballbal import _check
+from ballbal import _check, _native
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer
 from ballbal.scene import Scene
@@ -83,6 +83,7 @@ class Continuation:
                            ("max_newton", _check.MAX_NEWTON)):
             object.__setattr__(self, name, _check.integer(name, getattr(self, name), 1, most))
         object.__setattr__(self, "forward", _check.boolean("forward", self.forward))
+        _native.validate_continuation(self)
 
 
 @dataclass(frozen=True)

@@ -397,6 +397,44 @@ def vector(name: str, v: Any, max_size: int, *, empty: bool = False) -> np.ndarr
     return a
 
 
+def axis(name: str, spec: Any, max_size: int = MAX_AXIS_VALUES) -> np.ndarray:
+    """One grid axis, read the same way by every gridded function (scan, balance_map,
+    basins, speed_sweep, the command line), so that the same axis gives the same floats
+    everywhere. ``(start, stop, step)`` (a tuple) or ``"start:stop:step"``: a range with
+    ``stop`` included, ``round(start + step * i, 12)`` for ``i = 0, 1, ...`` (rounded so
+    that ``(1.0, 2.0, 0.1)`` gives 1.2, not 1.2000000000000002); anything else (a list,
+    an array, one number): explicit values, kept as given. At most ``max_size`` values,
+    all finite, none given twice (each value has one index in a gridded table)."""
+    if isinstance(spec, str):
+        try:
+            parts = [float(p) for p in spec.split(":")]
+        except ValueError as e:
+            raise ParameterError(name, f"give start:stop:step, got {spec!r}") from e
+        if len(parts) != 3:
+            raise ParameterError(name, f"give start:stop:step, got {spec!r}")
+        spec = (parts[0], parts[1], parts[2])
+    if isinstance(spec, tuple) and len(spec) == 3:
+        start, stop, step = (real(name, v) for v in spec)
+        if not all(math.isfinite(v) for v in (start, stop, step)):
+            raise ParameterError(name, f"(start, stop, step) must be finite, got {spec}")
+        if step <= 0 or stop < start:
+            raise ParameterError(
+                name, f"(start, stop, step) needs step > 0 and stop >= start, got {spec}"
+            )
+        count = axis_count(name, (stop - start) / step)
+        at_most(name, count, max_size, "values")
+        vals = np.round(start + step * np.arange(count), 12)
+    else:
+        vals = vector(name, spec, max_size)
+    if not np.all(np.isfinite(vals)):
+        raise ParameterError(name, "grid values must be finite (no NaN or inf)")
+    if np.unique(vals).size != vals.size:
+        u, counts = np.unique(vals, return_counts=True)
+        raise ParameterError(name, f"value {u[counts > 1][0]} is given twice: each grid "
+                             "value once", value=spec)
+    return vals
+
+
 def at_most(name: str, size: int, limit: int, what: str) -> int:
     """``size`` (a count the arguments imply: grid points, steps), refused above
     ``limit`` with an error naming ``name``, the argument to cut."""

@@ -14,7 +14,7 @@ from ._rotor import RotorOnBearing
 from .basins import BasinOptions
 from .bearing import Bearing
 from .model import Balancer
-from .options import PeriodicOptions, ScanOptions
+from .options import Floquet, GuessSearch, HarmonicBalance, PeriodicOptions, ScanOptions
 from .scene import Scene
 
 __all__ = [
@@ -23,7 +23,9 @@ __all__ = [
     "balance_map", "scan", "default_chunk", "certificate_seconds", "scan_stage_seconds",
     "hb_stage_profile", "hb_stage_seconds",
     "scan_work_counts", "scan_profile", "scan_wave_order",
-    "validate_bearing",
+    "validate_bearing", "validate_balancer", "validate_harmonic_balance", "validate_floquet",
+    "validate_guess", "validate_periodic_options", "validate_continuation",
+    "validate_basin_options",
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
@@ -40,6 +42,14 @@ def simulate(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int, int]: ...
 def validate(model: Balancer | Scene) -> None: ...
 def validate_bearing(bearing: Bearing) -> None: ...
+# Checks run when an object is made (rust/py/src/checks.rs): the core's own checks.
+def validate_balancer(balancer: Balancer) -> None: ...
+def validate_harmonic_balance(options: HarmonicBalance) -> None: ...
+def validate_floquet(options: Floquet) -> None: ...
+def validate_guess(options: GuessSearch) -> None: ...
+def validate_periodic_options(options: PeriodicOptions | ScanOptions) -> None: ...
+def validate_continuation(options: Continuation) -> None: ...
+def validate_basin_options(options: BasinOptions) -> None: ...
 # Film forces (rust/py/src/bearing.rs): dicts of floats, arrays where named.
 def bearing_force(
     bearing: Bearing, position: tuple[float, float], velocity: tuple[float, float],

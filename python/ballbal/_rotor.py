@@ -57,6 +57,9 @@ class RotorImpulse:
         for name in ("amplitude", "center", "sharpness", "direction"):
             object.__setattr__(self, name, _check.real(f"impulse.{name}", getattr(self, name),
                                                       finite=True))
+        # its ranges are the core's, checked on a rotor under gravity (an impulse is a
+        # multiple of the weight; that it needs gravity is the rotor's check)
+        RotorOnBearing(Bearing(), 1.0, gravity=1.0, impulse=self)
 
 
 @dataclass(frozen=True)

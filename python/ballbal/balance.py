@@ -30,7 +30,10 @@ def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
     return None if d is None else _equilibrium(d, capacities(model))
 
 
-def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -> pl.DataFrame:
+def balance_map(
+    model: Balancer | Scene,
+    **axes: Sequence[float] | np.ndarray | tuple[float, float, float] | str,
+) -> pl.DataFrame:
     """The balanced state's stability over a grid: one row per point of the product of
     ``axes`` (parameter name = values; balancer fields such as ``Omega``, ``eta``,
     ``zeta_b``, ``zeta``, the scene's ``springs`` and tilt fields ``j_t``, ``j_z``,
@@ -38,14 +41,18 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
     Points are solved in parallel in the core, each on its own, so the table does not
     depend on the thread count.
 
-    Columns: the axes, ``status`` (``"ok"``; ``"no_balance"`` where the balls cannot
-    balance the disk; ``"not_converged"`` where the continuation from the planar
-    balancer's perfect balance failed, e.g. springs near the critical speed), ``stability``,
+    Columns: the axes, ``<axis>_index`` (the value's position on its axis, counted from
+    0: the key that joins maps and scans over the same axes exactly), ``status``
+    (``"ok"``; ``"no_balance"`` where the balls cannot balance the disk;
+    ``"not_converged"`` where the continuation from the planar balancer's perfect
+    balance failed, e.g. springs near the critical speed), ``stability``,
     ``index`` (largest real part of the eigenvalues, seed 001's relative-stability
     index), ``whirl`` (residual ``hypot(x, y)``), ``tilt`` (residual ``hypot(A, B)``,
     0 for a planar disk), ``residual`` (of the equilibrium equations).
 
-    Each axis is a flat list of finite values inside the parameter's range (a value
+    Each axis is written as in :func:`ballbal.scan` (:func:`ballbal._check.axis`):
+    ``(start, stop, step)`` or ``"start:stop:step"`` a range with ``stop`` included,
+    a list or array explicit values; finite, inside the parameter's range (a value
     outside it raises :class:`~ballbal.exceptions.ParameterError` naming the axis); the
     grid has at most :data:`~ballbal._check.MAX_MAP_POINTS` points."""
     _check.model("model", model)
@@ -61,22 +68,25 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
             raise ParameterError(name, "not a parameter balance_map can vary (allowed: "
                                  f"{', '.join(sorted(allowed))})",
                                  allowed=", ".join(sorted(allowed)))
-        v = _check.vector(name, axes[name], _check.MAX_MAP_POINTS)
+        v = _check.axis(name, axes[name], _check.MAX_MAP_POINTS)
         _planar_range(scene.balancer, name, v)
         values.append([float(x) for x in v])
     k = max(range(len(values)), key=lambda i: len(values[i]))  # the longest: the one to cut
     _check.at_most(names[k], math.prod(len(v) for v in values), _check.MAX_MAP_POINTS,
                    "points (the product of the axes)")
     grid = list(itertools.product(*values))
+    at = list(itertools.product(*(range(len(v)) for v in values)))
     # The points are built and solved in the core (parameters set by name there), so a
     # map costs the solves and not one Python scene per point.
     results = _native.balance_map(scene, names, [list(c) for c in grid])
     cols: dict[str, list[Any]] = {n: [] for n in names}
+    cols |= {f"{n}_index": [] for n in names}
     for key in ("status", "stability", "index", "whirl", "tilt", "residual"):
         cols[key] = []
-    for combo, (status, d) in zip(grid, results, strict=True):
-        for n, x in zip(names, combo, strict=True):
+    for combo, where, (status, d) in zip(grid, at, results, strict=True):
+        for n, x, i in zip(names, combo, where, strict=True):
             cols[n].append(x)
+            cols[f"{n}_index"].append(i)
         cols["status"].append(status)
         if d is None:
             for key in ("stability", "index", "whirl", "tilt", "residual"):
@@ -88,7 +98,7 @@ def balance_map(model: Balancer | Scene, **axes: Sequence[float] | np.ndarray) -
         cols["whirl"].append(float(np.hypot(q[0], q[1])))
         cols["tilt"].append(float(np.hypot(q[2], q[3])) if scene.tilt is not None else 0.0)
         cols["residual"].append(float(d["residual"]))
-    schema = {n: pl.Float64 for n in names} | {
+    schema = {n: pl.Float64 for n in names} | {f"{n}_index": pl.Int64 for n in names} | {
         "status": pl.String, "stability": pl.String, "index": pl.Float64,
         "whirl": pl.Float64, "tilt": pl.Float64, "residual": pl.Float64}
     return pl.DataFrame(cols, schema=schema)

@@ -105,6 +105,7 @@ class BasinOptions:
         if self.settle_factor is not None:
             object.__setattr__(self, "settle_factor",
                                _check.real("settle_factor", self.settle_factor))
+        _native.validate_basin_options(self)
 
 
 @dataclass(frozen=True)
@@ -349,9 +350,11 @@ def _run_chunk(model: Balancer | Scene, starts: list[list[float]], options: Basi
 
 
 def _axis(name: str, v: Any) -> np.ndarray:
-    """A grid axis: a flat, non-empty list of finite angles (a 2-D array is refused, not
-    flattened; NaN is named here rather than as the core's ``starts``)."""
-    return _check.vector(name, v, _check.MAX_BASIN_STARTS)
+    """A grid axis of angles, written as every gridded function's
+    (:func:`ballbal._check.axis`: ``(start, stop, step)`` with ``stop`` included, or
+    explicit values; a 2-D array is refused, not flattened; NaN is named here rather
+    than as the core's ``starts``)."""
+    return _check.axis(name, v, _check.MAX_BASIN_STARTS)
 
 
 def _seed(v: Any) -> int | None:

@@ -3,7 +3,9 @@ and ``ballbal equilibria`` take parameters, or a scene file (``--scene SCENE.tom
 whose balancer the parameter options given change); ``ballbal scan SCENE.toml --Omega 1:2:0.1
 --eta 0.4:1.5:0.1 -o out.parquet`` maps a parameter plane (Ctrl-C keeps the finished
 chunks, running the same command again resumes) and ``ballbal plot out.parquet`` draws
-the map."""
+the map. Options are spelled with hyphens (``--zeta-b``) in every subcommand; ``--eta``
+takes one value per ball, as ``Balancer(eta=...)``. Exit status: 0 done, 1 the numerics
+failed or the asked-for solution was not found, 2 bad input, 130 interrupted."""
 
 from __future__ import annotations
 
@@ -17,6 +19,7 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from ._native import __version__
 from .analysis import equilibria, periodic
 from .exceptions import BallbalError, ParameterError, ScanInterrupted, ScanStoreError
 from .model import Balancer
@@ -80,8 +83,14 @@ def _model(a: argparse.Namespace) -> Balancer | Scene:
                              allowed=f"[1, {MAX_BALLS}]")
     if a.balls is not None and a.eta is not None and len(a.eta) > 1 and len(a.eta) != a.balls:
         raise ParameterError("balls", f"{a.balls} balls but {len(a.eta)} values of --eta")
-    eta: list[float] = a.eta or [1.0]
-    eta = eta if len(eta) > 1 else eta * (2 if a.balls is None else a.balls)
+    # --eta is Balancer(eta=...): one value per ball (one value is one ball); --balls
+    # repeats a single value
+    if a.eta is None:
+        eta = [1.0] * (2 if a.balls is None else a.balls)
+    elif len(a.eta) == 1 and a.balls is not None:
+        eta = a.eta * a.balls
+    else:
+        eta = a.eta
     return Balancer(**{**_DEFAULTS, **given}, eta=tuple(eta))
 
 
@@ -92,9 +101,12 @@ def _params(p: argparse.ArgumentParser) -> None:
     p.add_argument("--zeta-b", dest="zeta_b", type=float, default=None, help="default 0.05")
     p.add_argument("--delta", type=float, default=None, help="default 50")
     p.add_argument("--Omega", type=float, default=None, help="default 1.2")
-    p.add_argument("--eta", type=float, nargs="+", default=None, help="default 1.0")
+    p.add_argument("--eta", type=float, nargs="+", default=None,
+                   help="one value per ball, as Balancer(eta=...): '--eta 1.3' is one ball, "
+                        "'--eta 1.3 1.3' two (default: two balls of 1.0)")
     p.add_argument("--balls", type=int, default=None,
-                   help="number of equal balls if one eta (default 2)")
+                   help="number of equal balls, each of the one --eta value (default 2 "
+                        "without --eta)")
 
 
 def _print_equilibria(b: Balancer | Scene) -> None:
@@ -120,19 +132,22 @@ def _print_equilibria(b: Balancer | Scene) -> None:
                   f"index {min(idx):+.4g} to {max(idx):+.4g}")
 
 
-def _print_periodic(b: Balancer | Scene, pattern: str, N: int) -> None:
+def _print_periodic(b: Balancer | Scene, pattern: str, N: int) -> bool:
+    """Prints the solution; False (and why, on stderr) when none was found."""
     t = time.perf_counter()
     s = periodic(b, pattern, N=N)
     dt = time.perf_counter() - t
     if not s.converged:
-        print(f"  {pattern} N={N}: {s.status} after {s.iterations} iterations")
-        return
+        print(f"ballbal: no {pattern} solution found (N={N}): {s.status} after "
+              f"{s.iterations} iterations", file=sys.stderr)
+        return False
     assert s.multipliers is not None  # a converged solve has its multipliers
     mods = " ".join(f"{m:.4f}" for m in np.sort(np.abs(s.multipliers))[::-1])
     print(f"  {s.type} N={N}: omega={s.omega:.6f} (period {s.period:.3f}), {s.stability}; "
           f"|multipliers| {mods}; trivial error {s.trivial_error:.1e}; residual "
           f"{s.residual:.1e}; orbit closure by simulation {s.verify():.1e}; Hill's method: "
           f"{s.hill_stability}; {dt * 1e3:.1f} ms")
+    return True
 
 
 def _print_map(b: Balancer) -> None:
@@ -259,6 +274,7 @@ def _plot(a: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     ap = _Parser(prog="ballbal", description=__doc__)
+    ap.add_argument("--version", action="version", version=f"ballbal {__version__}")
     sub = ap.add_subparsers(dest="cmd", required=True, parser_class=_Parser)
     sub.add_parser("run", help="the thesis' standard case: equilibria and R-R solution")
     pp = sub.add_parser("periodic", help="a periodic solution with Floquet stability")
@@ -270,7 +286,8 @@ def main(argv: list[str] | None = None) -> int:
     ps = sub.add_parser("scan", help="scan a parameter grid; one Parquet row per solution")
     ps.add_argument("scene", nargs="?", help="scene TOML (default: the thesis' standard case)")
     for name in SCANNABLE:
-        ps.add_argument(f"--{name}", metavar="START:STOP:STEP")
+        # one spelling for every subcommand: --zeta-b, as periodic and equilibria
+        ps.add_argument(f"--{name.replace('_', '-')}", dest=name, metavar="START:STOP:STEP")
     ps.add_argument("--grid", action="append", default=[], metavar="NAME=START:STOP:STEP",
                     help="any scannable parameter, e.g. 'eta[0]=0.5:1.5:0.1'")
     ps.add_argument("--types", nargs="+", default=["R-R"], help="e.g. R-R O-O R-O")
@@ -293,15 +310,17 @@ def main(argv: list[str] | None = None) -> int:
             print(f"ballbal: thesis standard case {b}")
             _print_equilibria(b)
             print("Periodic solutions (balls merged, rotating):")
-            for N in (3, 8):
-                _print_periodic(b, "R-R", N)
+            found = [_print_periodic(b, "R-R", N) for N in (3, 8)]
             _print_map(b.replace(zeta_b=0.1))
+            if not all(found):
+                return 1
         elif a.cmd == "scan":
             return _scan(a)
         elif a.cmd == "plot":
             return _plot(a)
         elif a.cmd == "periodic":
-            _print_periodic(_model(a), a.pattern, a.N)
+            # the asked-for result not found: status 1, as a failed computation
+            return 0 if _print_periodic(_model(a), a.pattern, a.N) else 1
         else:
             _print_equilibria(_model(a))
     except (ValueError, TypeError) as e:

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
-from . import _check
+from . import _check, _native
 from ._check import is_real as _is_number
 from .exceptions import ParameterError, ParameterTypeError
 
@@ -47,8 +47,9 @@ class Balancer:
     """A planar automatic ball balancer in the thesis' nondimensional parameters.
 
     ``eta`` has one entry per ball (its length is the number of balls ``n``); ``zeta_b``
-    is one value shared by all balls or one per ball. Parameters are validated by the
-    core on first use; :meth:`validate` checks them eagerly.
+    is one value shared by all balls or one per ball. The core checks the parameters
+    when the balancer is made (a value out of range raises
+    :class:`~ballbal.exceptions.ParameterError` naming it and its range).
     """
 
     mu: float = 0.2
@@ -64,6 +65,7 @@ class Balancer:
         object.__setattr__(self, "eta", _tuple("eta", self.eta))
         zb = _tuple("zeta_b", self.zeta_b)
         object.__setattr__(self, "zeta_b", zb[0] if len(zb) == 1 else zb)
+        _native.validate_balancer(self)
 
     @property
     def n_balls(self) -> int:
@@ -84,9 +86,8 @@ class Balancer:
         return replace(self, **changes)
 
     def validate(self) -> Balancer:
-        """Check the parameters (the core's own checks, no analysis) and return self."""
-        from . import _native
-
+        """Check the parameters (the core's own checks, no analysis) and return self:
+        a balancer is checked when it is made, so this only repeats that check."""
         _native.validate(self)
         return self
 

@@ -1,7 +1,9 @@
 """The analyses' options as frozen dataclasses, mirroring the core's option structs.
 
-The native module reads these objects by attribute; their values are checked by the
-core (errors name the option), these classes check only types. One vocabulary:
+The native module reads these objects by attribute. Each is checked when it is made:
+types here, values by the core's own checks (errors name the option and its range);
+the only checks left to an analysis are those that need its model (the largest
+harmonic-balance system a model of that size allows). One vocabulary:
 ``rtol``/``atol`` are always integration tolerances (relative, absolute) of the
 Dormand–Prince integrator that uses them: :class:`Floquet`'s of the monodromy,
 :class:`GuessSearch`'s of the simulations that find starts. Mathematics (what is
@@ -38,7 +40,7 @@ from typing import Any, ClassVar, Literal
 
 import numpy as np
 
-from . import _check
+from . import _check, _native
 from .exceptions import ParameterError, ParameterTypeError
 
 #: Harmonics ``N = "auto"`` starts from.
@@ -115,6 +117,7 @@ class HarmonicBalance:
         auto = self.N == "auto"
         object.__setattr__(self, "_start", AUTO_START if auto else int(self.N))
         object.__setattr__(self, "_auto_target", self.target if auto else None)
+        _native.validate_harmonic_balance(self)
 
     # Instance attributes set above; declared as ClassVar so that they stay out of the
     # dataclass' fields (its equality, asdict and the scan files' metadata).
@@ -188,6 +191,7 @@ class Floquet:
         _reals(self, "rtol", "atol", "margin", "max_trivial")
         _counts(self, "max_steps")
         _flags(self, "monodromy", "hill", "refine")
+        _native.validate_floquet(self)
 
 
 @dataclass(frozen=True)
@@ -211,6 +215,7 @@ class GuessSearch:
     def __post_init__(self) -> None:
         _reals(self, "settle", "window", "rtol", "atol")
         _counts(self, "seeds", "starts")
+        _native.validate_guess(self)
 
 
 @dataclass(frozen=True)
@@ -231,6 +236,7 @@ class PeriodicOptions:
         _nested(self, "floquet", Floquet)
         _nested(self, "guess", GuessSearch)
         _reals(self, "max_closure", "max_tail")
+        _native.validate_periodic_options(self)
 
 
 def _scan_floquet() -> Floquet:
@@ -269,7 +275,8 @@ class ScanOptions:
         _nested(self, "guess", GuessSearch)
         _reals(self, "max_closure", "max_tail")
         if self.block is not None:
-            object.__setattr__(self, "block", _check.integer("block", self.block))
+            object.__setattr__(self, "block", _check.integer("block", self.block, 1))
+        _native.validate_periodic_options(self)
 
 
 @dataclass(frozen=True)
@@ -296,7 +303,7 @@ class Execution:
     def __post_init__(self) -> None:
         object.__setattr__(self, "threads", _check.optional_integer(
             "threads", self.threads, 1, _check.MAX_THREADS))
-        object.__setattr__(self, "chunk", _check.optional_integer("chunk", self.chunk))
+        object.__setattr__(self, "chunk", _check.optional_integer("chunk", self.chunk, 1))
         if self.out is not None:
             _check.path("out", self.out)
         _flags(self, "lazy")

@@ -69,44 +69,18 @@ _SCHEMA: dict[str, Any] = {
 
 
 def grid_values(name: str, spec: GridSpec) -> np.ndarray:
-    """The values of one grid axis: a sequence, an array, ``(start, stop, step)`` or
-    ``"start:stop:step"`` (both ends included)."""
+    """The values of one grid axis (:func:`ballbal._check.axis`, shared by every gridded
+    function): ``(start, stop, step)`` or ``"start:stop:step"`` (both ends included),
+    or a sequence or array of explicit values."""
     if not (name in SCANNABLE or name in SCENE_SCANNABLE
             or (name.startswith(_INDEXED) and name.endswith("]"))):
         raise ParameterError(
             name, f"not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
             f"eta[i], zeta_b[i]; for scenes also {', '.join(SCENE_SCANNABLE)})"
         )
-    if isinstance(spec, str):
-        try:
-            parts = [float(p) for p in spec.split(":")]
-        except ValueError as e:
-            raise ParameterError(name, f"give start:stop:step, got {spec!r}") from e
-        if len(parts) != 3:
-            raise ParameterError(name, f"give start:stop:step, got {spec!r}")
-        spec = (parts[0], parts[1], parts[2])
-    if isinstance(spec, tuple) and len(spec) == 3 and not isinstance(spec, np.ndarray):
-        start, stop, step = (_check.real(name, v) for v in spec)
-        if not all(math.isfinite(v) for v in (start, stop, step)):
-            raise ParameterError(name, f"(start, stop, step) must be finite, got {spec}")
-        if step <= 0 or stop < start:
-            raise ParameterError(
-                name, f"(start, stop, step) needs step > 0 and stop >= start, got {spec}"
-            )
-        count = _check.axis_count(name, (stop - start) / step)
-        vals = np.round(start + step * np.arange(count), 12)
-    else:
-        if spec is None or isinstance(spec, (bool, np.bool_)):
-            raise ParameterTypeError(name, f"grid values must be numbers, got {spec!r}")
-        try:
-            vals = np.asarray(spec, dtype=float).ravel()
-        except (TypeError, ValueError) as e:
-            raise ParameterError(name, f"grid values must be numbers, got {spec!r}") from e
-    if vals.size == 0:
-        raise ParameterError(name, "the grid is empty")
-    if not np.all(np.isfinite(vals)):
-        raise ParameterError(name, "grid values must be finite (no NaN or inf)")
-    return vals
+    if spec is None or isinstance(spec, (bool, np.bool_)):
+        raise ParameterTypeError(name, f"grid values must be numbers, got {spec!r}")
+    return _check.axis(name, spec)
 
 
 @dataclass(frozen=True)
@@ -151,7 +125,8 @@ class _Job:
             "patterns": list(self.patterns), "options": _meta_options(self.options),
             "block": self.block, "chunk": self.chunk,
             # A store written with other columns is not resumed into this table.
-            "columns": list(_SCHEMA),
+            # (the axes' index columns named generically: the axes are compared apart)
+            "columns": [_index_name("<axis>"), *_SCHEMA],
         }
 
 
@@ -225,22 +200,33 @@ def _multipliers(re_rows: Sequence[Any], im_rows: Sequence[Any]) -> pl.Series:
     return pl.Series("multipliers", mult, dtype=MULTIPLIER)
 
 
-def _frame(names: Sequence[str], d: dict[str, Any]) -> pl.DataFrame:
+def _index_name(axis: str) -> str:
+    """The column of an axis value's position on its axis (``Omega_index``)."""
+    return f"{axis}_index"
+
+
+def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
     mult = _multipliers(d["mult_re"], d["mult_im"])
+    names = job.names
     cols: dict[str, pl.Series] = {n: pl.Series(n, d[n], dtype=pl.Float64) for n in names}
+    for n, vals in zip(names, job.values, strict=True):
+        # the rows carry the grid's own floats, so each maps to its position exactly
+        cols[_index_name(n)] = cols[n].replace_strict(
+            list(vals), list(range(len(vals))), return_dtype=pl.Int64).alias(_index_name(n))
     for c, dtype in _SCHEMA.items():
         cols[c] = mult if c == "multipliers" else pl.Series(c, d[c], dtype=dtype)
     return pl.DataFrame(cols)
 
 
 def _empty(names: Sequence[str]) -> pl.DataFrame:
-    return pl.DataFrame(schema={**{n: pl.Float64 for n in names}, **_SCHEMA})
+    return pl.DataFrame(schema={**{n: pl.Float64 for n in names},
+                                **{_index_name(n): pl.Int64 for n in names}, **_SCHEMA})
 
 
 def run_chunk(job: _Job, c: int, threads: int = 1) -> pl.DataFrame:
     """One chunk of a scan as a DataFrame: what executors run on their workers."""
     out: list[pl.DataFrame] = []
-    job.native([c], threads, lambda _c, d: out.append(_frame(job.names, d)))
+    job.native([c], threads, lambda _c, d: out.append(_frame(job, d)))
     return out[0]
 
 
@@ -841,7 +827,7 @@ def _run(job: _Job, store: _Store | None, executor: Any, threads: int | None,
                     f.cancel()
                 raise
         elif todo:
-            job.native(todo, local_threads, lambda c, d: keep(c, _frame(job.names, d)))
+            job.native(todo, local_threads, lambda c, d: keep(c, _frame(job, d)))
 
     try:
         if _interrupted(work):

@@ -281,12 +281,11 @@ class Scene:
             if v is not None and not isinstance(v, kind):
                 raise ParameterTypeError(name, f"must be a {kind.__name__} or None, got "
                                          f"{type(v).__name__}")
-        if self.support is not None:
-            # what the support asks of the rest (Omega > 0, a planar disk), checked once,
-            # in the core
-            from . import _native
+        # the effects' ranges and what they ask of the rest (a support needs Omega > 0
+        # and a planar disk), checked once, in the core, when the scene is made
+        from . import _native
 
-            _native.validate(self)
+        _native.validate(self)
 
     # the interface the analyses use, shared with Balancer
     @property

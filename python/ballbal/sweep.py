@@ -107,7 +107,7 @@ class Sweep:
 
 def speed_sweep(
     model: Balancer,
-    speeds: Sequence[float] | np.ndarray,
+    speeds: Sequence[float] | np.ndarray | tuple[float, float, float] | str,
     *,
     dwell: float = 1000.0,
     direction: Literal["up-down", "up", "down"] = "up-down",
@@ -116,10 +116,11 @@ def speed_sweep(
     y0: Sequence[float] | np.ndarray | None = None,
     options: BasinOptions | None = None,
 ) -> Sweep:
-    """Step the speed through ``speeds`` (ascending) up, then back down (``"up-down"``:
-    the top speed is not repeated), dwelling ``dwell`` time units at each step, and
-    label the motion at each (the basins' classifier over the last ``options.window``
-    of the dwell).
+    """Step the speed through ``speeds`` (ascending; ``(start, stop, step)`` with
+    ``stop`` included, or explicit values, as every gridded function takes an axis) up,
+    then back down (``"up-down"``: the top speed is not repeated), dwelling ``dwell``
+    time units at each step, and label the motion at each (the basins' classifier over
+    the last ``options.window`` of the dwell).
 
     ``y0``: the state at the first step (default: at rest in the ground frame, the balls
     together at angle 0.3 of the disk, as a rig is started). ``kick``: see the module's
@@ -141,7 +142,8 @@ def speed_sweep(
     if not isinstance(direction, str) or direction not in ("up-down", "up", "down"):
         raise ParameterError("direction", f"must be 'up-down', 'up' or 'down', got "
                              f"{direction!r:.60}", allowed="up-down, up, down")
-    sp = _check.vector("speeds", speeds, _check.MAX_SWEEP_STEPS)
+    # an axis as every gridded function reads it: (start, stop, step) is a range
+    sp = _check.axis("speeds", speeds, _check.MAX_SWEEP_STEPS)
     if np.any(sp < 0) or np.any(np.diff(sp) <= 0):
         raise ParameterError("speeds", "give ascending speeds >= 0 (values of Omega)",
                              allowed="ascending values in [0, inf)", value=speeds)

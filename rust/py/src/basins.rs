@@ -26,7 +26,7 @@ pub struct BasinArgs {
 }
 
 impl BasinArgs {
-    fn to_core(&self) -> BasinOptions {
+    pub fn to_core(&self) -> BasinOptions {
         BasinOptions {
             t_end: self.t_end,
             window: self.window,

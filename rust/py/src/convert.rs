@@ -108,7 +108,7 @@ macro_rules! dispatch {
 pub(crate) use dispatch;
 
 impl BalancerArgs {
-    fn planar(&self) -> Result<Planar, Error> {
+    pub fn planar(&self) -> Result<Planar, Error> {
         let zb = match &self.zeta_b {
             Reals::One(v) => vec![*v],
             Reals::Many(v) => v.clone(),
@@ -277,49 +277,100 @@ impl PeriodicArgs {
     }
 
     pub fn to_core(&self) -> PyResult<PeriodicOptions> {
-        let h = &self.harmonic_balance;
-        let f = &self.floquet;
-        let g = &self.guess;
-        let fo = FloquetOptions {
-            method: FloquetMethod::parse(&f.method).py()?,
-            rtol: f.rtol,
-            atol: f.atol,
-            margin: f.margin,
-            max_steps: f.max_steps,
-            max_trivial: f.max_trivial,
-        };
-        // Checked even with the monodromy off: a bad value is a mistake either way.
-        fo.validate().py()?;
-        let opts = PeriodicOptions {
-            auto: h.auto_target.map(|target| AutoHarmonics {
-                target,
-                n_max: h.n_max,
-            }),
-            hill: f.hill,
-            hill_judging: Some((f.margin, f.max_trivial)),
-            hill_target: HillTarget::parse(&f.hill_target).py()?,
-            hill_band: f.hill_band,
-            refine_verdicts: f.refine,
-            hb: HbOptions {
-                n_harm: h.start,
-                samples: h.samples,
-                tol: h.tol,
-                step_tol: h.step_tol,
-                max_iter: h.max_iter,
-            },
-            floquet: f.monodromy.then_some(fo),
-            guess: GuessOptions {
-                settle: g.settle,
-                window: g.window,
-                rtol: g.rtol,
-                atol: g.atol,
-            },
+        let mut opts = PeriodicOptions {
             max_closure: self.max_closure,
             max_tail: self.max_tail,
+            ..Default::default()
         };
+        self.harmonic_balance.apply(&mut opts);
+        self.floquet.apply(&mut opts)?;
+        self.guess.apply(&mut opts);
         opts.validate().py()?;
         Ok(opts)
     }
+}
+
+impl HarmonicBalanceArgs {
+    /// Sets the harmonic-balance part of `opts` (`hb`, `auto`).
+    fn apply(&self, opts: &mut PeriodicOptions) {
+        opts.auto = self.auto_target.map(|target| AutoHarmonics {
+            target,
+            n_max: self.n_max,
+        });
+        opts.hb = HbOptions {
+            n_harm: self.start,
+            samples: self.samples,
+            tol: self.tol,
+            step_tol: self.step_tol,
+            max_iter: self.max_iter,
+        };
+    }
+}
+
+impl FloquetArgs {
+    /// Sets the stability part of `opts` (the monodromy's options and Hill's); the
+    /// monodromy's options are checked even with it off: a bad value is a mistake
+    /// either way.
+    fn apply(&self, opts: &mut PeriodicOptions) -> PyResult<()> {
+        let fo = FloquetOptions {
+            method: FloquetMethod::parse(&self.method).py()?,
+            rtol: self.rtol,
+            atol: self.atol,
+            margin: self.margin,
+            max_steps: self.max_steps,
+            max_trivial: self.max_trivial,
+        };
+        fo.validate().py()?;
+        opts.hill = self.hill;
+        opts.hill_judging = Some((self.margin, self.max_trivial));
+        opts.hill_target = HillTarget::parse(&self.hill_target).py()?;
+        opts.hill_band = self.hill_band;
+        opts.refine_verdicts = self.refine;
+        opts.floquet = self.monodromy.then_some(fo);
+        Ok(())
+    }
+}
+
+impl GuessArgs {
+    /// Sets the start search's part of `opts`.
+    fn apply(&self, opts: &mut PeriodicOptions) {
+        opts.guess = GuessOptions {
+            settle: self.settle,
+            window: self.window,
+            rtol: self.rtol,
+            atol: self.atol,
+        };
+    }
+}
+
+/// One option dataclass checked on its own when it is made: its part set into the
+/// core's default options (valid by construction), so that every error is this part's
+/// and the checks stay the core's ([`PeriodicOptions::validate`]).
+pub fn validate_part(set: impl FnOnce(&mut PeriodicOptions) -> PyResult<()>) -> PyResult<()> {
+    let mut opts = PeriodicOptions::default();
+    set(&mut opts)?;
+    opts.validate().py()
+}
+
+/// [`validate_part`] of `ballbal.options.HarmonicBalance`.
+pub fn validate_harmonic_balance(h: &HarmonicBalanceArgs) -> PyResult<()> {
+    validate_part(|o| {
+        h.apply(o);
+        Ok(())
+    })
+}
+
+/// [`validate_part`] of `ballbal.options.Floquet`.
+pub fn validate_floquet(f: &FloquetArgs) -> PyResult<()> {
+    validate_part(|o| f.apply(o))
+}
+
+/// [`validate_part`] of `ballbal.options.GuessSearch`.
+pub fn validate_guess(g: &GuessArgs) -> PyResult<()> {
+    validate_part(|o| {
+        g.apply(o);
+        Ok(())
+    })
 }
 
 /// A contiguous float64 array's values.

@@ -7,6 +7,7 @@
 
 mod basins;
 mod bearing;
+mod checks;
 mod continuation;
 mod convert;
 mod entries;
@@ -77,6 +78,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::scan_profile, m)?)?;
     m.add_function(wrap_pyfunction!(entries::scan_wave_order, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::validate_bearing, m)?)?;
+    checks::register(m)?;
     rotor::register(m)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_force, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_equilibrium, m)?)?;
