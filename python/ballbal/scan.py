@@ -687,7 +687,10 @@ def scan(  # noqa: E302 - overloads above
     one row with ``status="not_found"`` and nulls. ``max_tail`` refuses series whose
     last harmonic is that large relative to the motion (``N`` too small). Every solution
     is certified as in :func:`~ballbal.periodic` (``max_closure``, ``max_trivial``, the
-    same defaults): a series that fails is neither reported nor continued, and a row
+    same defaults): a series that fails is neither reported nor continued (a seed's
+    series refused by ``max_tail`` or by its closure is first solved again with twice
+    and four times ``N`` harmonics, as slow orbits near a rotating branch's
+    infinite-period end need; the row's ``N`` says how many it got), and a row
     gets a stability verdict only with an accurate trivial multiplier and a bound on its
     leading modulus' error (``modulus_error``; a row whose verdict the bound leaves open
     is refined to more harmonics first, see :func:`~ballbal.periodic`). The solution

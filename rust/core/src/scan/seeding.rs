@@ -7,7 +7,8 @@ use super::{count, profile, work, Family, Found, Origin, ScanSpec};
 use crate::analysis::attractors::{seed_guess, Capture};
 use crate::analysis::periodic::{pattern_whirl_starts, plain_windings, repetitions};
 use crate::continuation::Lattice;
-use crate::hb::{solve, HbSolution, Status};
+use crate::hb::{solve, HbOptions, HbSolution, Status};
+use crate::periodic::is_repeated;
 use crate::periodic::{finish, initial_states};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -140,12 +141,60 @@ fn simulated_candidate<D: Family>(
         None => spec.patterns.iter().position(|want| of_type(w, want))?,
     };
     count(work::SEED_SOLVE);
-    let sol = solve(model, &g, &spec.hb_for(&g.winding));
+    let hb = spec.hb_for(&g.winding);
+    let mut sol = solve(model, &g, &hb);
     if !accept(model, &sol, &g, spec) {
-        return None;
+        sol = with_more_harmonics(model, &sol, &g, spec, &hb)?;
     }
     let key = orbit_key(&sol, model.layout().support());
     Some((k, sol, key))
+}
+
+/// Times a seed's harmonics may be doubled when its series is not resolved or does
+/// not close at the scan's `N` ([`with_more_harmonics`]).
+const SEED_DOUBLINGS: usize = 2;
+
+/// A seed's series that Newton converged on but that the scan's `N` does not resolve
+/// (tail above `max_tail`) or that fails the closure certificate, solved again with
+/// twice and four times the harmonics; the first that is accepted. A slow orbit near a
+/// rotating branch's infinite-period end (the census' random point 22: omega 0.00178,
+/// a period of 3 500) spends its period in a slow phase and a fast turn, which three
+/// harmonics cannot write: simulation reaches it from every start, and the scan listed
+/// nothing there. Not with `N = "auto"`, whose refinement does this in `finish`.
+fn with_more_harmonics<D: Family>(
+    model: &D,
+    sol: &HbSolution,
+    guess: &HbSolution,
+    spec: &ScanSpec<'_, D>,
+    hb: &HbOptions,
+) -> Option<HbSolution> {
+    if spec.opts.auto.is_some()
+        || sol.status != Status::Converged
+        || sol.winding != guess.winding
+        || is_repeated(sol)
+    {
+        return None;
+    }
+    let mut n = hb.n_harm;
+    let mut from = sol.clone();
+    for _ in 0..SEED_DOUBLINGS {
+        n *= 2;
+        let opts = HbOptions {
+            n_harm: n,
+            samples: hb.samples.map(|s| s * n / hb.n_harm),
+            ..hb.clone()
+        };
+        count(work::SEED_SOLVE);
+        let s = solve(model, &from, &opts);
+        if accept(model, &s, guess, spec) {
+            return Some(s);
+        }
+        if s.status != Status::Converged {
+            return None;
+        }
+        from = s;
+    }
+    None
 }
 
 /// A seed's solved series before its Floquet analysis: (point, type, series, key,
