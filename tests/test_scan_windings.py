@@ -95,6 +95,7 @@ def test_wound_types_add_rows_of_their_own_only() -> None:
     ("R-R[a,b]", "integers"),
     ("R-O[-2,-2]", "ball 2 is O"),
     ("R-R[-17,-17]", "16"),
+    ("R-R[-3,-3]", "at most 2 turns"),
 ])
 def test_bad_wound_types_are_refused(kind: str, needle: str) -> None:
     with pytest.raises(ParameterError, match="pattern|windings") as e:

@@ -6,6 +6,9 @@ use crate::error::{Error, Result};
 use crate::periodic::{initial_states, require_autonomous, PeriodicOptions};
 use std::ops::Range;
 
+/// Most turns per period a scan type's windings may share ([`crate::periodic::repetitions`]).
+pub const MAX_SCAN_TURNS: usize = 2;
+
 #[derive(Debug, Clone)]
 pub struct ScanSpec<'a, D: Family> {
     pub base: &'a D,
@@ -71,6 +74,23 @@ impl<D: Family> ScanSpec<'_, D> {
         }
         if self.patterns.is_empty() {
             return Err(Error::param("patterns", "give at least one solution type"));
+        }
+        // Seeds watch six turns, enough to tell orbits of one and two turns per period
+        // apart; three would need a longer watch for every seed, which would change
+        // the guesses, and so the rows, of the other types.
+        if let Some(w) = self
+            .patterns
+            .iter()
+            .find(|w| crate::periodic::repetitions(w) > MAX_SCAN_TURNS)
+        {
+            return Err(Error::param_range(
+                "patterns",
+                format!(
+                    "a scan type may repeat at most {MAX_SCAN_TURNS} turns per period, got windings [{}] (periodic() takes any)",
+                    w.iter().map(|x| (*x as i64).to_string()).collect::<Vec<_>>().join(",")
+                ),
+                format!("windings whose common divisor is at most {MAX_SCAN_TURNS}"),
+            ));
         }
         for (name, v, lo) in [
             ("threads", self.threads, 1),
