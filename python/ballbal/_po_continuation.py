@@ -43,9 +43,10 @@ def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
         "trivial_error": d["trivial_error"], "closure": d["closure"], "tail": d["tail"],
         "separation_error": d["separation_error"], "residual": d["residual"],
         "dp_ds": d["dp_ds"], "det_sign": d["det_sign"],
-        "test_LP": d["test_LP"], "test_BP": d["test_BP"],
-        "test_BP_multipliers": d["test_BP_multipliers"], "test_PD": d["test_PD"],
-        "test_NS": d["test_NS"], "event": d["event"],
+        "test_fold": d["test_fold"], "test_branch_point": d["test_branch_point"],
+        "test_branch_point_multipliers": d["test_branch_point_multipliers"],
+        "test_period_doubling": d["test_period_doubling"],
+        "test_neimark_sacker": d["test_neimark_sacker"], "event": d["event"],
     }
 
 
@@ -55,8 +56,9 @@ def _schema(parameter: str) -> dict[str, Any]:
             "max_modulus": f, "modulus_error": f, "modulus_error_source": s, "omega_error": f,
             "mult_re": lf, "mult_im": lf, "trivial_error": f,
             "closure": f, "tail": f, "separation_error": f, "residual": f, "dp_ds": f,
-            "det_sign": f, "test_LP": f, "test_BP": f, "test_BP_multipliers": f,
-            "test_PD": f, "test_NS": f, "event": s}
+            "det_sign": f, "test_fold": f, "test_branch_point": f,
+            "test_branch_point_multipliers": f, "test_period_doubling": f,
+            "test_neimark_sacker": f, "event": s}
 
 
 def periodic_branch(
@@ -77,16 +79,19 @@ def periodic_branch(
     pseudo-arclength continuation of the harmonic-balance equations (through folds),
     with ``N`` harmonics (default: the start's).
 
+
     Every point gets the certificates and Floquet multipliers of :func:`ballbal.periodic`
     with ``periodic_options`` (default :data:`ballbal.options.PERIODIC_DEFAULTS`;
     ``Floquet(monodromy=False, hill=True)`` uses Hill's multipliers instead): a point
     whose certificate fails has status ``not_closed`` / ``truncated`` and is never
-    called stable. Events, located to ``event_tol`` in the parameter between two
-    points: ``LP`` (fold: ``dp/ds`` changes sign), ``BP`` (branch point: the bordered
-    determinant changes sign, i.e. a real multiplier passes +1 other than the trivial
-    one; for merged balls the ball-separation multiplier), ``PD`` (a real multiplier
-    through -1), ``NS`` (a complex pair through the unit circle) and ``IP`` (infinite
-    period: omega falls below ``min_omega``, or a point fails its certificate while
+    called stable. Events (named as on every branch, see
+    :func:`~ballbal.continuation.event_vocabulary`), located to ``event_tol`` in the
+    parameter between two points: ``fold`` (``dp/ds`` changes sign), ``branch_point``
+    (the bordered determinant changes sign, i.e. a real multiplier passes +1 other than
+    the trivial one; for merged balls the ball-separation multiplier),
+    ``period_doubling`` (a real multiplier through -1), ``neimark_sacker`` (a complex
+    pair through the unit circle) and ``infinite_period`` (omega falls below
+    ``min_omega``, or a point fails its certificate while
     omega falls; that point is not kept, the branch stops with ``"infinite_period"`` and
     the event's parameter ``p*`` is fitted on the last three points as
     ``T = C / sqrt|p - p*| + D``, the period law near a saddle-node on the invariant

@@ -27,11 +27,11 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
     d.set_item("p", pt.p)?;
     d.set_item("dp_ds", pt.arc.dp_ds())?;
     d.set_item("det_sign", pt.arc.det_sign)?;
-    d.set_item("test_LP", pt.tests.lp)?;
-    d.set_item("test_BP", pt.tests.bp)?;
-    d.set_item("test_BP_multipliers", pt.tests.bp_multipliers)?;
-    d.set_item("test_PD", pt.tests.pd)?;
-    d.set_item("test_NS", pt.tests.ns)?;
+    d.set_item("test_fold", pt.tests.lp)?;
+    d.set_item("test_branch_point", pt.tests.bp)?;
+    d.set_item("test_branch_point_multipliers", pt.tests.bp_multipliers)?;
+    d.set_item("test_period_doubling", pt.tests.pd)?;
+    d.set_item("test_neimark_sacker", pt.tests.ns)?;
     d.set_item(
         "event",
         pt.events

@@ -30,7 +30,7 @@
 //! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
 //! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
 
-use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength, Event};
 use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
@@ -94,14 +94,19 @@ pub enum PoEventKind {
 }
 
 impl PoEventKind {
-    pub fn as_str(&self) -> &'static str {
+    /// The event in the one vocabulary of all branches.
+    pub fn event(self) -> Event {
         match self {
-            PoEventKind::Fold => "LP",
-            PoEventKind::BranchPoint => "BP",
-            PoEventKind::PeriodDoubling => "PD",
-            PoEventKind::NeimarkSacker => "NS",
-            PoEventKind::InfinitePeriod => "IP",
+            PoEventKind::Fold => Event::Fold,
+            PoEventKind::BranchPoint => Event::BranchPoint,
+            PoEventKind::PeriodDoubling => Event::PeriodDoubling,
+            PoEventKind::NeimarkSacker => Event::NeimarkSacker,
+            PoEventKind::InfinitePeriod => Event::InfinitePeriod,
         }
+    }
+
+    pub fn as_str(&self) -> &'static str {
+        self.event().name()
     }
 }
 

@@ -28,6 +28,7 @@
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
 use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::continuation::curves::{join_halves, Extended, TwoParameter};
+use crate::continuation::event::Event;
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::seed003::Seed003;
@@ -432,12 +433,17 @@ pub enum EventKind {
 }
 
 impl EventKind {
-    pub fn as_str(&self) -> &'static str {
+    /// The event in the one vocabulary of all branches.
+    pub fn event(self) -> Event {
         match self {
-            EventKind::Fold => "fold",
-            EventKind::Hopf => "hopf",
-            EventKind::BranchPoint => "branch_point",
+            EventKind::Fold => Event::Fold,
+            EventKind::Hopf => Event::Hopf,
+            EventKind::BranchPoint => Event::BranchPoint,
         }
+    }
+
+    pub fn as_str(&self) -> &'static str {
+        self.event().name()
     }
 }
 
