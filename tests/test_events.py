@@ -156,3 +156,40 @@ def test_switch_takes_an_equilibrium_branchs_own_hopf_point() -> None:
     assert e.value.parameter == "event" and "its events:" in str(e.value)
 
 
+def test_periodic_branch_both_ways_covers_both_sides() -> None:
+    ref = merged_rr()
+    t = ref.table
+    bp, fold = (float(ref.events.filter(ref.events["type"] == k)["Omega"][0])
+                for k in ("branch_point", "fold"))
+    # a start between the branch point (below) and the fold (above)
+    k = next(i for i, om in enumerate(t["Omega"].to_list()) if bp < om < fold)
+    start, om0 = ref.solutions[k], float(t["Omega"][k])
+    opts = Continuation(ds=0.02, ds_max=0.05, max_points=30)
+    up = periodic_branch(start, "Omega", range=(1.6, 2.0), options=opts, direction="forward")
+    down = periodic_branch(start, "Omega", range=(1.6, 2.0), options=opts,
+                           direction="backward")
+    both = periodic_branch(start, "Omega", range=(1.6, 2.0), options=opts, direction="both")
+    assert "branch_point" not in up.events["type"].to_list()
+    assert "fold" not in down.events["type"].to_list()
+    assert both.stop.count("/") == 1
+    om = both.table["Omega"].to_numpy()
+    assert om.min() < bp < om0 < fold and (om == om0).sum() == 1
+    assert both.table.height == up.table.height + down.table.height - 1
+    j = int(np.nonzero(om == om0)[0][0])
+    np.testing.assert_allclose(om[j::-1], down.table["Omega"].to_numpy(), atol=0)
+    np.testing.assert_allclose(om[j:], up.table["Omega"].to_numpy(), atol=0)
+    ev = both.events
+    assert ev["type"].to_list()[:2] == ["branch_point", "fold"], ev
+    assert abs(ev["Omega"][0] - bp) < 1e-6 and abs(ev["Omega"][1] - fold) < 1e-6
+    # every event is named in its row's event column and lies between the row before
+    # it and its row (a fold, where Omega turns back, beyond both)
+    for typ, p, i in ev.select("type", "Omega", "index").rows():
+        lo, hi = sorted((om[i - 1], om[i]))
+        assert typ in both.table["event"][i]
+        assert lo - 1e-9 <= p <= hi + 1e-9 if typ != "fold" else p >= hi
+    # oriented along the rows: Omega grows from the lower end up to the fold
+    i_fold = int(ev["index"][1])
+    assert (both.table["dp_ds"].to_numpy()[:i_fold] > 0).all()
+    with pytest.raises(ParameterError) as e:
+        periodic_branch(start, "Omega", range=(1.6, 2.0), direction="up")  # type: ignore[arg-type]
+    assert e.value.parameter == "direction"

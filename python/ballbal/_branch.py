@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import polars as pl
@@ -80,6 +80,20 @@ def event_row(branch: Branch, event: Any, parameter: str = "event") -> int:
         raise ParameterError(parameter, f"the branch has {n} events; {_listing(branch)}",
                              value=i)
     return i
+
+
+def directed(options: Continuation, direction: Any) -> tuple[Continuation, bool]:
+    """``options`` turned by a branch function's ``direction`` (``"forward"``: towards
+    increasing parameter, ``"backward"``, ``"both"``, or None: ``options.forward``), and
+    whether both ways were asked for."""
+    if direction is None:
+        return options, False
+    if not isinstance(direction, str) or direction not in ("forward", "backward", "both"):
+        raise ParameterError("direction", f"must be 'forward', 'backward' or 'both', got "
+                             f"{direction!r:.60}", allowed="forward, backward, both")
+    if direction == "both":
+        return options, True
+    return replace(options, forward=direction == "forward"), False
 
 
 def model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:

@@ -6,7 +6,6 @@ two-parameter curves of those bifurcations (the core's
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
@@ -17,6 +16,7 @@ from ballbal._branch import (
     Branch,
     Continuation,
     Curve,
+    directed,
     event_row,
     model_at,
     parameter_range,
@@ -164,12 +164,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     parameter = _check.string("parameter", parameter)
     rng = parameter_range(range)
     options = _options(options)
-    if direction is not None and (not isinstance(direction, str)
-                                  or direction not in ("forward", "backward", "both")):
-        raise ParameterError("direction", f"must be 'forward', 'backward' or 'both', got "
-                             f"{direction!r:.60}", allowed="forward, backward, both")
-    if direction in ("forward", "backward"):
-        options = replace(options, forward=direction == "forward")
+    options, both = directed(options, direction)
     if isinstance(start, str):
         found = [e for e in equilibria(native) if e.kind == start]
         if not found:
@@ -180,7 +175,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     if not isinstance(start, Equilibrium):
         raise ParameterTypeError("start", "must be an Equilibrium or a kind name")
     d = _native.equilibrium_branch(native, parameter, [float(v) for v in start.q], start.kind,
-                                   rng, options, direction == "both", seed)
+                                   rng, options, both, seed)
     return _branch(d, parameter, model, rng, options)
 
 

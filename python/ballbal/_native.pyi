@@ -140,6 +140,7 @@ def periodic_branch(
     model: Balancer | Scene, parameter: str,
     start: tuple[float, npt.NDArray[np.float64], list[float]], p_range: tuple[float, float],
     continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
+    both: bool = False,
 ) -> dict[str, Any]: ...
 # {"kind", "together", "points": [solution dict + p1, p2, test, test_*], "special", "stop"}
 # special: [{"type", "p1", "p2", "omega", "row", "status" ("confirmed" | "rejected" |

@@ -6,13 +6,13 @@ certified and judged as :func:`ballbal.periodic` does, with its bifurcations loc
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import polars as pl
 
 from . import _check, _native
-from ._branch import Branch, Continuation, model_at, parameter_range
+from ._branch import Branch, Continuation, directed, model_at, parameter_range
 from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
@@ -71,6 +71,7 @@ def periodic_branch(
     periodic_options: PeriodicOptions | None = None,
     min_omega: float = 1e-3,
     event_tol: float = 1e-7,
+    direction: Literal["forward", "backward", "both"] | None = None,
 ) -> Branch:
     """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
     in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
@@ -79,6 +80,12 @@ def periodic_branch(
     pseudo-arclength continuation of the harmonic-balance equations (through folds),
     with ``N`` harmonics (default: the start's).
 
+    ``direction``: ``"forward"`` (towards increasing ``parameter``), ``"backward"``, or
+    ``"both"``: both ways from the start, the rows running from the end reached
+    downwards to the end reached upwards (the start once; tangents, ``dp_ds``,
+    ``det_sign``, ``test_fold`` and ``test_branch_point`` oriented along the rows),
+    ``stop`` then ``"<lower end>/<upper end>"``. Default: ``options.forward``, as for
+    :func:`~ballbal.continuation.equilibrium_branch`.
 
     Every point gets the certificates and Floquet multipliers of :func:`ballbal.periodic`
     with ``periodic_options`` (default :data:`ballbal.options.PERIODIC_DEFAULTS`;
@@ -129,6 +136,7 @@ def periodic_branch(
     lo, hi = parameter_range(range)
     options = _check.option("options", options, Continuation, Continuation(),
                             "ballbal.continuation.Continuation")
+    options, both = directed(options, direction)
     popts = _check.option("periodic_options", periodic_options, PeriodicOptions,
                           PERIODIC_DEFAULTS, "ballbal.PeriodicOptions")
     n = start.N if N is None else _check.integer("N", N, 1, 256)
@@ -139,7 +147,7 @@ def periodic_branch(
     coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
     winding = [float(w) for w in start.winding]
     d = _native.periodic_branch(model, parameter, (float(start.omega), coeffs, winding),
-                                (lo, hi), options, popts, min_omega, event_tol)
+                                (lo, hi), options, popts, min_omega, event_tol, both)
     table = pl.DataFrame([_row(parameter, p) for p in d["points"]], schema=_schema(parameter),
                          orient="row") if d["points"] else pl.DataFrame(schema=_schema(parameter))
     ev_rows = []
