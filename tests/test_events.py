@@ -9,6 +9,7 @@ from __future__ import annotations
 from functools import cache
 
 import numpy as np
+import polars as pl
 import pytest
 from scipy.optimize import brentq
 from test_eq_continuation import _pb_matrices, eta_fold
@@ -129,6 +130,38 @@ def _pb_hopf_points(eta: float, lo: float, hi: float) -> list[float]:
     for k in np.nonzero(np.sign(r[1:]) != np.sign(r[:-1]))[0]:
         out.append(brentq(_pb_max_real, grid[k], grid[k + 1], args=(eta,), xtol=1e-13))
     return out
+
+
+def test_default_step_finds_the_close_pair_of_hopf_points() -> None:
+    # eta 0.505: the perfect balance loses stability on (1.0543, 1.0758) only, between
+    # two Hopf points 0.0215 apart; with the default ds_max 0.05 a step used to span them.
+    eta = 0.505
+    exact = _pb_hopf_points(eta, 0.95, 1.2)
+    assert len(exact) == 3, exact
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50, Omega=0.9, eta=(eta, eta))
+    br = equilibrium_branch(b, "Omega", start="perfect_balance", range=(0.8, 1.5))
+    h = br.events.filter(br.events["type"] == "hopf")
+    assert h.height == 3, br.events
+    np.testing.assert_allclose(h["Omega"].to_numpy(), exact, atol=1e-7)
+    # the unstable window has rows, and they say so
+    om = br.table["Omega"].to_numpy()
+    inside = (om > exact[1]) & (om < exact[2])
+    assert inside.any()
+    assert (br.table.filter(pl.Series(inside))["stability"] == "unstable").all()
+    # the other directions see them too
+    both = equilibrium_branch(b.replace(Omega=1.2), "Omega", start="perfect_balance",
+                              range=(0.8, 1.5), direction="both")
+    hb = both.events.filter(both.events["type"] == "hopf")["Omega"].to_numpy()
+    np.testing.assert_allclose(np.sort(hb), exact, atol=1e-7)
+
+
+def test_a_zero_eigenvalue_at_the_start_is_named() -> None:
+    # eta = 1/2: the balls meet opposite the imbalance, a zero eigenvalue of the
+    # perfect balance at every speed.
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50, Omega=1.2, eta=(0.5, 0.5))
+    with pytest.raises(ParameterError) as e:
+        equilibrium_branch(b, "Omega", start="perfect_balance", range=(1.0, 1.5))
+    assert e.value.parameter == "start" and "singular" in str(e.value), e.value
 
 
 def test_switch_takes_an_equilibrium_branchs_own_hopf_point() -> None:

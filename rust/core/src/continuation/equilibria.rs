@@ -511,6 +511,86 @@ fn tests<D: Dynamics + Clone>(
     })
 }
 
+/// At most this many halvings of one step by [`branch`]'s checks for events hidden
+/// inside it (the step then stands: a check that keeps failing, e.g. on an eigenvalue
+/// that sits on the axis, must not stall the branch).
+const MAX_SPLITS: usize = 6;
+
+/// What [`branch`]'s step control reads of a point's eigenvalues.
+struct Spectrum {
+    /// Eigenvalues with a positive real part (above [`UNSTABLE_TOL`]).
+    unstable: usize,
+    /// The smallest `|Re|` of a complex pair (infinite without one).
+    pair_distance: f64,
+}
+
+/// Real parts below this count as on the axis, not unstable: neutral directions of a
+/// family sit at round-off from zero and must not look like crossings.
+const UNSTABLE_TOL: f64 = 1e-7;
+
+impl Spectrum {
+    fn of(eq: &Equilibrium) -> Spectrum {
+        let unstable = eq
+            .eigenvalues
+            .iter()
+            .filter(|(re, _)| *re > UNSTABLE_TOL)
+            .count();
+        let pair_distance = eq
+            .eigenvalues
+            .iter()
+            .filter(|(_, im)| im.abs() > UNSTABLE_TOL)
+            .map(|(re, _)| re.abs())
+            .fold(f64::INFINITY, f64::min);
+        Spectrum {
+            unstable,
+            pair_distance,
+        }
+    }
+}
+
+/// Whether a complex pair is near enough the imaginary axis at both ends of a step of
+/// arclength `ds` to cross it twice inside: its real part moves at most about as fast
+/// as the point (unknowns and parameters are O(1)), so one that stays farther than the
+/// step from the axis at both ends cannot reach it and come back.
+fn pair_near_axis(a: &Spectrum, b: &Spectrum, ds: f64) -> bool {
+    a.pair_distance.max(b.pair_distance) < ds.abs()
+}
+
+/// Whether the test functions change sign at the step's midpoint though not between
+/// its ends: two zeros (a Hopf point and its return, two folds) inside one step.
+#[allow(clippy::too_many_arguments)]
+fn crossed_twice<D: Dynamics + Clone>(
+    sys: &mut EqSystem<'_, D>,
+    a: &ArcPoint,
+    b: &ArcPoint,
+    ta: &Tests,
+    tb: &Tests,
+    together: bool,
+    opts: &ArcOptions,
+) -> Result<bool> {
+    let Some(m) = point_at(sys, a, 0.5 * b.ds, opts)? else {
+        return Ok(false);
+    };
+    let tm = tests(sys, &m, together)?;
+    let twice = |ga: f64, gm: f64, gb: f64| ga * gb > 0.0 && ga * gm < 0.0;
+    Ok(twice(ta.hopf, tm.hopf, tb.hopf)
+        || twice(ta.fold, tm.fold, tb.fold)
+        || twice(ta.bp, tm.bp, tb.bp))
+}
+
+/// Whether the located events account for the change in the count of unstable
+/// eigenvalues over a step: a Hopf point moves two, a fold or branch point one.
+fn explained(a: &Spectrum, b: &Spectrum, events: &[EqEvent]) -> bool {
+    let moved: usize = events
+        .iter()
+        .map(|e| match e.kind {
+            EventKind::Hopf => 2,
+            EventKind::Fold | EventKind::BranchPoint => 1,
+        })
+        .sum();
+    a.unstable.abs_diff(b.unstable) <= moved
+}
+
 fn analyse_at<D: Dynamics + Clone>(
     sys: &mut EqSystem<'_, D>,
     x: &[f64],
@@ -559,13 +639,26 @@ pub fn branch<D: Dynamics + Clone>(
     let mut arc = Arclength::new(sys, x0, p0, direction, arc_opts.clone())?;
     let mut points: Vec<EqPoint> = vec![];
     let mut events: Vec<EqEvent> = vec![];
-    let mut prev: Option<(ArcPoint, Tests, bool)> = None;
+    let mut prev: Option<(ArcPoint, Tests, bool, Spectrum)> = None;
+    let mut splits = 0;
     while let Some(pt) = arc.next() {
         let q = arc.problem().full(&pt.x);
         let together = kind_of(&q, o, start) == EquilibriumKind::Together;
         let t = tests(arc.problem(), &pt, together)?;
+        let eq = analyse_at(arc.problem(), &pt.x, pt.p, start, opts.family)?;
+        let spectrum = Spectrum::of(&eq);
         let row = points.len();
-        if let Some((a, ta, tog_a)) = &prev {
+        let mut found_events = vec![];
+        if let Some((a, ta, tog_a, sa)) = &prev {
+            let may_hide = splits < MAX_SPLITS && *tog_a == together;
+            if may_hide
+                && pair_near_axis(sa, &spectrum, pt.ds)
+                && crossed_twice(arc.problem(), a, &pt, ta, &t, together, &arc_opts)?
+                && arc.subdivide()
+            {
+                splits += 1;
+                continue;
+            }
             let mut found = vec![];
             if ta.fold * t.fold < 0.0 {
                 found.push(EventKind::Fold);
@@ -619,7 +712,7 @@ pub fn branch<D: Dynamics + Clone>(
                     f64::NAN
                 };
                 let eq = analyse_at(s, &e.x, e.p, start, opts.family)?;
-                events.push(EqEvent {
+                found_events.push(EqEvent {
                     kind,
                     row,
                     p: e.p,
@@ -630,8 +723,16 @@ pub fn branch<D: Dynamics + Clone>(
                     omega,
                 });
             }
+            // Unstable eigenvalues that appear or vanish with no located event to
+            // account for them crossed inside the step (a Hopf pair and its return, or
+            // two pairs at once): the step is taken again in halves.
+            if may_hide && !explained(sa, &spectrum, &found_events) && arc.subdivide() {
+                splits += 1;
+                continue;
+            }
         }
-        let eq = analyse_at(arc.problem(), &pt.x, pt.p, start, opts.family)?;
+        splits = 0;
+        events.extend(found_events);
         points.push(EqPoint {
             p: pt.p,
             x: pt.x.clone(),
@@ -641,7 +742,7 @@ pub fn branch<D: Dynamics + Clone>(
             bp: t.bp,
             hopf: t.hopf,
         });
-        prev = Some((pt, t, together));
+        prev = Some((pt, t, together, spectrum));
     }
     let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
     if crate::cancel::cancelled() {
@@ -650,7 +751,12 @@ pub fn branch<D: Dynamics + Clone>(
     if points.is_empty() {
         return Err(Error::param(
             "start",
-            format!("the start does not converge to an equilibrium at {p0}: {stop:?}"),
+            match &stop {
+                ArcStop::Failed(why) => format!("no branch from the start at {p0}: {why}"),
+                other => {
+                    format!("the start does not converge to an equilibrium at {p0}: {other:?}")
+                }
+            },
         ));
     }
     Ok(EqBranch {
