@@ -520,8 +520,9 @@ const MAX_SPLITS: usize = 6;
 struct Spectrum {
     /// Eigenvalues with a positive real part (above [`UNSTABLE_TOL`]).
     unstable: usize,
-    /// The smallest `|Re|` of a complex pair (infinite without one).
-    pair_distance: f64,
+    /// The real part of the complex eigenvalue nearest the imaginary axis (NaN without
+    /// one).
+    pair_re: f64,
 }
 
 /// Real parts below this count as on the axis, not unstable: neutral directions of a
@@ -535,25 +536,47 @@ impl Spectrum {
             .iter()
             .filter(|(re, _)| *re > UNSTABLE_TOL)
             .count();
-        let pair_distance = eq
+        let pair_re = eq
             .eigenvalues
             .iter()
             .filter(|(_, im)| im.abs() > UNSTABLE_TOL)
-            .map(|(re, _)| re.abs())
-            .fold(f64::INFINITY, f64::min);
-        Spectrum {
-            unstable,
-            pair_distance,
+            .map(|(re, _)| *re)
+            .fold(f64::NAN, |m, re| {
+                if re.abs() < m.abs() || m.is_nan() {
+                    re
+                } else {
+                    m
+                }
+            });
+        Spectrum { unstable, pair_re }
+    }
+
+    fn pair_distance(&self) -> f64 {
+        if self.pair_re.is_nan() {
+            f64::INFINITY
+        } else {
+            self.pair_re.abs()
         }
     }
 }
 
-/// Whether a complex pair is near enough the imaginary axis at both ends of a step of
-/// arclength `ds` to cross it twice inside: its real part moves at most about as fast
-/// as the point (unknowns and parameters are O(1)), so one that stays farther than the
-/// step from the axis at both ends cannot reach it and come back.
-fn pair_near_axis(a: &Spectrum, b: &Spectrum, ds: f64) -> bool {
-    a.pair_distance.max(b.pair_distance) < ds.abs()
+/// Whether the complex pair nearest the axis could cross it and come back inside a step
+/// of arclength `ds` from `a` to `b`. Near its largest value inside the step the real
+/// part is `m - k (s - s*)^2`: an end a distance `d <= ds` from `s*` that is still off
+/// the axis has `|Re| <= k d^2` and slope `2 k d`, so `|Re| <= slope ds / 2`. `rate` is
+/// that slope at `a` from the step before it (the secant); twice `rate ds`, four times
+/// the parabola's bound, allows for the secant's error. Without a step before `a`, the
+/// slope is taken as one (unknowns and parameters are O(1)).
+fn pair_may_return(a: &Spectrum, b: &Spectrum, rate: Option<f64>, ds: f64) -> bool {
+    let reach = rate.map_or(ds.abs(), |r| 2.0 * r * ds.abs());
+    a.pair_distance().max(b.pair_distance()) < reach
+}
+
+/// The rate at which the pair nearest the axis moves over a step of arclength `ds`.
+fn pair_rate(a: &Spectrum, b: &Spectrum, ds: f64) -> Option<f64> {
+    let r = (b.pair_re - a.pair_re).abs() / ds.abs();
+    // a pair appearing or vanishing (NaN) or a zero step: no rate, the O(1) default
+    r.is_finite().then_some(r)
 }
 
 /// Whether the test functions change sign at the step's midpoint though not between
@@ -639,7 +662,7 @@ pub fn branch<D: Dynamics + Clone>(
     let mut arc = Arclength::new(sys, x0, p0, direction, arc_opts.clone())?;
     let mut points: Vec<EqPoint> = vec![];
     let mut events: Vec<EqEvent> = vec![];
-    let mut prev: Option<(ArcPoint, Tests, bool, Spectrum)> = None;
+    let mut prev: Option<(ArcPoint, Tests, bool, Spectrum, Option<f64>)> = None;
     let mut splits = 0;
     while let Some(pt) = arc.next() {
         let q = arc.problem().full(&pt.x);
@@ -649,10 +672,12 @@ pub fn branch<D: Dynamics + Clone>(
         let spectrum = Spectrum::of(&eq);
         let row = points.len();
         let mut found_events = vec![];
-        if let Some((a, ta, tog_a, sa)) = &prev {
+        let mut rate = None;
+        if let Some((a, ta, tog_a, sa, rate_a)) = &prev {
+            rate = pair_rate(sa, &spectrum, pt.ds);
             let may_hide = splits < MAX_SPLITS && *tog_a == together;
             if may_hide
-                && pair_near_axis(sa, &spectrum, pt.ds)
+                && pair_may_return(sa, &spectrum, *rate_a, pt.ds)
                 && crossed_twice(arc.problem(), a, &pt, ta, &t, together, &arc_opts)?
                 && arc.subdivide()
             {
@@ -742,7 +767,7 @@ pub fn branch<D: Dynamics + Clone>(
             bp: t.bp,
             hopf: t.hopf,
         });
-        prev = Some((pt, t, together, spectrum));
+        prev = Some((pt, t, together, spectrum, rate));
     }
     let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
     if crate::cancel::cancelled() {
