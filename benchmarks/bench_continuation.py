@@ -1,6 +1,8 @@
 """Continuation speed: points per second. Sections: ``equilibria`` (a branch of the
-balls-together equilibria in eta with its events located, and a 100-point saddle-node
-curve in (eta, Omega)). Run: python benchmarks/bench_continuation.py"""
+balls-together equilibria in eta with its events located, a 100-point saddle-node
+curve in (eta, Omega), and the perfect balance in Omega at eta 0.505 with the default
+step, where two Hopf points 0.0215 apart make the step control subdivide a step).
+Run: python benchmarks/bench_continuation.py"""
 
 from __future__ import annotations
 
@@ -29,6 +31,15 @@ def equilibria() -> None:
     dt = time.perf_counter() - t
     print(f"equilibria: saddle-node curve {c.table.height} points: {dt:.3f} s "
           f"({c.table.height / dt:.0f} points/s)")
+    pb = b.replace(Omega=0.9, eta=(0.505, 0.505))
+    reps = 20
+    t = time.perf_counter()
+    for _ in range(reps):
+        br = equilibrium_branch(pb, "Omega", start="perfect_balance", range=(0.8, 1.5))
+    dt = (time.perf_counter() - t) / reps
+    hopf = (br.events["type"] == "hopf").sum()
+    print(f"equilibria: default-step branch at eta 0.505 {br.table.height} points, {hopf} Hopf: "
+          f"{dt * 1e3:.2f} ms ({br.table.height / dt:.0f} points/s)")
 
 
 if __name__ == "__main__":

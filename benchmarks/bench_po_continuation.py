@@ -55,7 +55,7 @@ def branch_vs_scan(opts: ballbal.PeriodicOptions, label: str) -> ballbal.continu
 
 
 def curve(br: ballbal.continuation.Branch, opts: ballbal.PeriodicOptions, label: str) -> None:
-    i = br.events["type"].to_list().index("BP")
+    i = br.events["type"].to_list().index("branch_point")
     t = time.perf_counter()
     c = periodic_curve(br, i, "eta", range=(0.3, 3.0), range1=(0.5, 5.0),
                        periodic_options=opts,

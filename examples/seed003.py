@@ -48,18 +48,15 @@ def figure4(ax: plt.Axes) -> None:
     """SN_2+, PF and H_1 in (omega0, m0), continued in the seed's parameters."""
     seed = Seed003(omega0=0.3, m0=M0, e=2.0, C0=0.35, D0=0.35)
     tog = equilibrium_branch(seed, "omega0", start="together", range=(0.25, 2.2), options=OPTS)
-    sn = equilibrium_curve(tog, tog.events["type"].to_list().index("fold"), "m0",
-                           range=(0.05, 5.0), options=OPTS)
+    sn = equilibrium_curve(tog, "fold", "m0", range=(0.05, 5.0), options=OPTS)
     at = seed.replace(omega0=1.5, m0=0.5)  # the state 2+ (balls opposite the imbalance)
     start = next(e for e in ballbal.equilibria(at.balancer)
                  if e.kind == "together" and np.cos(e.q[2]) < 0)
     up = equilibrium_branch(at, "m0", start=start, range=(0.05, 5.0), options=OPTS)
-    pf = equilibrium_curve(up, up.events["type"].to_list().index("branch_point"), "omega0",
-                           range=(0.01, 2.2), options=OPTS)
+    pf = equilibrium_curve(up, "branch_point", "omega0", range=(0.01, 2.2), options=OPTS)
     pb = equilibrium_branch(seed.replace(omega0=0.8), "omega0", start="perfect_balance",
                             range=(0.6, 2.2), options=OPTS)
-    h1 = equilibrium_curve(pb, pb.events["type"].to_list().index("hopf"), "m0",
-                           range=(1.0 + 1e-4, 5.0), options=OPTS)
+    h1 = equilibrium_curve(pb, "hopf", "m0", range=(1.0 + 1e-4, 5.0), options=OPTS)
     for c, name, style in ((sn, "SN_2+", "-"), (pf, "PF", "-."), (h1, "H_1", "--")):
         ax.plot(c.table["omega0"], c.table["m0"], style, label=name)
         print(f"figure 4: {name} of {c.table.height} points, stop {c.stop}")

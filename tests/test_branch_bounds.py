@@ -66,7 +66,7 @@ def across_the_period_doubling() -> ballbal.continuation.Branch:
 def test_verdicts_across_a_period_doubling_are_bounded_and_right() -> None:
     br = across_the_period_doubling()
     t = br.table
-    assert br.events["type"].to_list() == ["PD"], br.events
+    assert br.events["type"].to_list() == ["period_doubling"], br.events
     assert set(t["stability"].to_list()) >= set(DECIDED)
     _check_rows(br)
     # The decided rows on either side of the event, and the branch's two ends.

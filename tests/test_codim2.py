@@ -39,7 +39,7 @@ def branch() -> ballbal.continuation.Branch:
 def _fold_pair() -> tuple[int, int]:
     ev = branch().events
     lp = [(i, om) for i, (t, om) in enumerate(ev.select("type", "Omega").rows())
-          if t == "LP" and 1.225 < om < 1.24]
+          if t == "fold" and 1.225 < om < 1.24]
     # the snake's folds alternate; the pair around the CP: ~1.2312 and ~1.2381
     near = [i for i, om in lp if abs(om - 1.2312) < 2e-3 or abs(om - 1.2381) < 2e-3]
     assert len(near) == 2, ev

@@ -59,7 +59,7 @@ def fold_flip_curve() -> Curve:
     br = periodic_branch(s, "eta", range=(0.25, 0.30), periodic_options=MONODROMY,
                          options=Continuation(ds=0.01, ds_max=0.02, forward=False,
                                               max_points=40))
-    i = br.events["type"].to_list().index("PD")
+    i = br.events["type"].to_list().index("period_doubling")
     return periodic_curve(br, i, "Omega", range=(1.155, 1.1605), range1=(0.25, 0.4),
                           periodic_options=NO_FLOQUET,
                           options=Continuation(ds=0.005, ds_max=0.01, max_points=30))
@@ -176,8 +176,8 @@ def test_snake_period_doubling_against_shooting() -> None:
     br = snake()
     ev = br.events
     types = ev["type"].to_list()
-    assert "PD" in types, ev
-    i = types.index("PD")
+    assert "period_doubling" in types, ev
+    i = types.index("period_doubling")
     k = int(ev["index"][i])
     assert 1.2 < float(ev["Omega"][i]) < 1.25
     assert float(br.table["max_modulus"][k]) > 100  # the snake's: strongly unstable

@@ -57,7 +57,7 @@ def test_switch_to_the_perfect_balance() -> None:
     np.testing.assert_allclose(b1, np.arccos(-1 / (2 * eta)), atol=1e-8)
     with pytest.raises(ParameterError) as e:
         switch_equilibrium(br, br.events["type"].to_list().index("fold"))
-    assert e.value.parameter == "event_index"
+    assert e.value.parameter == "event"
 
 
 def test_saddle_node_curve_against_the_closed_form() -> None:

@@ -60,7 +60,7 @@ NAMES = {
     "early_stop", "speeds", "dwell", "direction", "kick", "record", "angles", "t",
     "magnus_rtol", "result", "title", "y", "d", "n_balls", "omega_from", "omega_to",
     # continuation
-    "range", "range1", "parameter", "parameter2", "event_index", "event", "kind",
+    "range", "range1", "parameter", "parameter2", "event", "kind",
     "amplitude", "solution", "branch", "min_omega", "event_tol", "periodic_options",
     "locate_tol", "ds", "ds_min", "ds_max", "max_points", "max_newton", "grow", "min_cos",
     "forward", "omega0", "m0", "e", "C0", "D0",

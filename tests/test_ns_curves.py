@@ -101,7 +101,7 @@ def whirl_branch() -> ballbal.continuation.Branch:
 
 def ns_event() -> int:
     ev = whirl_branch().events
-    rows = [i for i, t in enumerate(ev["type"]) if t == "NS"]
+    rows = [i for i, t in enumerate(ev["type"]) if t == "neimark_sacker"]
     assert len(rows) == 1, ev
     return rows[0]
 
@@ -136,7 +136,7 @@ def test_ns_event_is_where_shooting_multipliers_leave_the_unit_circle():
 def test_ns_curve_points_have_a_shooting_pair_on_the_unit_circle_at_theta():
     c = ns_curve()
     t = c.table
-    assert c.kind == "NS" and "theta" in t.columns
+    assert c.kind == "neimark_sacker" and "theta" in t.columns
     assert t.height >= 5, c.stop
     assert t["rho"].min() < 0.495 and t["rho"].max() > 0.505
     sols = c.meta["solutions"]
@@ -159,7 +159,7 @@ def test_ns_curve_meets_the_branch_event_at_another_rho():
     br = periodic_branch(start, "zeta", range=(zeta - 0.01, zeta + 0.01),
                          options=Continuation(ds=0.004, ds_max=0.005, max_points=20,
                                               forward=False))
-    ns = br.events.filter(br.events["type"] == "NS")
+    ns = br.events.filter(br.events["type"] == "neimark_sacker")
     assert ns.height == 1, br.events
     assert ns["zeta"][0] == pytest.approx(zeta, abs=1e-6)
 

@@ -131,7 +131,7 @@ def test_branch_point_against_shooting() -> None:
     (the merged balls' separation multiplier): shooting on both sides of the located
     point brackets it, and its secant zero is the located parameter."""
     br = standard_up()
-    bp = br.events.filter(br.events["type"] == "BP")
+    bp = br.events.filter(br.events["type"] == "branch_point")
     assert bp.height >= 1, br.events
     om = float(bp["Omega"][0])
     k = _row_near(br, om)
@@ -203,7 +203,7 @@ def test_fold_against_shooting() -> None:
     after the fold) is 1e-5, hence the 3e-5 allowed. Each shooting starts from the
     series re-solved at its Omega from the branch row on its side (the start only)."""
     br = standard_up()
-    lp = br.events.filter(br.events["type"] == "LP")
+    lp = br.events.filter(br.events["type"] == "fold")
     assert lp.height == 1, br.events
     om = float(lp["Omega"][0])
     i = int(lp["index"][0])
@@ -247,8 +247,8 @@ def test_simulation_past_the_branch_point_separates_the_balls() -> None:
     2 pi / 3 apart). Before it the nudge dies out and the balls stay merged. (The branch
     folds back 0.009 above the branch point: the point past it is taken between the two.)"""
     br = standard_up()
-    bp = float(br.events.filter(br.events["type"] == "BP")["Omega"][0])
-    lp = float(br.events.filter(br.events["type"] == "LP")["Omega"][0])
+    bp = float(br.events.filter(br.events["type"] == "branch_point")["Omega"][0])
+    lp = float(br.events.filter(br.events["type"] == "fold")["Omega"][0])
     assert bp + 3e-3 < lp
     guess = br.solutions[_row_near(br, bp)]
     for om, past in ((bp - 5e-3, False), (bp + 3e-3, True)):
@@ -310,8 +310,9 @@ def test_continuation_down_stops_at_the_infinite_period_end() -> None:
     br = rr_zeta_b_01_down()
     t = br.table
     assert br.stop == "infinite_period", br.stop
-    assert br.events["type"].to_list()[-1] == "IP" and (br.events["type"] == "IP").sum() == 1
-    ip = br.events.filter(br.events["type"] == "IP")
+    types = br.events["type"].to_list()
+    assert types[-1] == "infinite_period" and types.count("infinite_period") == 1
+    ip = br.events.filter(br.events["type"] == "infinite_period")
     assert int(ip["index"][0]) == t.height
     om_ip = float(ip["Omega"][0])
     assert (t["Omega"] > om_ip).all()
@@ -365,7 +366,7 @@ def test_period_doubling_against_shooting_and_simulation() -> None:
     s = ballbal.periodic(_thesis(0.9), "R-R", options=OPTS)
     br = periodic_branch(s, "eta", range=(0.8, 0.9),
                          options=Continuation(ds=0.01, ds_max=0.02, forward=False))
-    pd = br.events.filter(br.events["type"] == "PD")
+    pd = br.events.filter(br.events["type"] == "period_doubling")
     assert pd.height == 1, br.events
     e_pd = float(pd["eta"][0])
     k = int(pd["index"][0])
@@ -382,7 +383,7 @@ def test_period_doubling_against_shooting_and_simulation() -> None:
     zero = (e_pd + h) - g[0] * (-2 * h) / (g[1] - g[0])
     assert abs(zero - e_pd) < 2e-5, (zero, e_pd)
     # The doubled orbit from the event, followed into the tongue.
-    i_pd = br.events["type"].to_list().index("PD")
+    i_pd = br.events["type"].to_list().index("period_doubling")
     d2 = switch(br, event=i_pd, amplitude=0.2)
     assert d2.converged and list(d2.winding[2:]) == [-2, -2] and d2.info["value"] < e_pd
     for e in (0.84, 0.82):
@@ -427,7 +428,7 @@ def test_scan_verdicts_agree_with_the_events() -> None:
     df = df.filter((df["status"] == "converged") & df["separation_error"].is_not_null()
                    & df["stability"].is_in(["stable", "unstable"]))
     assert df.height > 10
-    ev = br.events.filter(br.events["type"] != "IP")["Omega"].to_numpy()
+    ev = br.events.filter(br.events["type"] != "infinite_period")["Omega"].to_numpy()
     t = br.table.filter(br.table["stability"].is_in(["stable", "unstable"]))
     checked = 0
     for r in df.iter_rows(named=True):

@@ -118,14 +118,14 @@ def pd_curve() -> Curve:
     br = periodic_branch(start, "eta", range=(0.8, 0.9), periodic_options=MONODROMY,
                          options=Continuation(ds=0.01, ds_max=0.02, forward=False,
                                               max_points=60))
-    return periodic_curve(br, _event(br, "PD"), "Omega", range=(1.15, 1.25), range1=(0.3, 1.5),
+    return periodic_curve(br, "period_doubling", "Omega", range=(1.15, 1.25), range1=(0.3, 1.5),
                           options=Continuation(ds=0.05, ds_max=0.2, max_points=8))
 
 
 def test_pd_curve_points_have_a_multiplier_minus_one_by_shooting() -> None:
     c = pd_curve()
     t = c.table
-    assert c.kind == "PD" and c.meta["together"]
+    assert c.kind == "period_doubling" and c.meta["together"]
     assert t.height >= 10 and float(t["Omega"].max() - t["Omega"].min()) > 0.05
     assert np.all(np.abs(t["test"].to_numpy()) < 1e-8)
     # The far end (the start is the branch's own event); a shooting costs seconds here.
@@ -137,7 +137,7 @@ def test_pd_curve_points_have_a_multiplier_minus_one_by_shooting() -> None:
         assert np.min(np.abs(ev + 1)) < 1e-6, (t["eta"][k], t["Omega"][k], ev)
 
 
-@pytest.mark.parametrize("kind", ["BP", "LP"])
+@pytest.mark.parametrize("kind", ["branch_point", "fold"])
 def test_band_end_curves_agree_with_branches_at_fixed_eta(kind: str) -> None:
     c = band_curve(kind)
     t = c.table
@@ -154,7 +154,7 @@ def test_band_end_curves_agree_with_branches_at_fixed_eta(kind: str) -> None:
 def test_branch_point_curve_against_shooting() -> None:
     # On the BP curve the merged balls' separation multiplier is +1: two multipliers
     # at 1 (with the trivial one), the others inside the unit circle.
-    c = band_curve("BP")
+    c = band_curve("branch_point")
     k = c.table.height - 1
     _, _, ev = _shoot_row(c, k)
     near = np.sort(np.abs(ev - 1))
@@ -165,7 +165,7 @@ def test_branch_point_curve_against_shooting() -> None:
 def test_scan_verdicts_lie_on_the_right_side_of_the_band_end() -> None:
     """Merged R-R rows of a fine (Omega, eta) scan: a converged one lies left of the LP
     curve, a stable one left of the BP curve, except within one grid step."""
-    bp, lp = band_curve("BP").table.sort("eta"), band_curve("LP").table.sort("eta")
+    bp, lp = band_curve("branch_point").table.sort("eta"), band_curve("fold").table.sort("eta")
     step = 0.01
     etas = np.array([0.92, 1.0, 1.08])
     # From Omega 1.3: simulation finds no R-R start near the band end, the scan's
@@ -195,16 +195,16 @@ def test_scan_verdicts_lie_on_the_right_side_of_the_band_end() -> None:
 
 def test_bad_inputs_name_the_parameter() -> None:
     br = band_end()
-    i = _event(br, "BP")
+    i = _event(br, "branch_point")
     cases: list[tuple[dict[str, object], str]] = [
-        (dict(event_index=99, parameter2="eta", range=(0.9, 1.1)), "event_index"),
-        (dict(event_index=i, parameter2="nope", range=(0.9, 1.1)), "parameter2"),
-        (dict(event_index=i, parameter2="Omega", range=(0.9, 1.1)), "parameter2"),
-        (dict(event_index=i, parameter2="eta", range=(1.1, 0.9)), "range"),
-        (dict(event_index=i, parameter2="eta", range=(1.2, 1.3)), "range"),
-        (dict(event_index=i, parameter2="eta", range=(0.9, 1.1), range1=(2.0, 3.0)),
+        (dict(event=99, parameter2="eta", range=(0.9, 1.1)), "event"),
+        (dict(event=i, parameter2="nope", range=(0.9, 1.1)), "parameter2"),
+        (dict(event=i, parameter2="Omega", range=(0.9, 1.1)), "parameter2"),
+        (dict(event=i, parameter2="eta", range=(1.1, 0.9)), "range"),
+        (dict(event=i, parameter2="eta", range=(1.2, 1.3)), "range"),
+        (dict(event=i, parameter2="eta", range=(0.9, 1.1), range1=(2.0, 3.0)),
          "range1"),
-        (dict(event_index=i, parameter2="eta", range=(0.9, 1.1),
+        (dict(event=i, parameter2="eta", range=(0.9, 1.1),
               options=Continuation(ds=-1.0)), "ds"),
     ]
     for kw, name in cases:

@@ -89,7 +89,7 @@ def test_period_doubling_switch_gives_the_orbit_simulation_reaches() -> None:
     r = switch(s, parameter="eta", kind="PD", amplitude=0.2)
     assert r.converged and list(r.winding[2:]) == [-2, -2]
     eta = r.info["value"]
-    assert r.info["switched_from"] == "PD" and r.balancer.eta[0] == eta
+    assert r.info["switched_from"] == "period_doubling" and r.balancer.eta[0] == eta
     b = thesis(1.2, eta)
     single = periodic(b, "R-R", N=8, guess=s)
     assert single.converged
@@ -139,7 +139,7 @@ def test_branch_point_switch_separates_the_balls() -> None:
     assert _separation_after(1.38, s138, 300.0) < 1e-5
     assert _separation_after(1.40, s140, 300.0) > 1e-3
     r = switch(s140, parameter="Omega", kind="BP", amplitude=0.05)
-    assert r.converged and r.info["switched_from"] == "BP"
+    assert r.converged and r.info["switched_from"] == "branch_point"
     assert 1.38 < r.info["value"] < 1.40
     # Unmerged: the balls' mean positions differ; it is an orbit (scipy closure).
     assert abs(r.coeffs[2, 0] - r.coeffs[3, 0]) > 0.01

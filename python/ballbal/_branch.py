@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import polars as pl
@@ -32,6 +32,68 @@ def parameter_range(v: Any) -> tuple[float, float]:
     if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
         raise ParameterError("range", f"needs finite lo < hi, got ({lo}, {hi})")
     return lo, hi
+
+
+def event_vocabulary() -> list[tuple[str, list[str], str]]:
+    """The events every branch, curve and switch names, from the core: ``(name, aliases,
+    meaning)`` for each, the canonical lower-case ``name`` being what every ``events``
+    table's ``type`` column and every :class:`Curve`'s ``kind`` write. A function that
+    takes an event reads the name or any alias (AUTO's ``LP``, ``BP``, ``HB``, ``PD``,
+    ``NS`` / ``TR``, ...), in any case."""
+    return [(n, list(a), m) for n, a, m in _native.event_vocabulary()]
+
+
+def event_name(text: Any, parameter: str = "event") -> str:
+    """The canonical name of the event ``text`` (a name or an alias, any case); an unknown
+    one raises :class:`~ballbal.exceptions.ParameterError` naming ``parameter``."""
+    if not isinstance(text, str):
+        raise ParameterTypeError(parameter, f"must be an event name, got {type(text).__name__}",
+                                 value=text)
+    return _native.event_name(text, parameter)
+
+
+def _listing(branch: Branch) -> str:
+    ev = branch.events
+    if ev.height == 0:
+        return "it has no located events"
+    rows = [f"{i} {t} at {branch.parameter}={p:.6g}"
+            for i, (t, p) in enumerate(zip(ev["type"], ev[branch.parameter], strict=True))]
+    return "its events: " + "; ".join(rows)
+
+
+def event_row(branch: Branch, event: Any, parameter: str = "event") -> int:
+    """The row of ``branch.events`` that ``event`` selects: an integer is the row itself;
+    a name (or alias, see :func:`event_vocabulary`) the first event of that kind along
+    the branch. A row the branch does not have, or a kind it did not locate, raises
+    :class:`~ballbal.exceptions.ParameterError` naming ``parameter`` and listing the
+    branch's events."""
+    n = branch.events.height
+    if isinstance(event, str):
+        name = event_name(event, parameter)
+        rows = [i for i, t in enumerate(branch.events["type"]) if t == name]
+        if not rows:
+            raise ParameterError(parameter, f"the branch has no {name} event; "
+                                 f"{_listing(branch)}", value=event)
+        return rows[0]
+    i = _check.integer(parameter, event, 0)
+    if i >= n:
+        raise ParameterError(parameter, f"the branch has {n} events; {_listing(branch)}",
+                             value=i)
+    return i
+
+
+def directed(options: Continuation, direction: Any) -> tuple[Continuation, bool]:
+    """``options`` turned by a branch function's ``direction`` (``"forward"``: towards
+    increasing parameter, ``"backward"``, ``"both"``, or None: ``options.forward``), and
+    whether both ways were asked for."""
+    if direction is None:
+        return options, False
+    if not isinstance(direction, str) or direction not in ("forward", "backward", "both"):
+        raise ParameterError("direction", f"must be 'forward', 'backward' or 'both', got "
+                             f"{direction!r:.60}", allowed="forward, backward, both")
+    if direction == "both":
+        return options, True
+    return replace(options, forward=direction == "forward"), False
 
 
 def model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:

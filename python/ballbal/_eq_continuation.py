@@ -6,14 +6,21 @@ two-parameter curves of those bifurcations (the core's
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
 import polars as pl
 
 from ballbal import _check, _native
-from ballbal._branch import Branch, Continuation, Curve, model_at, parameter_range
+from ballbal._branch import (
+    Branch,
+    Continuation,
+    Curve,
+    directed,
+    event_row,
+    model_at,
+    parameter_range,
+)
 from ballbal.analysis import Equilibrium, _equilibrium, capacities, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer, Seed003
@@ -23,10 +30,6 @@ __all__ = ["equilibrium_branch", "equilibrium_curve", "switch_equilibrium"]
 
 #: The default step control (a module-level value: a frozen dataclass).
 _DEFAULT = Continuation()
-
-#: The curve each event type continues into.
-_CURVE_OF = {"fold": "saddle_node", "hopf": "hopf", "branch_point": "pitchfork"}
-
 
 def _options(options: Any) -> Continuation:
     if not isinstance(options, Continuation):
@@ -161,12 +164,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     parameter = _check.string("parameter", parameter)
     rng = parameter_range(range)
     options = _options(options)
-    if direction is not None and (not isinstance(direction, str)
-                                  or direction not in ("forward", "backward", "both")):
-        raise ParameterError("direction", f"must be 'forward', 'backward' or 'both', got "
-                             f"{direction!r:.60}", allowed="forward, backward, both")
-    if direction in ("forward", "backward"):
-        options = replace(options, forward=direction == "forward")
+    options, both = directed(options, direction)
     if isinstance(start, str):
         found = [e for e in equilibria(native) if e.kind == start]
         if not found:
@@ -177,28 +175,25 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     if not isinstance(start, Equilibrium):
         raise ParameterTypeError("start", "must be an Equilibrium or a kind name")
     d = _native.equilibrium_branch(native, parameter, [float(v) for v in start.q], start.kind,
-                                   rng, options, direction == "both", seed)
+                                   rng, options, both, seed)
     return _branch(d, parameter, model, rng, options)
 
 
-def _event(branch: Any, event_index: Any) -> int:
+def _event(branch: Any, event: Any) -> int:
     if not isinstance(branch, Branch) or branch.kind != "equilibrium":
         raise ParameterTypeError("branch", "must be a Branch of equilibria")
-    i = _check.integer("event_index", event_index, 0)
-    if i >= branch.events.height:
-        raise ParameterError("event_index", f"the branch has {branch.events.height} events",
-                             value=i)
-    return i
+    return event_row(branch, event)
 
 
-def switch_equilibrium(branch: Branch, event_index: int) -> Branch:
-    """The other branch through the branch point ``branch.events[event_index]`` (e.g. the
-    perfect balance born at the pitchfork of the balls-together branch, eta = 1/2 for two
-    balls), started along the null vector of ``[F_q, F_p]`` orthogonal to the branch's
-    tangent, over the same range with the same options."""
-    i = _event(branch, event_index)
+def switch_equilibrium(branch: Branch, event: int | str = "branch_point") -> Branch:
+    """The other branch through the branch point ``event`` of ``branch`` (a row of
+    ``branch.events``, or an event name: the first event of that kind; default the first
+    branch point), e.g. the perfect balance born at the pitchfork of the balls-together
+    branch, eta = 1/2 for two balls, started along the null vector of ``[F_q, F_p]``
+    orthogonal to the branch's tangent, over the same range with the same options."""
+    i = _event(branch, event)
     if branch.events["type"][i] != "branch_point":
-        raise ParameterError("event_index", f"event {i} is a {branch.events['type'][i]}, "
+        raise ParameterError("event", f"event {i} is a {branch.events['type'][i]}, "
                              "not a branch point", allowed="branch_point")
     m = branch.meta
     native, seed = _native_model(m["model"])
@@ -208,11 +203,13 @@ def switch_equilibrium(branch: Branch, event_index: int) -> Branch:
     return _branch(d, branch.parameter, m["model"], m["range"], m["options"])
 
 
-def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
+def equilibrium_curve(branch: Branch, event: int | str, parameter2: str, *,
                       range: tuple[float, float], options: Continuation = _DEFAULT
                       ) -> Curve:
-    """The curve of the bifurcation ``branch.events[event_index]`` in (the branch's
-    parameter, ``parameter2``), ``range`` bounding ``parameter2``, continued both ways:
+    """The curve of the bifurcation ``event`` of ``branch`` (an event name, e.g.
+    ``"fold"``: the first event of that kind along the branch, or a row of
+    ``branch.events``) in (the branch's parameter, ``parameter2``), ``range`` bounding
+    ``parameter2``, continued both ways:
     a fold gives the saddle-node curve, a Hopf point the Hopf curve (with ``omega``), a
     branch point of the balls-together branch the pitchfork curve (folds and pitchforks
     of that branch are continued on its invariant subspace ``b_1 = ... = b_n``).
@@ -228,21 +225,20 @@ def equilibrium_curve(branch: Branch, event_index: int, parameter2: str, *,
     seed 003's (omega0, m0) = (1/sqrt(1 + 2 m0), e/2), where the second zero
     eigenvalue is the antisymmetric ball mode's), ``"saddle_node"`` (a pitchfork curve
     meets the saddle-node curve)."""
-    i = _event(branch, event_index)
+    i = _event(branch, event)
     parameter2 = _check.string("parameter2", parameter2)
     rng = parameter_range(range)
     options = _options(options)
     etype = branch.events["type"][i]
-    kind = _CURVE_OF[etype]
     ekind = branch.events["kind"][i]
     together = ekind == "together" and etype in ("fold", "branch_point")
     if etype == "branch_point" and not together:
-        raise ParameterError("event_index", "curves of branch points are continued for the "
+        raise ParameterError("event", "curves of branch points are continued for the "
                              "pitchfork of the balls-together branch only",
                              allowed="fold, hopf, or a together branch point")
     m = branch.meta
     native, seed = _native_model(m["model"])
-    d = _native.equilibrium_curve(native, kind, branch.parameter, parameter2,
+    d = _native.equilibrium_curve(native, etype, branch.parameter, parameter2,
                                   m["event_x"][i], float(branch.events[branch.parameter][i]),
                                   together, rng, options, seed)
     p1, p2 = branch.parameter, parameter2

@@ -18,7 +18,8 @@ from .options import Floquet, GuessSearch, HarmonicBalance, PeriodicOptions, Sca
 from .scene import Scene
 
 __all__ = [
-    "simulate", "validate", "equilibria", "balanced_states", "equilibrium_branch",
+    "simulate", "validate", "equilibria", "balanced_states", "event_vocabulary",
+    "event_name", "equilibrium_branch",
     "equilibrium_switch", "equilibrium_curve", "periodic", "orbit_closure",
     "balance_map", "scan", "default_chunk", "certificate_seconds", "scan_stage_seconds",
     "hb_stage_profile", "hb_stage_seconds",
@@ -68,6 +69,8 @@ def groove_study(
 def equilibria(model: Balancer | Scene) -> list[dict[str, Any]]: ...
 def balanced_states(models: Sequence[Balancer | Scene]) -> list[dict[str, Any] | None]: ...
 # seed003: a ballbal.model.Seed003 (read by attribute): continue in the seed's parameters
+def event_vocabulary() -> list[tuple[str, list[str], str]]: ...
+def event_name(text: str, parameter: str = "event") -> str: ...
 def equilibrium_branch(model: Balancer | Scene, parameter: str, q: Sequence[float], kind: str,
                        range: tuple[float, float], options: Any, both: bool = False,
                        seed003: Any = None) -> dict[str, Any]: ...
@@ -147,6 +150,7 @@ def periodic_branch(
     model: Balancer | Scene, parameter: str,
     start: tuple[float, npt.NDArray[np.float64], list[float]], p_range: tuple[float, float],
     continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
+    both: bool = False,
 ) -> dict[str, Any]: ...
 # {"kind", "together", "points": [solution dict + p1, p2, test, test_*], "special", "stop"}
 # special: [{"type", "p1", "p2", "omega", "row", "status" ("confirmed" | "rejected" |

@@ -6,13 +6,13 @@ certified and judged as :func:`ballbal.periodic` does, with its bifurcations loc
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import polars as pl
 
 from . import _check, _native
-from ._branch import Branch, Continuation, model_at, parameter_range
+from ._branch import Branch, Continuation, directed, model_at, parameter_range
 from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
@@ -43,9 +43,10 @@ def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
         "trivial_error": d["trivial_error"], "closure": d["closure"], "tail": d["tail"],
         "separation_error": d["separation_error"], "residual": d["residual"],
         "dp_ds": d["dp_ds"], "det_sign": d["det_sign"],
-        "test_LP": d["test_LP"], "test_BP": d["test_BP"],
-        "test_BP_multipliers": d["test_BP_multipliers"], "test_PD": d["test_PD"],
-        "test_NS": d["test_NS"], "event": d["event"],
+        "test_fold": d["test_fold"], "test_branch_point": d["test_branch_point"],
+        "test_branch_point_multipliers": d["test_branch_point_multipliers"],
+        "test_period_doubling": d["test_period_doubling"],
+        "test_neimark_sacker": d["test_neimark_sacker"], "event": d["event"],
     }
 
 
@@ -55,8 +56,9 @@ def _schema(parameter: str) -> dict[str, Any]:
             "max_modulus": f, "modulus_error": f, "modulus_error_source": s, "omega_error": f,
             "mult_re": lf, "mult_im": lf, "trivial_error": f,
             "closure": f, "tail": f, "separation_error": f, "residual": f, "dp_ds": f,
-            "det_sign": f, "test_LP": f, "test_BP": f, "test_BP_multipliers": f,
-            "test_PD": f, "test_NS": f, "event": s}
+            "det_sign": f, "test_fold": f, "test_branch_point": f,
+            "test_branch_point_multipliers": f, "test_period_doubling": f,
+            "test_neimark_sacker": f, "event": s}
 
 
 def periodic_branch(
@@ -69,6 +71,7 @@ def periodic_branch(
     periodic_options: PeriodicOptions | None = None,
     min_omega: float = 1e-3,
     event_tol: float = 1e-7,
+    direction: Literal["forward", "backward", "both"] | None = None,
 ) -> Branch:
     """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
     in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
@@ -77,16 +80,25 @@ def periodic_branch(
     pseudo-arclength continuation of the harmonic-balance equations (through folds),
     with ``N`` harmonics (default: the start's).
 
+    ``direction``: ``"forward"`` (towards increasing ``parameter``), ``"backward"``, or
+    ``"both"``: both ways from the start, the rows running from the end reached
+    downwards to the end reached upwards (the start once; tangents, ``dp_ds``,
+    ``det_sign``, ``test_fold`` and ``test_branch_point`` oriented along the rows),
+    ``stop`` then ``"<lower end>/<upper end>"``. Default: ``options.forward``, as for
+    :func:`~ballbal.continuation.equilibrium_branch`.
+
     Every point gets the certificates and Floquet multipliers of :func:`ballbal.periodic`
     with ``periodic_options`` (default :data:`ballbal.options.PERIODIC_DEFAULTS`;
     ``Floquet(monodromy=False, hill=True)`` uses Hill's multipliers instead): a point
     whose certificate fails has status ``not_closed`` / ``truncated`` and is never
-    called stable. Events, located to ``event_tol`` in the parameter between two
-    points: ``LP`` (fold: ``dp/ds`` changes sign), ``BP`` (branch point: the bordered
-    determinant changes sign, i.e. a real multiplier passes +1 other than the trivial
-    one; for merged balls the ball-separation multiplier), ``PD`` (a real multiplier
-    through -1), ``NS`` (a complex pair through the unit circle) and ``IP`` (infinite
-    period: omega falls below ``min_omega``, or a point fails its certificate while
+    called stable. Events (named as on every branch, see
+    :func:`~ballbal.continuation.event_vocabulary`), located to ``event_tol`` in the
+    parameter between two points: ``fold`` (``dp/ds`` changes sign), ``branch_point``
+    (the bordered determinant changes sign, i.e. a real multiplier passes +1 other than
+    the trivial one; for merged balls the ball-separation multiplier),
+    ``period_doubling`` (a real multiplier through -1), ``neimark_sacker`` (a complex
+    pair through the unit circle) and ``infinite_period`` (omega falls below
+    ``min_omega``, or a point fails its certificate while
     omega falls; that point is not kept, the branch stops with ``"infinite_period"`` and
     the event's parameter ``p*`` is fitted on the last three points as
     ``T = C / sqrt|p - p*| + D``, the period law near a saddle-node on the invariant
@@ -124,6 +136,7 @@ def periodic_branch(
     lo, hi = parameter_range(range)
     options = _check.option("options", options, Continuation, Continuation(),
                             "ballbal.continuation.Continuation")
+    options, both = directed(options, direction)
     popts = _check.option("periodic_options", periodic_options, PeriodicOptions,
                           PERIODIC_DEFAULTS, "ballbal.PeriodicOptions")
     n = start.N if N is None else _check.integer("N", N, 1, 256)
@@ -134,7 +147,7 @@ def periodic_branch(
     coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
     winding = [float(w) for w in start.winding]
     d = _native.periodic_branch(model, parameter, (float(start.omega), coeffs, winding),
-                                (lo, hi), options, popts, min_omega, event_tol)
+                                (lo, hi), options, popts, min_omega, event_tol, both)
     table = pl.DataFrame([_row(parameter, p) for p in d["points"]], schema=_schema(parameter),
                          orient="row") if d["points"] else pl.DataFrame(schema=_schema(parameter))
     ev_rows = []

@@ -1,5 +1,5 @@
-"""Two-parameter curves of bifurcations of periodic solutions (folds ``LP``, branch
-points of merged balls ``BP``, period doublings ``PD``, Neimark–Sacker ``NS``): a
+"""Two-parameter curves of bifurcations of periodic solutions (``fold``,
+``branch_point`` of merged balls, ``period_doubling``, ``neimark_sacker``): a
 minimally augmented harmonic-balance system continued by pseudo-arclength
 (``rust/core/src/analysis/po_curves.rs``), from an event of a periodic branch.
 """
@@ -13,17 +13,13 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from ._branch import Branch, Continuation, Curve, model_at, parameter_range
+from ._branch import Branch, Continuation, Curve, event_row, model_at, parameter_range
 from ._po_continuation import _multipliers
 from .analysis import _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
 
 __all__ = ["periodic_curve"]
-
-#: Event types with a curve.
-_KINDS = ("LP", "BP", "PD", "NS")
-
 
 def _flag_label(kind: str, status: str) -> str:
     """A codimension-two label as the ``flag`` column shows it: only a confirmed point
@@ -35,7 +31,7 @@ def _flag_label(kind: str, status: str) -> str:
 
 def periodic_curve(
     branch: Branch,
-    event_index: int,
+    event: int | str,
     parameter2: str,
     *,
     range: tuple[float, float],  # noqa: A002 - the documented keyword
@@ -44,17 +40,19 @@ def periodic_curve(
     periodic_options: PeriodicOptions | None = None,
     locate_tol: float = 1e-8,
 ) -> Curve:
-    """The curve of the bifurcation ``branch.events[event_index]`` (``LP``, ``BP``, ``PD``
-    or ``NS`` of a periodic branch) in (``branch.parameter``, ``parameter2``), continued
+    """The curve of the bifurcation ``event`` of a periodic branch (an event name, e.g.
+    ``"period_doubling"``: the first event of that kind along the branch, or a row of
+    ``branch.events``; a ``fold``, ``branch_point``, ``period_doubling`` or
+    ``neimark_sacker``) in (``branch.parameter``, ``parameter2``), continued
     both ways from the event over ``range`` in ``parameter2`` and ``range1`` in the
     branch's parameter (default: the branch's range), with the branch's harmonics.
 
     The curve solves the harmonic-balance equations together with one scalar test
     function from a bordered matrix that is singular on it: the harmonic-balance
-    Jacobian (``LP``), the separating mode's Galerkin block of merged balls (``BP``: the
+    Jacobian (``fold``), the separating mode's Galerkin block of merged balls (``branch_point``: the
     separation multiplier at +1), the linearisation's Galerkin matrix on half harmonics
-    (``PD``: a multiplier at -1), Hill's matrix on the harmonics ``k + theta / 2 pi``
-    (``NS``: a complex pair ``e^{+-i theta}`` on the unit circle; the test function is
+    (``period_doubling``: a multiplier at -1), Hill's matrix on the harmonics ``k + theta / 2 pi``
+    (``neimark_sacker``: a complex pair ``e^{+-i theta}`` on the unit circle; the test function is
     complex, and ``theta`` is an unknown of the curve next to the branch's parameter,
     started where Hill's matrix at the event is closest to singular). A merged start is
     continued with its balls merged.
@@ -69,18 +67,20 @@ def periodic_curve(
     function, ~0), ``test_*`` (the other kinds' determinants, whose sign changes are the
     codimension-two points), ``flag`` (the codimension-two points located since the
     previous row: the bare label when its multipliers confirm it, ``"LPPD?"`` when they
-    cannot decide, ``"not LPPD"`` when they reject it)); an ``NS`` curve also has
+    cannot decide, ``"not LPPD"`` when they reject it)); a ``neimark_sacker`` curve also has
     ``theta``, the critical pair's angle in ``(0, pi)``. ``points``: the sign changes of
-    the test functions located on the curve (``CP`` cusp of an LP curve,
-    ``BP`` / ``LP`` / ``PD`` where the curve meets that curve, ``LPPD`` fold–flip; on an
-    ``NS`` curve ``LPNS`` fold–Neimark–Sacker, ``PDNS`` flip–Neimark–Sacker, ``BPNS`` and
-    the strong resonances ``R4`` (``theta = pi/2``) and ``R3`` (``theta = 2 pi/3``)). An
-    ``NS`` curve ends with ``"resonance_1:1"`` / ``"resonance_1:2"`` where ``theta``
+    the test functions located on the curve (codimension-two points keep AUTO's labels:
+    ``CP`` cusp of a fold curve,
+    ``BP`` / ``LP`` / ``PD`` where the curve meets that curve, ``LPPD`` fold–flip; on a
+    ``neimark_sacker`` curve ``LPNS`` fold–Neimark–Sacker, ``PDNS`` flip–Neimark–Sacker,
+    ``BPNS`` and
+    the strong resonances ``R4`` (``theta = pi/2``) and ``R3`` (``theta = 2 pi/3``)). A
+    ``neimark_sacker`` curve ends with ``"resonance_1:1"`` / ``"resonance_1:2"`` where ``theta``
     reaches 0 or pi (the pair meets the real axis). Each point carries its multiplier
     certificate: ``status`` (``"confirmed"``, ``"rejected"``, ``"undetermined"``; only a
     confirmed point is a codimension-two bifurcation, a truncated Galerkin determinant can
     change sign with no multiplier crossing), ``gap`` (distance of the nearest multiplier
-    to the value the label adds: -1 for ``LPPD`` on an LP curve, ``PD``, ``PDNS``; the
+    to the value the label adds: -1 for ``LPPD`` on a fold curve, ``PD``, ``PDNS``; the
     separation multiplier's +1 for ``BP``, ``BPNS``; a second +1 for ``LP``, ``LPNS``,
     ``LPPD`` on a PD curve; for ``CP``, ``R3``, ``R4`` the curve's own), ``residual`` /
     ``own_residual`` (the smallest perturbation of the monodromy that puts a multiplier at
@@ -91,14 +91,8 @@ def periodic_curve(
     if not isinstance(branch, Branch) or branch.kind != "periodic":
         raise ParameterTypeError("branch", "must be a periodic Branch (from periodic_branch)",
                                  value=branch)
-    i = _check.integer("event_index", event_index, 0)
-    if i >= branch.events.height:
-        raise ParameterError("event_index", f"the branch has {branch.events.height} events",
-                             value=i)
+    i = event_row(branch, event)
     kind = branch.events["type"][i]
-    if kind not in _KINDS:
-        raise ParameterError("event_index", f"event {i} is {kind!r}: no curve of it",
-                             allowed=", ".join(_KINDS))
     p1 = branch.parameter
     p2 = _check.string("parameter2", parameter2)
     if p2 == p1:
@@ -132,7 +126,7 @@ def periodic_curve(
         label = _flag_label(s["type"], s["status"])
         flags[r] = label if flags[r] is None else f"{flags[r]},{label}"
     tests = sorted({k for p in pts for k in p if k.startswith("test_")})
-    ns = kind == "NS"
+    ns = kind == "neimark_sacker"
     rows = []
     for p, flag in zip(pts, flags, strict=True):
         re_, im = _multipliers(p)

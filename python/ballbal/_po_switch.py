@@ -4,48 +4,78 @@ core's ``analysis/switch.rs``."""
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from . import _check, _native
-from ._branch import Branch, model_at
+from ._branch import Branch, _listing, event_name, event_row, model_at
 from .analysis import Equilibrium, PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
-from .model import Balancer
+from .model import Balancer, Seed003
 from .options import PERIODIC_DEFAULTS, PERIODIC_KEYWORDS, PeriodicOptions, with_keywords
 from .scene import Scene
 
-SwitchKind = Literal["PD", "BP", "Hopf"]
-_KINDS = ("PD", "BP", "Hopf")
+
+def _from_branch(branch: Branch, event: Any, kind: str | None, parameter: str | None,
+                 model: Balancer | Scene | None
+                 ) -> tuple[PeriodicSolution | Equilibrium, str, str, Balancer | Scene | None]:
+    """The solution, event name, parameter and (for an equilibrium) model that switching
+    at ``branch``'s event ``event`` starts from: all the branch's own."""
+    if event is None:
+        raise ParameterError("event", f"name the event to switch at; {_listing(branch)}")
+    i = event_row(branch, event)
+    etype = str(branch.events["type"][i])
+    if kind is not None and event_name(kind, "kind") != etype:
+        raise ParameterError("kind", f"event {i} of the branch is a {etype}, not "
+                             f"{kind!r:.40}", allowed=etype)
+    if parameter is not None and parameter != branch.parameter:
+        raise ParameterError("parameter", f"the branch is continued in "
+                             f"{branch.parameter!r}, got {parameter!r:.40}",
+                             allowed=branch.parameter)
+    solution = branch.event_solutions[i]
+    if branch.kind == "equilibrium" and model is None:
+        own = branch.meta["model"]
+        if isinstance(own, Seed003):
+            raise ParameterError("branch", "a branch continued in seed 003's units has no "
+                                 "ballbal model at its events: continue the Balancer "
+                                 "(ballbal.continuation.from_seed003) to switch")
+        model = model_at(own, branch.parameter, float(branch.events[branch.parameter][i]))
+    return solution, etype, branch.parameter, model
 
 
 def switch(
     solution: PeriodicSolution | Equilibrium | Branch,
     *,
     parameter: str | None = None,
-    kind: SwitchKind | None = None,
-    event: int | None = None,
+    kind: str | None = None,
+    event: int | str | None = None,
     model: Balancer | Scene | None = None,
     amplitude: float = 0.05,
     options: PeriodicOptions | None = None,
     **keywords: Any,
 ) -> PeriodicSolution:
     """The first periodic solution on the branch that leaves ``solution`` at a
-    bifurcation in ``parameter``:
+    bifurcation in ``parameter``, ``kind`` naming it (the names of
+    :func:`~ballbal.continuation.event_vocabulary`, or an alias such as AUTO's ``PD``,
+    ``BP``, ``HB``, in any case):
 
-    * ``kind="PD"`` (period doubling, a multiplier at -1) from a
+    * ``kind="period_doubling"`` (a multiplier at -1) from a
       :class:`~ballbal.PeriodicSolution` near the event: the doubled orbit, period ``2 T``
       and every winding doubled (an R-R orbit becomes ``windings (-2, -2)``);
-    * ``kind="BP"`` (branch point, a real multiplier at +1 other than the trivial one)
+    * ``kind="branch_point"`` (a real multiplier at +1 other than the trivial one)
       from a periodic solution: for merged balls the unmerged orbit, along the balls'
       antisymmetric separation mode;
-    * ``kind="Hopf"`` from an :class:`~ballbal.Equilibrium` (give its ``model=``) near a
+    * ``kind="hopf"`` from an :class:`~ballbal.Equilibrium` (give its ``model=``) near a
       Hopf point: the small all-``O`` orbit it gives birth to, from the critical
       eigenvector of the equilibrium's Jacobian, at its frequency.
 
-    ``solution`` may also be a :class:`~ballbal._branch.Branch` with ``event`` the row of
-    its ``events`` table (its type, solution and parameter are used).
+    ``solution`` may also be a :class:`~ballbal._branch.Branch` (of periodic solutions or
+    of equilibria) with ``event`` one of its events: a row of its ``events`` table, or an
+    event name (the first event of that kind along the branch, e.g. ``event="hopf"``).
+    The event's type, solution, parameter and (for equilibria) model at the event are the
+    branch's own: ``kind``, ``parameter`` and ``model`` need not be given (a ``kind`` or
+    ``parameter`` given must agree with the event's).
 
     The new branch's point lies at distance ``amplitude`` from the given one along the
     critical direction (in the series' coefficients), the parameter left free: near a
@@ -55,38 +85,30 @@ def switch(
     with: its verdict's ``modulus_error`` comes from a series with more harmonics, as on
     a branch, but a verdict that bound leaves open stays undetermined (``N`` is not
     raised); ``info`` holds
-    ``switched_from`` (the kind), ``parameter``, ``value`` and ``critical`` (the
-    multiplier, or at a Hopf point the eigenvalue, switched along). ``options`` and the
+    ``switched_from`` (the event's canonical name), ``parameter``, ``value`` and
+    ``critical`` (the multiplier, or at a Hopf point the eigenvalue, switched along).
+    ``options`` and the
     keywords as in :func:`~ballbal.periodic` (``N`` sets the harmonics of a Hopf orbit;
     a doubled orbit has twice the solution's). When no solution of the new branch is
     found within ``amplitude`` (halved up to four times), raises
     :class:`~ballbal.exceptions.ParameterError` naming ``amplitude``.
     """
     if isinstance(solution, Branch):
-        if event is None:
-            raise ParameterError("event", "give the row of the branch's events table to "
-                                 "switch at")
-        n = len(solution.event_solutions)
-        i = _check.integer("event", event, 0, max(n - 1, 0))
-        if i >= n:
-            raise ParameterError("event", "the branch has no located events")
-        if kind is None:
-            kind = str(solution.events["type"][i])  # type: ignore[assignment]
-        parameter = solution.parameter if parameter is None else parameter
-        solution = solution.event_solutions[i]
+        solution, kind, parameter, model = _from_branch(solution, event, kind, parameter,
+                                                        model)
     if parameter is None:
         raise ParameterError("parameter", "name the parameter the branch is continued in")
     _check.string("parameter", parameter)
     if kind is not None:
-        _check.string("kind", kind)
+        kind = event_name(kind, "kind")
     amp = _check.real("amplitude", amplitude, 0.0, 10.0, lo_open=True)
     options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
                             "ballbal.PeriodicOptions")
     options = with_keywords(options, "switch", keywords, PERIODIC_KEYWORDS)
     if isinstance(solution, PeriodicSolution):
-        if kind is None or kind not in ("PD", "BP"):
-            raise ParameterError("kind", f"must be 'PD' or 'BP' for a periodic solution, got "
-                                 f"{kind!r}", allowed="PD, BP")
+        if kind is None:
+            raise ParameterError("kind", "name the event a periodic solution is switched "
+                                 "at", allowed="period_doubling, branch_point")
         if solution.omega is None:
             raise ParameterError("solution", f"did not converge (status {solution.status})")
         base = solution.balancer
@@ -95,10 +117,12 @@ def switch(
             np.ascontiguousarray(solution.coeffs, dtype=np.float64).ravel(),
             [float(w) for w in solution.winding], kind, amp, options)
     elif isinstance(solution, Equilibrium):
-        if kind not in (None, "Hopf"):
-            raise ParameterError("kind", f"must be 'Hopf' for an equilibrium, got {kind!r}",
-                                 allowed="Hopf")
-        kind = "Hopf"
+        if kind not in (None, "hopf"):
+            raise ParameterError("kind", f"an equilibrium is switched at a hopf event, not "
+                                 f"a {kind}" + (" (switch_equilibrium switches at a branch "
+                                                "point)" if kind == "branch_point" else ""),
+                                 allowed="hopf")
+        kind = "hopf"
         if model is None:
             raise ParameterError("model", "give the model the equilibrium belongs to")
         base = _check.model("model", model)

@@ -10,7 +10,8 @@ use crate::tables::equilibrium_dict;
 use ballbal_core::continuation::equilibria::{
     branch, branch_both_ways, curve, switch, CurveKind, EqBranch, EqCurve, EqOptions, EqSystem,
 };
-use ballbal_core::continuation::ArcStop;
+use ballbal_core::continuation::event::VOCABULARY;
+use ballbal_core::continuation::{ArcStop, Event};
 use ballbal_core::equilibria::EquilibriumKind;
 use ballbal_core::model::Seed003;
 use ballbal_core::numerics::problem::{Parametric, Problem};
@@ -309,7 +310,8 @@ pub fn equilibrium_switch<'py>(
     branch_dict(py, b)
 }
 
-/// The curve of `kind` (`"saddle_node"`, `"hopf"`, `"pitchfork"`) through the event
+/// The curve of the event `kind` (`"fold"`: the saddle-node curve, `"hopf"`,
+/// `"branch_point"`: the pitchfork curve; or an alias `Event::parse` reads) through the event
 /// `(q, p1)` in `(parameter, parameter2)`, `range` bounding `parameter2`; `together`:
 /// on the balls-together subspace.
 #[pyfunction]
@@ -329,15 +331,16 @@ pub fn equilibrium_curve<'py>(
     seed003: Option<Seed003Args>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
-    let k = match kind.as_str() {
-        "saddle_node" => CurveKind::Fold,
-        "hopf" => CurveKind::Hopf,
-        "pitchfork" => CurveKind::Pitchfork,
+    let k = match Event::parse(&kind, "event").py()? {
+        Event::Fold => CurveKind::Fold,
+        Event::Hopf => CurveKind::Hopf,
+        // of the balls-together branch, the one continued: the pitchfork
+        Event::BranchPoint => CurveKind::Pitchfork,
         other => {
             return Err(Error::param_range(
-                "kind",
-                format!("unknown curve kind {other:?}"),
-                "saddle_node, hopf, pitchfork",
+                "event",
+                format!("an equilibrium has no {} curve", other.name()),
+                "fold, hopf, branch_point",
             ))
             .py()
         }
@@ -363,7 +366,27 @@ fn options_checked(m: &Model, args: &ContinuationArgs, range: (f64, f64)) -> PyR
     Ok(o)
 }
 
+/// The events' vocabulary: `(name, aliases, meaning)` for every event, in the order
+/// the docs list them (the core's `continuation::event::VOCABULARY`).
+#[pyfunction]
+pub fn event_vocabulary() -> Vec<(&'static str, Vec<&'static str>, &'static str)> {
+    VOCABULARY
+        .iter()
+        .map(|e| (e.name, e.aliases.to_vec(), e.meaning))
+        .collect()
+}
+
+/// The canonical name of the event called `text` (a name or an alias, any case); an
+/// unknown one is an error about `parameter`.
+#[pyfunction]
+#[pyo3(signature = (text, parameter="event"))]
+pub fn event_name(text: &str, parameter: &str) -> PyResult<&'static str> {
+    Event::parse(text, parameter).map(|e| e.name()).py()
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(event_vocabulary, m)?)?;
+    m.add_function(wrap_pyfunction!(event_name, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium_branch, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium_switch, m)?)?;
     m.add_function(wrap_pyfunction!(equilibrium_curve, m)?)?;

@@ -6,7 +6,9 @@ use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
 use crate::tables::solution_dict;
-use ballbal_core::analysis::po_branch::{periodic_branch as core_branch, PoBranchOptions, PoPoint};
+use ballbal_core::analysis::po_branch::{
+    periodic_branch as core_branch, periodic_branch_both_ways, PoBranchOptions, PoPoint,
+};
 use ballbal_core::hb::{HbSolution, Status};
 use ballbal_core::periodic::require_autonomous;
 use ballbal_core::{Dynamics, Error};
@@ -27,11 +29,11 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
     d.set_item("p", pt.p)?;
     d.set_item("dp_ds", pt.arc.dp_ds())?;
     d.set_item("det_sign", pt.arc.det_sign)?;
-    d.set_item("test_LP", pt.tests.lp)?;
-    d.set_item("test_BP", pt.tests.bp)?;
-    d.set_item("test_BP_multipliers", pt.tests.bp_multipliers)?;
-    d.set_item("test_PD", pt.tests.pd)?;
-    d.set_item("test_NS", pt.tests.ns)?;
+    d.set_item("test_fold", pt.tests.lp)?;
+    d.set_item("test_branch_point", pt.tests.bp)?;
+    d.set_item("test_branch_point_multipliers", pt.tests.bp_multipliers)?;
+    d.set_item("test_period_doubling", pt.tests.pd)?;
+    d.set_item("test_neimark_sacker", pt.tests.ns)?;
     d.set_item(
         "event",
         pt.events
@@ -44,10 +46,10 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
 }
 
 /// Continues the periodic solution `start = (omega, coeffs, winding)` of `model` in
-/// `parameter` over `p_range`; returns `{"points": [dict], "events": [dict], "stop":
-/// str}`.
+/// `parameter` over `p_range` (`both`: both ways from the start, joined into one branch);
+/// returns `{"points": [dict], "events": [dict], "stop": str}`.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol))]
+#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn periodic_branch<'py>(
     py: Python<'py>,
@@ -59,6 +61,7 @@ pub fn periodic_branch<'py>(
     options: PeriodicArgs,
     min_omega: f64,
     event_tol: f64,
+    both: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     // A scene is continued as a scene even with every effect off (as a scan does).
     let always_scene = matches!(model, ModelArgs::Scene(_));
@@ -89,10 +92,13 @@ pub fn periodic_branch<'py>(
         event_tol,
     };
     let name = parameter.to_string();
-    let b = guarded(
-        py,
-        || dispatch!(&m, x => core_branch(x, &name, &start, &opts)),
-    )?;
+    let b = guarded(py, || {
+        if both {
+            dispatch!(&m, x => periodic_branch_both_ways(x, &name, &start, &opts))
+        } else {
+            dispatch!(&m, x => core_branch(x, &name, &start, &opts))
+        }
+    })?;
     let out = PyDict::new(py);
     let mut points = Vec::with_capacity(b.points.len());
     for pt in b.points {

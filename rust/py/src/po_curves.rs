@@ -16,11 +16,12 @@ use numpy::PyReadonlyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-/// Continues the curve of `kind` (`"LP"`, `"BP"`, `"PD"`, `"NS"`) through the event solution
+/// Continues the curve of `kind` (`"fold"`, `"branch_point"`, `"period_doubling"`,
+/// `"neimark_sacker"`, or an alias the core's `Event::parse` reads) through the event solution
 /// `start = (omega, coeffs, winding)` of `model` (at the event's parameter values) in
 /// `(parameter, parameter2)`; `range` bounds `parameter2`, `range1` `parameter`. Returns
 /// `{"kind", "together", "points": [dict], "special": [dict], "stop": str}`; an `NS`
-/// curve's points carry `"theta"`, the critical pair's angle; each special point its
+/// `neimark_sacker` curve's points carry `"theta"`, the critical pair's angle; each special point its
 /// multiplier certificate (`"status"`, `"gap"`, `"residual"`, `"own_residual"`,
 /// `"error"`).
 #[pyfunction]

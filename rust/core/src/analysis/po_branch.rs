@@ -30,7 +30,8 @@
 //! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
 //! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
 
-use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::continuation::curves::join_halves;
+use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength, Event};
 use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
@@ -94,14 +95,19 @@ pub enum PoEventKind {
 }
 
 impl PoEventKind {
-    pub fn as_str(&self) -> &'static str {
+    /// The event in the one vocabulary of all branches.
+    pub fn event(self) -> Event {
         match self {
-            PoEventKind::Fold => "LP",
-            PoEventKind::BranchPoint => "BP",
-            PoEventKind::PeriodDoubling => "PD",
-            PoEventKind::NeimarkSacker => "NS",
-            PoEventKind::InfinitePeriod => "IP",
+            PoEventKind::Fold => Event::Fold,
+            PoEventKind::BranchPoint => Event::BranchPoint,
+            PoEventKind::PeriodDoubling => Event::PeriodDoubling,
+            PoEventKind::NeimarkSacker => Event::NeimarkSacker,
+            PoEventKind::InfinitePeriod => Event::InfinitePeriod,
         }
+    }
+
+    pub fn as_str(&self) -> &'static str {
+        self.event().name()
     }
 }
 
@@ -311,6 +317,54 @@ fn multiplier_tests(m: &[(f64, f64)]) -> (f64, f64, f64, usize) {
         }
     }
     (bp.0, pd.0, ns, pairs)
+}
+
+/// [`periodic_branch`] both ways from the start (`opts.arc.forward` ignored): the rows
+/// run from the end reached towards decreasing `p` to the end reached towards increasing
+/// `p`, the start once, as one branch. The backward half is turned round: its tangents
+/// and the test functions that depend on their orientation (`dp/ds`, the bordered
+/// determinant) change sign, each point's `events` move to the point that now follows
+/// them, and the events' `index`es are renumbered. `stop` is `"<lower end>/<upper
+/// end>"`.
+pub fn periodic_branch_both_ways<D: Parametric>(
+    base: &D,
+    name: &str,
+    start: &HbSolution,
+    opts: &PoBranchOptions,
+) -> Result<PoBranch> {
+    let mut o = opts.clone();
+    o.arc.forward = false;
+    let mut back = periodic_branch(base, name, start, &o)?;
+    o.arc.forward = true;
+    let fwd = periodic_branch(base, name, start, &o)?;
+    let turn = |pt: &mut PoPoint| {
+        pt.arc.tangent.iter_mut().for_each(|t| *t = -*t);
+        pt.arc.det_sign = -pt.arc.det_sign;
+        pt.tests.lp = -pt.tests.lp;
+        pt.tests.bp = -pt.tests.bp;
+    };
+    back.points.iter_mut().for_each(turn);
+    // An event between back points i - 1 and i lies, in the new order, just before the
+    // row of back point i - 1.
+    for i in 0..back.points.len().saturating_sub(1) {
+        back.points[i].events = std::mem::take(&mut back.points[i + 1].events);
+    }
+    for e in &mut back.events {
+        turn(&mut e.point);
+        if matches!(e.kind, PoEventKind::Fold | PoEventKind::BranchPoint) {
+            e.test = -e.test;
+        }
+    }
+    let (points, events) = join_halves(
+        (back.points, back.events),
+        (fwd.points, fwd.events),
+        |e: &mut PoEvent| &mut e.index,
+    );
+    Ok(PoBranch {
+        points,
+        events,
+        stop: format!("{}/{}", back.stop, fwd.stop),
+    })
 }
 
 /// Continues the periodic solution `start` (a converged series of `base`) in the

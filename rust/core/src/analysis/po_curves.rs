@@ -47,7 +47,7 @@
 
 use crate::analysis::po_branch::{branch_options, check_start};
 use crate::continuation::curves::join_halves;
-use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength, Event};
 use crate::error::{Error, Result};
 use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
 use crate::numerics::problem::{Parametric, Problem};
@@ -65,25 +65,31 @@ pub enum PoCurveKind {
 }
 
 impl PoCurveKind {
-    pub fn as_str(&self) -> &'static str {
+    /// The event whose curve this is, in the one vocabulary of all branches.
+    pub fn event(self) -> Event {
         match self {
-            PoCurveKind::Fold => "LP",
-            PoCurveKind::BranchPoint => "BP",
-            PoCurveKind::PeriodDoubling => "PD",
-            PoCurveKind::NeimarkSacker => "NS",
+            PoCurveKind::Fold => Event::Fold,
+            PoCurveKind::BranchPoint => Event::BranchPoint,
+            PoCurveKind::PeriodDoubling => Event::PeriodDoubling,
+            PoCurveKind::NeimarkSacker => Event::NeimarkSacker,
         }
     }
 
+    pub fn as_str(&self) -> &'static str {
+        self.event().name()
+    }
+
+    /// The curve of the event named `name` (any spelling [`Event::parse`] reads).
     pub fn parse(name: &str) -> Result<Self> {
-        match name {
-            "LP" => Ok(PoCurveKind::Fold),
-            "BP" => Ok(PoCurveKind::BranchPoint),
-            "PD" => Ok(PoCurveKind::PeriodDoubling),
-            "NS" => Ok(PoCurveKind::NeimarkSacker),
-            _ => Err(Error::param_range(
+        match Event::parse(name, "kind")? {
+            Event::Fold => Ok(PoCurveKind::Fold),
+            Event::BranchPoint => Ok(PoCurveKind::BranchPoint),
+            Event::PeriodDoubling => Ok(PoCurveKind::PeriodDoubling),
+            Event::NeimarkSacker => Ok(PoCurveKind::NeimarkSacker),
+            other => Err(Error::param_range(
                 "kind",
-                format!("no curve of {name:?} events"),
-                "LP, BP, PD, NS",
+                format!("no curve of {} events of periodic orbits", other.name()),
+                "fold, branch_point, period_doubling, neimark_sacker",
             )),
         }
     }

@@ -20,7 +20,7 @@
 //! finds by itself.
 
 use crate::analysis::periodic::{finish_on_branch, Periodic, PeriodicOptions};
-use crate::continuation::{point_at, ArcOptions, ArcPoint};
+use crate::continuation::{point_at, ArcOptions, ArcPoint, Event};
 use crate::error::{Error, Result};
 use crate::floquet::{merged_pair, monodromy, FloquetOptions};
 use crate::hb::{default_samples, fit_coefficients, HbProblem, HbSolution, Status};
@@ -37,14 +37,19 @@ pub enum Switch {
 }
 
 impl Switch {
+    /// The switch at the event named `kind` (any spelling [`Event::parse`] reads).
     pub fn parse(kind: &str) -> Result<Self> {
-        match kind {
-            "PD" => Ok(Switch::PeriodDoubling),
-            "BP" => Ok(Switch::BranchPoint),
+        match Event::parse(kind, "kind")? {
+            Event::PeriodDoubling => Ok(Switch::PeriodDoubling),
+            Event::BranchPoint => Ok(Switch::BranchPoint),
             other => Err(Error::param_range(
                 "kind",
-                format!("must be 'PD' or 'BP' for a periodic solution, got {other:?}"),
-                "PD, BP",
+                format!(
+                    "a periodic solution is switched at a period_doubling or branch_point, \
+                     not a {}",
+                    other.name()
+                ),
+                "period_doubling, branch_point",
             )),
         }
     }

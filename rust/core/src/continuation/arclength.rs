@@ -311,6 +311,16 @@ fn correct<P: Problem + ?Sized>(
     Ok(None)
 }
 
+/// Whether `F_x` at `(x, p)` is singular to working precision (its LU's smallest pivot
+/// below `1e-10` of the largest).
+fn singular_at<P: Problem + ?Sized>(problem: &mut P, x: &[f64], p: f64) -> Result<bool> {
+    let n = x.len();
+    let (mut r, mut jac) = (vec![0.0; n], vec![0.0; n * n]);
+    problem.jac_x(x, p, &mut r, &mut jac)?;
+    let probe = vec![1.0; n];
+    Ok(crate::linalg::lu_solve(&jac, n, &probe).is_none_or(|s| s.pivot_ratio < 1e-10))
+}
+
 /// Newton on `F(x, p_fixed) = 0` from `x0` (natural-parameter correction), for the point
 /// on the parameter window's edge.
 fn correct_at_p<P: Problem + ?Sized>(
@@ -455,6 +465,8 @@ pub struct Arclength<'a, P: Problem + ?Sized> {
     w: Vec<f64>,
     start: Option<(Vec<f64>, f64, Option<Vec<f64>>)>,
     last: Option<ArcPoint>,
+    /// The point before `last`: where [`Arclength::subdivide`] steps again from.
+    before: Option<ArcPoint>,
     ds: f64,
     stop: Option<ArcStop>,
     yielded: usize,
@@ -495,6 +507,7 @@ impl<'a, P: Problem + ?Sized> Arclength<'a, P> {
             w,
             start: Some((x0.to_vec(), p0, direction)),
             last: None,
+            before: None,
             ds,
             stop: None,
             yielded: 0,
@@ -518,6 +531,27 @@ impl<'a, P: Problem + ?Sized> Arclength<'a, P> {
         self.stop = Some(ArcStop::Finished(why.into()));
     }
 
+    /// The caller refuses the point just yielded because its step may hide what the
+    /// caller must see (e.g. a pair of events, whose test function changes sign twice):
+    /// the next point is taken from the point before it with half that step. Returns
+    /// `false`, changing nothing, when the step is already `ds_min` or the refused
+    /// point is the start.
+    pub fn subdivide(&mut self) -> bool {
+        let (Some(last), Some(_)) = (&self.last, &self.before) else {
+            return false;
+        };
+        if last.ds.abs() <= self.opts.ds_min {
+            return false;
+        }
+        self.ds = (0.5 * last.ds.abs()).max(self.opts.ds_min);
+        self.last = self.before.take();
+        self.yielded -= 1;
+        if self.stop == Some(ArcStop::Boundary) {
+            self.stop = None;
+        }
+        true
+    }
+
     fn first(
         &mut self,
         x0: Vec<f64>,
@@ -526,6 +560,13 @@ impl<'a, P: Problem + ?Sized> Arclength<'a, P> {
     ) -> Result<Option<ArcPoint>> {
         let Some((x, iterations, residual)) = correct_at_p(self.problem, &x0, p0, &self.opts)?
         else {
+            if singular_at(self.problem, &x0, p0)? {
+                // Newton cannot converge there; say why, not only that it failed.
+                self.stop = Some(ArcStop::Failed(format!(
+                    "the Jacobian is singular at the start (p = {p0}): a zero eigenvalue (a \
+                     fold, a branch point, or a family of equilibria); start beside it"
+                )));
+            }
             return Ok(None);
         };
         let n1 = x.len() + 1;
@@ -630,7 +671,7 @@ impl<P: Problem + ?Sized> Iterator for Arclength<'_, P> {
         }
         let out = if let Some((x0, p0, dir)) = self.start.take() {
             self.first(x0, p0, dir).inspect(|o| {
-                if o.is_none() {
+                if o.is_none() && self.stop.is_none() {
                     self.stop = Some(ArcStop::Failed("the start does not converge".into()));
                 }
             })
@@ -639,7 +680,7 @@ impl<P: Problem + ?Sized> Iterator for Arclength<'_, P> {
         };
         match out {
             Ok(Some(pt)) => {
-                self.last = Some(pt.clone());
+                self.before = self.last.replace(pt.clone());
                 self.yielded += 1;
                 Some(pt)
             }
@@ -738,6 +779,46 @@ mod tests {
         .unwrap();
         assert!(g.abs() < 1e-9);
         assert!((fold.p - 1.0).abs() < 1e-12 && fold.x[0].abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_refused_step_is_taken_again_in_halves() {
+        // On the unit circle a step ds from a point lands where the angle's sine is ds
+        // (the corrector stays on the hyperplane ds along the tangent).
+        let opts = ArcOptions {
+            ds: 0.2,
+            ds_max: 0.2,
+            grow: 1.0,
+            p_min: -0.5,
+            p_max: 0.5,
+            ..Default::default()
+        };
+        let mut prob = Circle;
+        let mut arc = Arclength::new(&mut prob, &[1.0], 0.0, None, opts).unwrap();
+        let start = arc.next().unwrap();
+        assert!(!arc.subdivide(), "the start has no step to halve");
+        let far = arc.next().unwrap();
+        assert!(arc.subdivide());
+        let near = arc.next().unwrap();
+        let angle = |pt: &ArcPoint| pt.p.atan2(pt.x[0]) - start.p.atan2(start.x[0]);
+        assert!(
+            (angle(&far) - 0.2f64.asin()).abs() < 1e-8,
+            "{}",
+            angle(&far)
+        );
+        assert!(
+            (angle(&near) - 0.1f64.asin()).abs() < 1e-8,
+            "{}",
+            angle(&near)
+        );
+        // refused at the edge: the boundary stop is lifted, the edge reached again
+        let rest: Vec<ArcPoint> = arc.by_ref().collect();
+        assert_eq!(rest.last().unwrap().p, 0.5);
+        assert!(arc.subdivide());
+        assert!(arc.stop().is_none());
+        let again: Vec<ArcPoint> = arc.by_ref().collect();
+        assert_eq!(again.last().unwrap().p, 0.5);
+        assert_eq!(arc.stop(), Some(&ArcStop::Boundary));
     }
 
     #[test]

@@ -28,6 +28,7 @@
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
 use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::continuation::curves::{join_halves, Extended, TwoParameter};
+use crate::continuation::event::Event;
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::seed003::Seed003;
@@ -432,12 +433,17 @@ pub enum EventKind {
 }
 
 impl EventKind {
-    pub fn as_str(&self) -> &'static str {
+    /// The event in the one vocabulary of all branches.
+    pub fn event(self) -> Event {
         match self {
-            EventKind::Fold => "fold",
-            EventKind::Hopf => "hopf",
-            EventKind::BranchPoint => "branch_point",
+            EventKind::Fold => Event::Fold,
+            EventKind::Hopf => Event::Hopf,
+            EventKind::BranchPoint => Event::BranchPoint,
         }
+    }
+
+    pub fn as_str(&self) -> &'static str {
+        self.event().name()
     }
 }
 
@@ -505,6 +511,109 @@ fn tests<D: Dynamics + Clone>(
     })
 }
 
+/// At most this many halvings of one step by [`branch`]'s checks for events hidden
+/// inside it (the step then stands: a check that keeps failing, e.g. on an eigenvalue
+/// that sits on the axis, must not stall the branch).
+const MAX_SPLITS: usize = 6;
+
+/// What [`branch`]'s step control reads of a point's eigenvalues.
+struct Spectrum {
+    /// Eigenvalues with a positive real part (above [`UNSTABLE_TOL`]).
+    unstable: usize,
+    /// The real part of the complex eigenvalue nearest the imaginary axis (NaN without
+    /// one).
+    pair_re: f64,
+}
+
+/// Real parts below this count as on the axis, not unstable: neutral directions of a
+/// family sit at round-off from zero and must not look like crossings.
+const UNSTABLE_TOL: f64 = 1e-7;
+
+impl Spectrum {
+    fn of(eq: &Equilibrium) -> Spectrum {
+        let unstable = eq
+            .eigenvalues
+            .iter()
+            .filter(|(re, _)| *re > UNSTABLE_TOL)
+            .count();
+        let pair_re = eq
+            .eigenvalues
+            .iter()
+            .filter(|(_, im)| im.abs() > UNSTABLE_TOL)
+            .map(|(re, _)| *re)
+            .fold(f64::NAN, |m, re| {
+                if re.abs() < m.abs() || m.is_nan() {
+                    re
+                } else {
+                    m
+                }
+            });
+        Spectrum { unstable, pair_re }
+    }
+
+    fn pair_distance(&self) -> f64 {
+        if self.pair_re.is_nan() {
+            f64::INFINITY
+        } else {
+            self.pair_re.abs()
+        }
+    }
+}
+
+/// Whether the complex pair nearest the axis could cross it and come back inside a step
+/// of arclength `ds` from `a` to `b`. Near its largest value inside the step the real
+/// part is `m - k (s - s*)^2`: an end a distance `d <= ds` from `s*` that is still off
+/// the axis has `|Re| <= k d^2` and slope `2 k d`, so `|Re| <= slope ds / 2`. `rate` is
+/// that slope at `a` from the step before it (the secant); twice `rate ds`, four times
+/// the parabola's bound, allows for the secant's error. Without a step before `a`, the
+/// slope is taken as one (unknowns and parameters are O(1)).
+fn pair_may_return(a: &Spectrum, b: &Spectrum, rate: Option<f64>, ds: f64) -> bool {
+    let reach = rate.map_or(ds.abs(), |r| 2.0 * r * ds.abs());
+    a.pair_distance().max(b.pair_distance()) < reach
+}
+
+/// The rate at which the pair nearest the axis moves over a step of arclength `ds`.
+fn pair_rate(a: &Spectrum, b: &Spectrum, ds: f64) -> Option<f64> {
+    let r = (b.pair_re - a.pair_re).abs() / ds.abs();
+    // a pair appearing or vanishing (NaN) or a zero step: no rate, the O(1) default
+    r.is_finite().then_some(r)
+}
+
+/// Whether the test functions change sign at the step's midpoint though not between
+/// its ends: two zeros (a Hopf point and its return, two folds) inside one step.
+#[allow(clippy::too_many_arguments)]
+fn crossed_twice<D: Dynamics + Clone>(
+    sys: &mut EqSystem<'_, D>,
+    a: &ArcPoint,
+    b: &ArcPoint,
+    ta: &Tests,
+    tb: &Tests,
+    together: bool,
+    opts: &ArcOptions,
+) -> Result<bool> {
+    let Some(m) = point_at(sys, a, 0.5 * b.ds, opts)? else {
+        return Ok(false);
+    };
+    let tm = tests(sys, &m, together)?;
+    let twice = |ga: f64, gm: f64, gb: f64| ga * gb > 0.0 && ga * gm < 0.0;
+    Ok(twice(ta.hopf, tm.hopf, tb.hopf)
+        || twice(ta.fold, tm.fold, tb.fold)
+        || twice(ta.bp, tm.bp, tb.bp))
+}
+
+/// Whether the located events account for the change in the count of unstable
+/// eigenvalues over a step: a Hopf point moves two, a fold or branch point one.
+fn explained(a: &Spectrum, b: &Spectrum, events: &[EqEvent]) -> bool {
+    let moved: usize = events
+        .iter()
+        .map(|e| match e.kind {
+            EventKind::Hopf => 2,
+            EventKind::Fold | EventKind::BranchPoint => 1,
+        })
+        .sum();
+    a.unstable.abs_diff(b.unstable) <= moved
+}
+
 fn analyse_at<D: Dynamics + Clone>(
     sys: &mut EqSystem<'_, D>,
     x: &[f64],
@@ -553,13 +662,28 @@ pub fn branch<D: Dynamics + Clone>(
     let mut arc = Arclength::new(sys, x0, p0, direction, arc_opts.clone())?;
     let mut points: Vec<EqPoint> = vec![];
     let mut events: Vec<EqEvent> = vec![];
-    let mut prev: Option<(ArcPoint, Tests, bool)> = None;
+    let mut prev: Option<(ArcPoint, Tests, bool, Spectrum, Option<f64>)> = None;
+    let mut splits = 0;
     while let Some(pt) = arc.next() {
         let q = arc.problem().full(&pt.x);
         let together = kind_of(&q, o, start) == EquilibriumKind::Together;
         let t = tests(arc.problem(), &pt, together)?;
+        let eq = analyse_at(arc.problem(), &pt.x, pt.p, start, opts.family)?;
+        let spectrum = Spectrum::of(&eq);
         let row = points.len();
-        if let Some((a, ta, tog_a)) = &prev {
+        let mut found_events = vec![];
+        let mut rate = None;
+        if let Some((a, ta, tog_a, sa, rate_a)) = &prev {
+            rate = pair_rate(sa, &spectrum, pt.ds);
+            let may_hide = splits < MAX_SPLITS && *tog_a == together;
+            if may_hide
+                && pair_may_return(sa, &spectrum, *rate_a, pt.ds)
+                && crossed_twice(arc.problem(), a, &pt, ta, &t, together, &arc_opts)?
+                && arc.subdivide()
+            {
+                splits += 1;
+                continue;
+            }
             let mut found = vec![];
             if ta.fold * t.fold < 0.0 {
                 found.push(EventKind::Fold);
@@ -613,7 +737,7 @@ pub fn branch<D: Dynamics + Clone>(
                     f64::NAN
                 };
                 let eq = analyse_at(s, &e.x, e.p, start, opts.family)?;
-                events.push(EqEvent {
+                found_events.push(EqEvent {
                     kind,
                     row,
                     p: e.p,
@@ -624,8 +748,16 @@ pub fn branch<D: Dynamics + Clone>(
                     omega,
                 });
             }
+            // Unstable eigenvalues that appear or vanish with no located event to
+            // account for them crossed inside the step (a Hopf pair and its return, or
+            // two pairs at once): the step is taken again in halves.
+            if may_hide && !explained(sa, &spectrum, &found_events) && arc.subdivide() {
+                splits += 1;
+                continue;
+            }
         }
-        let eq = analyse_at(arc.problem(), &pt.x, pt.p, start, opts.family)?;
+        splits = 0;
+        events.extend(found_events);
         points.push(EqPoint {
             p: pt.p,
             x: pt.x.clone(),
@@ -635,7 +767,7 @@ pub fn branch<D: Dynamics + Clone>(
             bp: t.bp,
             hopf: t.hopf,
         });
-        prev = Some((pt, t, together));
+        prev = Some((pt, t, together, spectrum, rate));
     }
     let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
     if crate::cancel::cancelled() {
@@ -644,7 +776,12 @@ pub fn branch<D: Dynamics + Clone>(
     if points.is_empty() {
         return Err(Error::param(
             "start",
-            format!("the start does not converge to an equilibrium at {p0}: {stop:?}"),
+            match &stop {
+                ArcStop::Failed(why) => format!("no branch from the start at {p0}: {why}"),
+                other => {
+                    format!("the start does not converge to an equilibrium at {p0}: {other:?}")
+                }
+            },
         ));
     }
     Ok(EqBranch {

@@ -12,11 +12,13 @@
 pub mod arclength;
 pub mod curves;
 pub mod equilibria;
+pub mod event;
 pub mod lattice;
 pub mod natural;
 
 pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
 pub use curves::{Extended, TestFunction, TwoParameter};
+pub use event::Event;
 pub use lattice::{waves, Lattice, Tally, Waves};
 pub use natural::{natural_step, Natural, Step};
 
