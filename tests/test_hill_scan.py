@@ -93,8 +93,11 @@ def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map(
     opposite = both.filter((pl.col("hill_stability") != pl.col("stability_tight"))
                            & (pl.col("hill_stability") != "undetermined"))
     assert opposite.height == 0, opposite
+    # A slow orbit that a seed solved with more harmonics than N = 3 (near a rotating
+    # branch's infinite-period end) may leave Hill undetermined far from 1; never wrong.
     open_ = both.filter((pl.col("hill_stability") == "undetermined")
-                        & (pl.col("stability_tight") != "undetermined"))
+                        & (pl.col("stability_tight") != "undetermined")
+                        & (pl.col("N") == 3))
     assert ((open_["max_modulus_tight"] - 1.0).abs() < 1e-3).all(), open_
     assert not both["verdicts_disagree"].any()
 
@@ -124,7 +127,9 @@ def test_default_scan_cross_checks_the_doubtful_verdicts(
     assert skipped.height > 0.5 * dflt.height
     assert ((skipped["max_modulus"] - 1.0).abs() > band).all()
     assert skipped["verdicts_disagree"].is_null().all()
-    assert (skipped["stability"] == skipped["hill_stability_all"]).all()
+    # (Hill undetermined, not opposite, on slow orbits solved with more harmonics)
+    slow_open = (skipped["hill_stability_all"] == "undetermined") & (skipped["N"] > 3)
+    assert ((skipped["stability"] == skipped["hill_stability_all"]) | slow_open).all()
     assert (skipped["stability"] == skipped["stability_tight"]).all()
 
 

@@ -36,7 +36,8 @@ CALLS = {
     "simulate_long": "simulate(Balancer(), t_eval=[0.0, 1e6])",
     "equilibria_springs": "equilibria(Scene(Balancer(eta=(0.04,) * 64), springs=0.5))",
     # balanced states in parallel (rayon threads must see the cancellation too)
-    "balance_map": "balance_map(Balancer(eta=(0.05,) * 24), Omega=[1.5] * 20000)",
+    "balance_map": "balance_map(Balancer(eta=(0.05,) * 24), "
+                   "Omega=[1.5 + 1e-6 * i for i in range(20000)])",
     "verify": "_verify()",
 }
 

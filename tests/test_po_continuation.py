@@ -99,7 +99,6 @@ def test_bad_inputs_name_the_parameter() -> None:
         (dict(parameter="Omega", range=(1.3, 2.0)), "range"),
         (dict(parameter="Omega", range=(2.0, 1.0)), "range"),
         (dict(parameter="Omega", range=(1.0, 2.0), min_omega=-1.0), "min_omega"),
-        (dict(parameter="Omega", range=(1.0, 2.0), options=Continuation(ds=-1.0)), "ds"),
         (dict(parameter="Omega", range=(1.0, 2.0), N=0), "N"),
     ]
     for kw, name in cases:
@@ -107,6 +106,10 @@ def test_bad_inputs_name_the_parameter() -> None:
         with pytest.raises(ParameterError) as e:
             periodic_branch(start, p, **kw)
         assert e.value.parameter == name, (kw, e.value)
+    # A bad step is refused when the options are made, before any branch.
+    with pytest.raises(ParameterError) as e:
+        Continuation(ds=-1.0)
+    assert e.value.parameter == "ds"
     with pytest.raises(ParameterError) as e:
         periodic_branch("x", "Omega", range=(1.0, 2.0))  # type: ignore[arg-type]
     assert e.value.parameter == "start"

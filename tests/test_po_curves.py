@@ -204,13 +204,14 @@ def test_bad_inputs_name_the_parameter() -> None:
         (dict(event=i, parameter2="eta", range=(1.2, 1.3)), "range"),
         (dict(event=i, parameter2="eta", range=(0.9, 1.1), range1=(2.0, 3.0)),
          "range1"),
-        (dict(event=i, parameter2="eta", range=(0.9, 1.1),
-              options=Continuation(ds=-1.0)), "ds"),
     ]
     for kw, name in cases:
         with pytest.raises(ParameterError) as e:
             periodic_curve(br, **kw)  # type: ignore[arg-type]
         assert e.value.parameter == name, (kw, e.value)
+    with pytest.raises(ParameterError) as e:
+        Continuation(ds=-1.0)
+    assert e.value.parameter == "ds"
     with pytest.raises(ParameterError) as e:
         periodic_curve("x", 0, "eta", range=(0.9, 1.1))  # type: ignore[arg-type]
     assert e.value.parameter == "branch"
