@@ -271,33 +271,31 @@ class _BasinStore:
     locking, atomic writes and setting aside of damaged files it reuses): a later call
     with the same arguments skips the chunks on disk; a chunk file that is unreadable,
     changed since it was written (its checksum), of another grid or another chunk's
-    position, or short is set aside as ``<name>.damaged`` with a
-    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed."""
+    position, or short is set aside in ``<out>.damaged`` beside the directory with a
+    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed. Each chunk carries the
+    grid's description in its Parquet metadata, so the directory holds only the table's
+    files (``polars.read_parquet(out)`` reads them)."""
 
     def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any]) -> None:
         from .scan import _Store
 
         class Store(_Store):
             def _open(self, job: Any, chunk_given: bool) -> Any:
-                mfile = self.dir / "meta.json"
-                want = json.loads(json.dumps(meta))
-                if mfile.exists():
-                    try:
-                        old = json.loads(mfile.read_text())
-                    except (OSError, ValueError):
-                        old = None
-                    if old is None:
-                        self._set_aside(mfile, "unreadable", "rewritten")
-                    elif old != want:
-                        raise ScanStoreError(f"out: {self.dir} holds a different basin grid; "
-                                             "choose another directory or delete it")
-                if not mfile.exists():
-                    from .scan import _write_atomic
+                from .scan import _LEGACY_META, _stored_description
 
-                    _write_atomic(mfile, lambda fh: fh.write(
-                        json.dumps(want, indent=1).encode()))
+                want = json.loads(json.dumps(meta))
+                legacy = self.dir / _LEGACY_META
+                if legacy.exists():
+                    self._set_aside(legacy, "a grid description of ballbal before 0.2, "
+                                    "which polars cannot read among the chunks",
+                                    "no longer used")
+                old = _stored_description(self.dir, "basins")
+                if old is not None and old != want:
+                    raise ScanStoreError(f"out: {self.dir} holds a different basin grid; "
+                                         "choose another directory or delete it")
                 self.meta = want
                 self.fingerprint = hashlib.sha256(json.dumps(want).encode()).hexdigest()
+                self.description = json.dumps(want)
                 return job
 
         self.store = Store(path, None, False)  # type: ignore[arg-type]

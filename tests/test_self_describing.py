@@ -1,0 +1,196 @@
+"""Tables that say what they are (issue 32): a scan directory is a Parquet dataset polars
+reads by itself, with no lock left however the scan ended; every scan table carries the
+model it was computed for (columns in memory, the whole description in every chunk's
+Parquet metadata on disk); nested columns have a flat export that ``write_csv`` takes."""
+
+import json
+import os
+import warnings
+from pathlib import Path
+
+import polars as pl
+import pytest
+
+import ballbal
+from ballbal.exceptions import ScanInterrupted, ScanStoreError, ScanStoreWarning
+
+# 2 x 3 points in three chunks of one block (block=1): about a second on one thread.
+GRID = dict(Omega=[1.2, 1.3], eta=[0.9, 1.0, 1.1])
+KW = dict(block=1, threads=1, starts=4)
+
+
+def names_in(d: Path) -> list[str]:
+    return sorted(p.name for p in d.iterdir())
+
+
+def only_chunks(d: Path) -> bool:
+    return all(n.startswith("chunk-") and n.endswith(".parquet") for n in names_in(d))
+
+
+def same_rows(a: pl.DataFrame, b: pl.DataFrame) -> bool:
+    return a.drop("seconds").equals(b.drop("seconds"))
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ds") / "fine.parquet"
+    df = ballbal.scan(ballbal.Balancer(), out=out, **GRID, **KW)
+    return out, df
+
+
+# --- 1. the directory is a Parquet dataset ------------------------------------------------
+
+
+def test_polars_reads_the_scan_directory_itself(written):
+    out, df = written
+    assert only_chunks(out), names_in(out)  # no meta.json, no .lock
+    assert len(names_in(out)) == 3
+    for got in (pl.read_parquet(out), pl.scan_parquet(out).collect(),
+                pl.read_parquet(f"{out}/*.parquet")):
+        assert got.height == 2 * 3
+        assert same_rows(got, df)
+        assert same_rows(got, ballbal.read_scan(out))
+
+
+def test_no_lock_is_left_after_an_error(tmp_path):
+    out = tmp_path / "s"
+
+    def fail(done, total):
+        raise RuntimeError("a progress callback that fails")
+
+    with pytest.raises(RuntimeError, match="progress callback"):
+        ballbal.scan(ballbal.Balancer(), out=out, progress=fail, **GRID, **KW)
+    assert only_chunks(out), names_in(out)
+    # A different scan into the directory is refused, and leaves no lock either.
+    ballbal.scan(ballbal.Balancer(), out=out, **GRID, **KW)
+    with pytest.raises(ScanStoreError, match="differs in balancer.zeta"):
+        ballbal.scan(ballbal.Balancer(zeta=0.06), out=out, **GRID, **KW)
+    assert only_chunks(out), names_in(out)
+    assert pl.read_parquet(out).height == 6
+
+
+def test_no_lock_is_left_after_ctrl_c(tmp_path):
+    out = tmp_path / "s"
+    calls = []
+
+    def ctrl_c(done, total):
+        calls.append(done)
+        if len(calls) == 1:
+            raise KeyboardInterrupt
+
+    with pytest.warns(ScanInterrupted):
+        part = ballbal.scan(ballbal.Balancer(), out=out, progress=ctrl_c, **GRID, **KW)
+    assert part.height >= 2  # the chunks finished before the interrupt took effect
+    assert only_chunks(out), names_in(out)
+    assert same_rows(pl.read_parquet(out), part)
+    # ... and resuming finishes it.
+    full = ballbal.scan(ballbal.Balancer(), out=out, **GRID, **KW)
+    assert full.height == 6 and same_rows(pl.read_parquet(out), full)
+
+
+def test_the_directory_is_locked_while_a_scan_uses_it(tmp_path):
+    out = tmp_path / "s"
+    refused = []
+
+    def second_scan(done, total):
+        if not refused:
+            with pytest.raises(ScanStoreError, match=f"in use by another scan "
+                               f"\\(process {os.getpid()}\\)") as e:
+                ballbal.scan(ballbal.Balancer(), out=out, **GRID, **KW)
+            refused.append(e.value)
+
+    ballbal.scan(ballbal.Balancer(), out=out, progress=second_scan, **GRID, **KW)
+    assert refused
+    assert only_chunks(out)
+    # Released: the next scan opens it (and resumes everything).
+    ballbal.scan(ballbal.Balancer(), out=out, **GRID, **KW)
+
+
+def test_damaged_files_are_set_aside_outside_the_dataset(tmp_path, written):
+    src, df = written
+    out = tmp_path / "fine.parquet"
+    out.mkdir()
+    for f in src.iterdir():
+        (out / f.name).write_bytes(f.read_bytes())
+    f = out / "chunk-00001.parquet"
+    f.write_bytes(f.read_bytes()[:100])
+    (out / "meta.json").write_text("{}")  # the description of ballbal before 0.2
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        again = ballbal.scan(ballbal.Balancer(), out=out, **GRID, **KW)
+    said = [str(x.message) for x in w if issubclass(x.category, ScanStoreWarning)]
+    assert len(said) == 2 and any("meta.json" in m for m in said)
+    aside = tmp_path / "fine.parquet.damaged"
+    assert sorted(p.name for p in aside.iterdir()) == ["chunk-00001.parquet", "meta.json"]
+    assert only_chunks(out)
+    assert same_rows(again, df) and same_rows(pl.read_parquet(out), df)
+
+
+# --- 2. every table says its model ----------------------------------------------------------
+
+MODEL = dict(mu=0.15, zeta=0.07, zeta_b=(0.1, 0.2), delta=40.0, Omega=1.25, eta=(0.9, 1.1))
+
+
+def test_in_memory_table_carries_every_fixed_parameter(tmp_path):
+    b = ballbal.Balancer(**MODEL)
+    df = ballbal.scan(b, Omega=[1.2, 1.3], threads=1, starts=4)
+    expect = {"mu": 0.15, "zeta": 0.07, "zeta_b[0]": 0.1, "zeta_b[1]": 0.2, "delta": 40.0,
+              "eta[0]": 0.9, "eta[1]": 1.1}
+    for c, v in expect.items():
+        assert df[c].to_list() == [v] * df.height, c
+    assert df["Omega"].to_list() == [1.2, 1.3]  # the axis, not the model's 1.25
+    # Saved in a format without metadata and read back: still the same model.
+    df.drop("multipliers").write_csv(tmp_path / "t.csv")
+    back = pl.read_csv(tmp_path / "t.csv")
+    for c, v in expect.items():
+        assert back[c].to_list() == [v] * df.height, c
+
+
+def test_a_ball_under_an_axis_of_every_ball_takes_the_axis_value():
+    b = ballbal.Balancer(**MODEL)
+    df = ballbal.scan(b, eta=[0.8, 1.2], threads=1, starts=4)
+    assert df["eta[0]"].to_list() == df["eta"].to_list() == df["eta[1]"].to_list()
+    assert sorted(set(df["eta"].to_list())) == [0.8, 1.2]
+    one = ballbal.scan(b, grid={"eta[1]": [0.8, 1.2]}, threads=1, starts=4)
+    assert one["eta[0]"].to_list() == [0.9] * one.height
+    assert sorted(set(one["eta[1]"].to_list())) == [0.8, 1.2]
+    assert one.columns.count("eta[1]") == 1
+
+
+def test_stored_scan_says_model_options_and_scene(tmp_path):
+    b = ballbal.Balancer(**MODEL)
+    out = tmp_path / "s"
+    ballbal.scan(b, out=out, Omega=[1.2, 1.3], threads=1, starts=4, seeds=3)
+    meta = ballbal.scan_meta(out)
+    bal = meta["balancer"]
+    assert (bal["mu"], bal["zeta"], bal["delta"], bal["Omega"]) == (0.15, 0.07, 40.0, 1.25)
+    assert list(bal["zeta_b"]) == [0.1, 0.2] and list(bal["eta"]) == [0.9, 1.1]
+    assert meta["options"]["seeds"] == 3 and meta["options"]["starts"] == 4
+    assert meta["grid"] == {"Omega": [1.2, 1.3]}
+    # Every chunk carries it, readable by polars alone.
+    for f in out.glob("chunk-*.parquet"):
+        kv = pl.read_parquet_metadata(f)
+        assert json.loads(kv["ballbal_scan_description"]) == meta
+    # The table read back from the directory by polars has the model's columns too.
+    back = pl.read_parquet(out)
+    assert back["mu"].to_list() == [0.15] * back.height
+
+    # A scene: its effects too (here springs in a chain; the axis is stored beside).
+    s = ballbal.Scene(balancer=b, springs=0.05, spring_layout="chain")
+    out2 = tmp_path / "scene"
+    got = ballbal.scan(s, out=out2, springs=[0.05, 0.06], threads=1, starts=4)
+    m2 = ballbal.scan_meta(out2)
+    assert m2["scene"]["springs"] == {"stiffness": 0.05, "layout": "chain"}
+    assert m2["scene"]["balancer"]["mu"] == 0.15 and m2["grid"] == {"springs": [0.05, 0.06]}
+    assert got["zeta_b[1]"].to_list() == [0.2] * got.height
+
+
+def test_scan_meta_refuses_a_directory_without_a_whole_chunk(tmp_path):
+    out = tmp_path / "s"
+    out.mkdir()
+    (out / "chunk-00000.parquet").write_bytes(b"PAR1 not a file")
+    with pytest.raises(ScanStoreError, match="chunk-00000.parquet"):
+        ballbal.read_scan(out)
+    with pytest.raises(ScanStoreError, match="description"):
+        ballbal.scan_meta(out)
+
