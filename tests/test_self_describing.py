@@ -4,10 +4,12 @@ model it was computed for (columns in memory, the whole description in every chu
 Parquet metadata on disk); nested columns have a flat export that ``write_csv`` takes."""
 
 import json
+import math
 import os
 import warnings
 from pathlib import Path
 
+import numpy as np
 import polars as pl
 import pytest
 
@@ -194,3 +196,38 @@ def test_scan_meta_refuses_a_directory_without_a_whole_chunk(tmp_path):
     with pytest.raises(ScanStoreError, match="description"):
         ballbal.scan_meta(out)
 
+
+# --- 3. flat export -----------------------------------------------------------------------
+
+
+def test_flat_table_writes_csv_and_keeps_the_multipliers(tmp_path):
+    df = ballbal.scan(ballbal.Balancer(zeta_b=0.1), Omega=[1.1, 1.2, 1.3, 1.5], eta=[0.6, 1.0, 1.2],
+                      patterns=["R-R", "O-O"], threads=1, starts=4)
+    with pytest.raises(Exception, match="(?i)nested|list|struct"):  # why flat() exists
+        df.write_csv(tmp_path / "nested.csv")
+    flat = ballbal.flat(df)
+    path = tmp_path / "t.csv"
+    flat.write_csv(path)
+    back = pl.read_csv(path, infer_schema_length=None)
+    assert back.height == df.height
+    have = df.filter(pl.col("multipliers").is_not_null())
+    assert have.height >= 3
+    k = max(len(m) for m in have["multipliers"].to_list())
+    assert {f"multipliers_re_{k - 1}", f"multipliers_im_{k - 1}"} <= set(back.columns)
+    for i, row in enumerate(df.iter_rows(named=True)):
+        mult = row["multipliers"]
+        if mult is None:
+            assert back["multipliers_re_0"][i] is None
+            continue
+        want = np.abs([complex(m["re"], m["im"]) for m in mult])
+        got = np.hypot([back[f"multipliers_re_{j}"][i] for j in range(len(mult))],
+                       [back[f"multipliers_im_{j}"][i] for j in range(len(mult))])
+        assert np.allclose(got, want, rtol=1e-12, atol=0), (i, got, want)
+    # The other columns are kept as they were.
+    for a, b in zip(back["omega"].to_list(), df["omega"].to_list(), strict=True):
+        assert (a is None and b is None) or math.isclose(a, b, rel_tol=1e-14)
+
+
+def test_flat_refuses_a_lazy_frame():
+    with pytest.raises(ballbal.exceptions.ParameterTypeError, match="table"):
+        ballbal.flat(pl.LazyFrame({"a": [1]}))  # type: ignore[arg-type]

@@ -787,8 +787,10 @@ def scan(  # noqa: E302 - overloads above
     leading modulus' error (``modulus_error``; a row whose verdict the bound leaves open
     is refined to more harmonics first, see :func:`~ballbal.periodic`). The solution
     columns have the names and meaning of :class:`~ballbal.PeriodicSolution`'s fields
-    (``pivot_ratio``, ...); the multipliers are a list of ``{re, im}``. After them, the
-    table says what model its rows are of: a column for every balancer parameter that is not an axis (``mu``,
+    (``pivot_ratio``, ...); the multipliers are a list of ``{re, im}`` (a nested column,
+    which ``write_csv`` cannot hold: :func:`ballbal.flat` spreads it into
+    ``multipliers_re_0, multipliers_im_0, ...``). After them, the table says what model
+    its rows are of: a column for every balancer parameter that is not an axis (``mu``,
     ``zeta``, ``zeta_b[i]``, ``delta``, ``Omega``, ``eta[i]``, one per ball; a ball's
     column repeats an axis that sets every ball, such as ``eta``). Columns rather than
     metadata, since a polars DataFrame carries none: they survive every format, filter
@@ -1036,3 +1038,34 @@ def scan_meta(path: str | os.PathLike[str]) -> dict[str, Any]:
     file is whole."""
     return _read_description(Path(_check.path("path", path)))
 
+
+def flat(table: pl.DataFrame) -> pl.DataFrame:
+    """``table`` with its nested columns spread into plain ones, for formats that hold
+    only those (``write_csv``): a list of structs ``x`` (a scan's ``multipliers``, a
+    list of ``{re, im}``) becomes ``x_re_0, x_im_0, x_re_1, ...``, a list of numbers
+    ``x_0, x_1, ...``, a struct ``x_<field>``. Lists are padded with nulls to the longest
+    row's length; a row without the list (null) gets nulls. Other columns keep their
+    place and values."""
+    if not isinstance(table, pl.DataFrame):
+        raise ParameterTypeError("table", "must be a polars DataFrame (collect a LazyFrame "
+                                 f"first), got {type(table).__name__}")
+    out: list[pl.Expr] = []
+    for name, dtype in table.schema.items():
+        col = pl.col(name)
+        if isinstance(dtype, (pl.List, pl.Array)):
+            inner = dtype.inner
+            longest = table.select(col.list.len().max() if isinstance(dtype, pl.List)
+                                   else pl.lit(dtype.size)).item() or 0
+            for i in range(longest):
+                item = col.list.get(i, null_on_oob=True) if isinstance(dtype, pl.List) \
+                    else col.arr.get(i, null_on_oob=True)
+                if isinstance(inner, pl.Struct):
+                    out += [item.struct.field(f.name).alias(f"{name}_{f.name}_{i}")
+                            for f in inner.fields]
+                else:
+                    out.append(item.alias(f"{name}_{i}"))
+        elif isinstance(dtype, pl.Struct):
+            out += [col.struct.field(f.name).alias(f"{name}_{f.name}") for f in dtype.fields]
+        else:
+            out.append(col)
+    return table.select(out)
