@@ -231,3 +231,35 @@ def test_flat_table_writes_csv_and_keeps_the_multipliers(tmp_path):
 def test_flat_refuses_a_lazy_frame():
     with pytest.raises(ballbal.exceptions.ParameterTypeError, match="table"):
         ballbal.flat(pl.LazyFrame({"a": [1]}))  # type: ignore[arg-type]
+
+
+# --- 4. axis indices in the other gridded tables ------------------------------------------
+
+
+def test_basin_table_has_each_starts_axis_positions():
+    from ballbal.basins import BasinOptions, basins
+
+    m = ballbal.Balancer(zeta_b=0.05, Omega=1.35, eta=(0.7, 0.7))
+    ax1, ax2 = [0.3, 1.1, 2.0], [0.6, 2.5]
+    t = basins(m, b1=ax1, b2=ax2, t_end=60, options=BasinOptions(window=30)).table
+    assert t.height == 6 and t.schema["b1_index"] == pl.Int64
+    assert sorted(zip(t["b1_index"], t["b2_index"], strict=True)) == [
+        (i, j) for i in range(3) for j in range(2)]
+    for r in t.iter_rows(named=True):
+        assert math.isclose(ax1[r["b1_index"]], r["b1"], rel_tol=1e-15)
+        assert math.isclose(ax2[r["b2_index"]], r["b2"], rel_tol=1e-15)
+    rnd = basins(m, samples=3, seed=1, t_end=60, options=BasinOptions(window=30)).table
+    assert rnd["b1_index"].null_count() == rnd["b2_index"].null_count() == 3
+
+
+def test_speed_sweep_table_has_the_speeds_positions():
+    speeds = [1.0, 1.2, 1.4]
+    from ballbal.sweep import speed_sweep
+
+    s = speed_sweep(ballbal.Balancer(), speeds, dwell=40.0, record=None)
+    assert s.table["Omega_index"].to_list() == [0, 1, 2, 1, 0]  # up, then down
+    for om, i in zip(s.table["Omega"], s.table["Omega_index"], strict=True):
+        assert math.isclose(speeds[i], om, rel_tol=1e-15)
+    down = speed_sweep(ballbal.Balancer(), speeds, dwell=40.0, record=None,
+                       direction="down")
+    assert down.table["Omega_index"].to_list() == [2, 1, 0]

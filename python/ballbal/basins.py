@@ -112,7 +112,9 @@ class BasinOptions:
 class Basins:
     """The result of :func:`basins`.
 
-    ``table``: one row per start (``b1, b2, label, pattern, omega`` (mean ball rate of
+    ``table``: one row per start (``b1, b2, b1_index, b2_index`` (the start's position
+    on each axis, for exact joins; null for random starts), ``label, pattern, omega``
+    (mean ball rate of
     the rotating balls), ``period`` (null unless regular), ``rate1, rate2`` (each
     ball's mean rate), ``t_stop`` (time simulated in all), ``motion`` (``rest``,
     ``periodic``: a period that repeats over the last three periods to 1e-3,
@@ -445,6 +447,8 @@ def basins(
         rng = np.random.default_rng(_seed(seed))
         pts = rng.uniform(0.0, 2 * np.pi, size=(k, 2))
         s1, s2 = pts[:, 0], pts[:, 1]
+        # random starts lie on no axis
+        i1 = i2 = np.full(k, None, dtype=object)
     else:
         if seed is not None:
             raise ParameterError("seed", "draws random starts: give it with samples, not "
@@ -462,6 +466,9 @@ def basins(
             a1, a2 = default_grid(20 if n is None else n)
         g1, g2 = np.meshgrid(a1, a2, indexing="xy")
         s1, s2 = g1.ravel(), g2.ravel()
+        # each start's position on its axes: joins on these are exact
+        j1, j2 = np.meshgrid(np.arange(a1.size), np.arange(a2.size), indexing="xy")
+        i1, i2 = j1.ravel(), j2.ravel()
     starts = [[float(x), float(y)] for x, y in zip(s1, s2, strict=True)]
     threads = (os.cpu_count() or 1) if execution.threads is None else execution.threads
     n_chunks = -(-len(starts) // chunk)
@@ -472,7 +479,10 @@ def basins(
         lo = c * chunk
         hi = lo + (sizes[c] if size is None else size)
         return pl.DataFrame({
-            "b1": s1[lo:hi], "b2": s2[lo:hi], "label": pl.Series(cols["label"], dtype=pl.Utf8),
+            "b1": s1[lo:hi], "b2": s2[lo:hi],
+            "b1_index": pl.Series(i1[lo:hi].tolist(), dtype=pl.Int64),
+            "b2_index": pl.Series(i2[lo:hi].tolist(), dtype=pl.Int64),
+            "label": pl.Series(cols["label"], dtype=pl.Utf8),
             "pattern": pl.Series(cols["pattern"], dtype=pl.Utf8),
             "omega": pl.Series(cols["omega"], dtype=pl.Float64),
             "period": pl.Series(cols["period"], dtype=pl.Float64),
@@ -492,7 +502,9 @@ def basins(
         meta = {"ballbal": _native.__version__, "basins": {
             "model": model.to_dict() if isinstance(model, Scene) else asdict(model),
             "starts": hashlib.sha256(np.stack([s1, s2]).tobytes()).hexdigest(),
-            "count": len(starts), "options": asdict(options), "chunk": chunk}}
+            "count": len(starts), "options": asdict(options), "chunk": chunk,
+            # chunks written before the index columns hold other columns
+            "columns": ["b1", "b2", "b1_index", "b2_index"]}}
         store = _BasinStore(execution.out, meta)
     done: set[int] = set()
     todo: list[int] = []
