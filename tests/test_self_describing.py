@@ -26,7 +26,9 @@ def names_in(d: Path) -> list[str]:
 
 
 def only_chunks(d: Path) -> bool:
-    return all(n.startswith("chunk-") and n.endswith(".parquet") for n in names_in(d))
+    """Only the table's Parquet files: the chunks and the description (no rows)."""
+    return all((n.startswith("chunk-") and n.endswith(".parquet")) or n == "_scan.parquet"
+               for n in names_in(d))
 
 
 def same_rows(a: pl.DataFrame, b: pl.DataFrame) -> bool:
@@ -46,7 +48,7 @@ def written(tmp_path_factory):
 def test_polars_reads_the_scan_directory_itself(written):
     out, df = written
     assert only_chunks(out), names_in(out)  # no meta.json, no .lock
-    assert len(names_in(out)) == 3
+    assert len(names_in(out)) == 3 + 1
     for got in (pl.read_parquet(out), pl.scan_parquet(out).collect(),
                 pl.read_parquet(f"{out}/*.parquet")):
         assert got.height == 2 * 3
@@ -169,10 +171,10 @@ def test_stored_scan_says_model_options_and_scene(tmp_path):
     assert list(bal["zeta_b"]) == [0.1, 0.2] and list(bal["eta"]) == [0.9, 1.1]
     assert meta["options"]["seeds"] == 3 and meta["options"]["starts"] == 4
     assert meta["grid"] == {"Omega": [1.2, 1.3]}
-    # Every chunk carries it, readable by polars alone.
-    for f in out.glob("chunk-*.parquet"):
-        kv = pl.read_parquet_metadata(f)
-        assert json.loads(kv["ballbal_scan_description"]) == meta
+    # The description file carries it, readable by polars alone, and adds no rows.
+    kv = pl.read_parquet_metadata(out / "_scan.parquet")
+    assert json.loads(kv["ballbal_scan_description"]) == meta
+    assert pl.read_parquet(out / "_scan.parquet").height == 0
     # The table read back from the directory by polars has the model's columns too.
     back = pl.read_parquet(out)
     assert back["mu"].to_list() == [0.15] * back.height
@@ -187,14 +189,17 @@ def test_stored_scan_says_model_options_and_scene(tmp_path):
     assert got["zeta_b[1]"].to_list() == [0.2] * got.height
 
 
-def test_scan_meta_refuses_a_directory_without_a_whole_chunk(tmp_path):
+def test_a_description_without_a_description_is_damaged(tmp_path, written):
+    src, _ = written
     out = tmp_path / "s"
     out.mkdir()
-    (out / "chunk-00000.parquet").write_bytes(b"PAR1 not a file")
-    with pytest.raises(ScanStoreError, match="chunk-00000.parquet"):
-        ballbal.read_scan(out)
-    with pytest.raises(ScanStoreError, match="description"):
-        ballbal.scan_meta(out)
+    for f in src.iterdir():
+        (out / f.name).write_bytes(f.read_bytes())
+    # A readable Parquet file with the right columns but no description in it.
+    pl.read_parquet(out / "_scan.parquet").write_parquet(out / "_scan.parquet")
+    for call in (ballbal.read_scan, ballbal.scan_meta):
+        with pytest.raises(ScanStoreError, match="_scan.parquet"):
+            call(out)
 
 
 # --- 3. flat export -----------------------------------------------------------------------

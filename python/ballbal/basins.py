@@ -60,6 +60,10 @@ ROTATING = ("merged_R-R", "separated_R-R", "R-O")
 #: periods repeat to 1e-3 and agree with the orbits' to about 1e-5; distinct orbits of
 #: one class and winding differ by more). Over it, a new orbit is solved.
 LINK_TOL = 0.01
+#: The columns a chunk's native call returns, none of them filled: a table of no rows.
+_NO_ROWS: dict[str, list[Any]] = {k: [] for k in (
+    "label", "pattern", "omega", "period", "rate1", "rate2", "t_stop", "motion",
+    "winding1", "winding2", "extensions", "long_label", "state")}
 #: Columns of :attr:`Basins.orbits`.
 ORBIT_SCHEMA = {
     "orbit": pl.Int64, "label": pl.Utf8, "pattern": pl.Utf8, "winding1": pl.Int64,
@@ -274,30 +278,22 @@ class _BasinStore:
     with the same arguments skips the chunks on disk; a chunk file that is unreadable,
     changed since it was written (its checksum), of another grid or another chunk's
     position, or short is set aside in ``<out>.damaged`` beside the directory with a
-    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed. Each chunk carries the
-    grid's description in its Parquet metadata, so the directory holds only the table's
-    files (``polars.read_parquet(out)`` reads them)."""
+    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed. The grid's description
+    is a Parquet file of no rows (``_scan.parquet``), so the directory holds only the
+    table's files (``polars.read_parquet(out)`` reads them)."""
 
-    def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any]) -> None:
+    def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any],
+                 empty: pl.DataFrame) -> None:
         from .scan import _Store
 
         class Store(_Store):
             def _open(self, job: Any, chunk_given: bool) -> Any:
-                from .scan import _LEGACY_META, _stored_description
-
                 want = json.loads(json.dumps(meta))
-                legacy = self.dir / _LEGACY_META
-                if legacy.exists():
-                    self._set_aside(legacy, "a grid description of ballbal before 0.2, "
-                                    "which polars cannot read among the chunks",
-                                    "no longer used")
-                old = _stored_description(self.dir, "basins")
+                old = self._old_description("basins")
                 if old is not None and old != want:
                     raise ScanStoreError(f"out: {self.dir} holds a different basin grid; "
                                          "choose another directory or delete it")
-                self.meta = want
-                self.fingerprint = hashlib.sha256(json.dumps(want).encode()).hexdigest()
-                self.description = json.dumps(want)
+                self._describe(want, empty)
                 return job
 
         self.store = Store(path, None, False)  # type: ignore[arg-type]
@@ -505,7 +501,7 @@ def basins(
             "count": len(starts), "options": asdict(options), "chunk": chunk,
             # chunks written before the index columns hold other columns
             "columns": ["b1", "b2", "b1_index", "b2_index"]}}
-        store = _BasinStore(execution.out, meta)
+        store = _BasinStore(execution.out, meta, frame(0, _NO_ROWS, 0))
     done: set[int] = set()
     todo: list[int] = []
     interrupted = False
@@ -563,10 +559,7 @@ def basins(
         if store is not None:
             store.close()
     df = (pl.concat([parts[c] for c in sorted(parts)], how="vertical") if parts
-          else frame(0, {k: [] for k in ("label", "pattern", "omega", "period", "rate1",
-                                         "rate2", "t_stop", "motion", "winding1",
-                                         "winding2", "extensions", "long_label",
-                                         "state")}, 0))
+          else frame(0, _NO_ROWS, 0))
     states = df["state"].to_list()
     df = df.drop("state")
     if settle_check:

@@ -149,7 +149,7 @@ def _differences(old: Mapping[str, Any], new: Mapping[str, Any], prefix: str = "
 
 
 def _meta_options(o: ScanOptions) -> dict[str, Any]:
-    """The options as ``meta.json`` records them (the scan's fingerprint): the flat
+    """The options as the scan's description records them (its fingerprint): the flat
     keywords of before the option classes, in their order, so that directories written
     then resume; ``guess_atol`` only where it is not ``guess_rtol / 1000`` (what those
     keywords implied). The Floquet method only where it is not RK45: directories written
@@ -254,16 +254,22 @@ def run_chunk(job: _Job, c: int, threads: int = 1) -> pl.DataFrame:
 
 
 #: Parquet key-value metadata entry holding the fingerprint of the scan a chunk belongs
-#: to, so that a chunk is trusted only for the scan that wrote it (even when meta.json
-#: itself was damaged and had to be rewritten).
+#: to, so that a chunk is trusted only for the scan that wrote it (even when the
+#: description file itself was damaged and had to be rewritten).
 _FINGERPRINT = "ballbal_scan"
 _CHUNK_FILE = re.compile(r"chunk-(\d{5,})\.parquet")
 #: Parquet key-value entry holding the scan's description (:meth:`_Job.meta` as JSON:
-#: model, grid, patterns, options, layout), in every chunk. Not a ``meta.json`` beside
-#: the chunks: polars reads a directory only when every file in it is Parquet (it
-#: skips no name by default, only empty files), and a chunk copied elsewhere still
-#: says what it was computed for.
+#: model, grid, patterns, options, layout) in the directory's description file.
 _DESCRIPTION = "ballbal_scan_description"
+#: The description file: a Parquet file of no rows with the table's columns, the
+#: description, the scan's fingerprint and a checksum (as a chunk's) in its key-value
+#: metadata. Not a ``meta.json``: polars reads a directory only when every file in it is
+#: Parquet (it skips no name by default, not even a leading ``.`` or ``_``, only empty
+#: files), and a file of no rows with the same columns adds nothing to the table. The
+#: leading ``_`` is what pyarrow and Spark datasets skip (as their ``_common_metadata``,
+#: the same idea). One file, not a copy in every chunk: the description holds every
+#: axis value, which in every chunk would grow as the square of a long axis.
+_DESCRIPTION_FILE = "_scan.parquet"
 #: Parquet key-value entry holding the chunk's number, so that a chunk copied or renamed
 #: to another position of the same grid is not taken for that position's: the basin
 #: store's rows are checked only by their count, and a checksum travels with its file.
@@ -419,7 +425,7 @@ def _chunk_problem(f: Path, meta: Mapping[str, Any], c: int | None) -> str | Non
         df = pl.read_parquet(io.BytesIO(data))
     except Exception as e:  # noqa: BLE001 - any failure to read means a damaged file
         return f"unreadable: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
-    if df.schema != _empty(names, meta["model_columns"]).schema:
+    if df.schema != _empty(names, meta.get("model_columns", [])).schema:
         return "its columns are not a scan table's"
     wanted = [set(v) for v in values[:-1]] + [set(values[-1][lo:hi])]
     for n, w in zip(names, wanted, strict=True):
@@ -448,61 +454,44 @@ def _chunk_files(d: Path) -> list[Path]:
     return sorted(d.glob("chunk-*.parquet"), key=_chunk_order)
 
 
-def _description_in(f: Path, kind: str) -> dict[str, Any] | None:
-    """The scan description carried by chunk file ``f`` if its bytes are the ones
-    written (its checksum) and it is one (a mapping whose ``kind`` is a mapping: ``grid``
-    for a scan, ``basins`` for a basin grid), else ``None``."""
+def _description_problem(f: Path, kind: str = "grid") -> tuple[dict[str, Any] | None,
+                                                             str | None]:
+    """The description in the description file ``f`` (see ``_DESCRIPTION_FILE``), or why it
+    cannot be trusted: its bytes changed since written (checksum), no description in its
+    metadata, or not one of ``kind`` (``grid`` for a scan, ``basins`` for a basin grid)."""
     try:
         data = f.read_bytes()
-    except OSError:
-        return None
-    if _checksum_problem(data) is not None:
-        return None
+    except FileNotFoundError:
+        return None, "missing: not a scan directory"
+    except OSError as e:
+        return None, f"unreadable: {type(e).__name__}: {e}"
+    why = _checksum_problem(data)
+    if why is not None:
+        return None, why
     try:
         meta = json.loads(pl.read_parquet_metadata(io.BytesIO(data))[_DESCRIPTION])
-    except Exception:  # noqa: BLE001 - no description, or not one: not a reference
-        return None
+    except Exception as e:  # noqa: BLE001 - no description, or not JSON: damaged
+        return None, f"unreadable: {type(e).__name__}"
     if not isinstance(meta, dict) or not isinstance(meta.get(kind), dict):
-        return None
-    return meta
-
-
-def _whole_problem(f: Path) -> str:
-    """Why chunk file ``f`` carries no scan description that can be trusted."""
-    try:
-        data = f.read_bytes()
-    except OSError as e:
-        return f"unreadable: {type(e).__name__}: {e}"
-    return _checksum_problem(data) or "it carries no scan description"
-
-
-def _stored_description(d: Path, kind: str = "grid") -> dict[str, Any] | None:
-    """The description of the scan in directory ``d``: the one carried by its first
-    chunk file that is whole (checksum); ``None`` if no chunk is. The other chunks are
-    checked against it by their fingerprints, so one damaged or foreign chunk cannot
-    speak for the directory unless it comes first and is whole."""
-    for f in _chunk_files(d):
-        meta = _description_in(f, kind)
-        if meta is not None:
-            return meta
-    return None
+        return None, "not a scan description"
+    return meta, None
 
 
 def _read_description(d: Path) -> dict[str, Any]:
-    """The description of the scan in ``d``; ScanStoreError when no chunk carries one."""
-    meta = _stored_description(d)
+    """The description of the scan in ``d``; ScanStoreError naming its file when it is
+    damaged."""
+    f = d / _DESCRIPTION_FILE
+    meta, why = _description_problem(f)
     if meta is None:
-        raise ScanStoreError(
-            f"path: no chunk file in {d} carries a whole scan description (none is "
-            "intact, or they were written before ballbal 0.2, with a meta.json); run the "
-            "same scan with out= again to recompute them")
+        raise ScanStoreError(f"path: {f} is damaged ({why}); run the same scan with "
+                             "out= again to rewrite it")
     return meta
 
 
 class _Store:
-    """Finished chunks as Parquet files in a directory, each carrying the scan's
-    description (``_DESCRIPTION``), so that the directory holds nothing but the table:
-    ``polars.read_parquet(dir)`` reads it.
+    """Finished chunks as Parquet files in a directory, with the scan's description in a
+    Parquet file of no rows (``_DESCRIPTION_FILE``), so that the directory holds nothing
+    but the table: ``polars.read_parquet(dir)`` reads it.
 
     The directory itself is locked (``fcntl.flock`` on its descriptor) while a scan uses
     it: the kernel drops the lock when the process ends, even when killed, and no lock
@@ -586,16 +575,41 @@ class _Store:
         warnings.warn(ScanStoreWarning(f"out: {f} is damaged ({why}); set aside as "
                                        f"{dest} and {then}"), stacklevel=_caller())
 
-    def _open(self, job: _Job, chunk_given: bool) -> _Job:
-        # As it reads back from JSON (tuples become lists), to compare with the chunks'.
-        meta = json.loads(json.dumps(job.meta()))
+    def _old_description(self, kind: str) -> dict[str, Any] | None:
+        """The description the directory holds, if it can be trusted; a damaged one is
+        set aside (the chunks are still checked by their fingerprints), and so is a
+        ``meta.json`` of ballbal 0.1, which would stop polars reading the directory."""
         legacy = self.dir / _LEGACY_META
         if legacy.exists():
-            # Written before ballbal 0.2: its chunks carry no description and are
-            # recomputed; the file would stop polars reading the directory.
-            self._set_aside(legacy, "a scan description of ballbal before 0.2, which "
-                            "polars cannot read among the chunks", "no longer used")
-        old = _stored_description(self.dir)
+            self._set_aside(legacy, "the description of ballbal 0.1, which polars cannot "
+                            "read among the chunks", "replaced by "
+                            f"{_DESCRIPTION_FILE}; the chunks are checked by their "
+                            "fingerprints")
+        f = self.dir / _DESCRIPTION_FILE
+        if not f.exists():
+            return None
+        old, why = _description_problem(f, kind)
+        if old is None:
+            self._set_aside(f, why or "", "rewritten; the chunks are checked by their "
+                            "fingerprints")
+        return old
+
+    def _describe(self, meta: dict[str, Any], empty: pl.DataFrame) -> None:
+        """Record ``meta`` as the directory's description, in a file of no rows with the
+        table's columns ``empty``."""
+        self.meta = meta
+        self.fingerprint = _fingerprint(meta)
+        f = self.dir / _DESCRIPTION_FILE
+        if not f.exists():
+            _write_atomic(f, lambda fh: fh.write(_sealed(empty, {
+                _FINGERPRINT: self.fingerprint, _DESCRIPTION: json.dumps(meta)})))
+        for tmp in self.dir.glob(".*.tmp"):  # left by a crash; the lock says nobody writes
+            tmp.unlink(missing_ok=True)
+
+    def _open(self, job: _Job, chunk_given: bool) -> _Job:
+        # As it reads back from JSON (tuples become lists), to compare with the file's.
+        meta = json.loads(json.dumps(job.meta()))
+        old = self._old_description("grid")
         if old is not None:
             same = {k: v for k, v in old.items() if k != "chunk"} == {
                 k: v for k, v in meta.items() if k != "chunk"}
@@ -615,11 +629,7 @@ class _Store:
                 raise ScanStoreError(
                     f"out: {self.dir} holds this scan with its axes in the order "
                     f"{', '.join(old['grid'])}; give them in that order to resume it")
-        self.meta = meta
-        self.fingerprint = _fingerprint(meta)
-        self.description = json.dumps(meta)
-        for tmp in self.dir.glob(".*.tmp"):  # left by a crash; the lock says nobody writes
-            tmp.unlink(missing_ok=True)
+        self._describe(meta, _empty(job.names, list(job.model_values())))
         return job
 
     def file(self, c: int) -> Path:
@@ -638,9 +648,8 @@ class _Store:
         return ok
 
     def write(self, c: int, df: pl.DataFrame) -> None:
-        _write_atomic(self.file(c), lambda fh: fh.write(_sealed(df, {
-            _FINGERPRINT: self.fingerprint, _CHUNK_KEY: str(c),
-            _DESCRIPTION: self.description})))
+        _write_atomic(self.file(c), lambda fh: fh.write(
+            _sealed(df, {_FINGERPRINT: self.fingerprint, _CHUNK_KEY: str(c)})))
 
     def files(self, chunks: Iterable[int]) -> list[Path]:
         return [self.file(c) for c in sorted(chunks)]
@@ -815,9 +824,10 @@ def scan(  # noqa: E302 - overloads above
     (atomically), and a later call with the same arguments and ``out`` skips the chunks
     on disk (resume; the axes must be given in the same order). The directory is a
     Parquet dataset: once the scan ends (finished, failed or interrupted) it holds only
-    the chunk files, so ``polars.read_parquet(out)`` and ``polars.scan_parquet(out)``
-    read the table; each chunk carries the scan's description in its Parquet metadata
-    (:func:`scan_meta`). Only one scan at a time may use a directory (another gets
+    Parquet files, so ``polars.read_parquet(out)`` and ``polars.scan_parquet(out)`` read
+    the table: the chunks, and ``_scan.parquet`` (no rows, the table's columns), which
+    carries the scan's description in its Parquet metadata (:func:`scan_meta`). Only
+    one scan at a time may use a directory (another gets
     :class:`~ballbal.exceptions.ScanStoreError`). A damaged file found on resuming
     (truncated, unreadable, changed since it was written -- every chunk carries a
     SHA-256 of its bytes --, another scan's or another chunk's) is set aside in
@@ -973,9 +983,9 @@ def read_scan(  # noqa: E302 - overloads above
     """The table of a scan written with ``out=path`` (the finished chunks, in order).
 
     The directory is also a Parquet dataset: ``polars.read_parquet(path)`` and
-    ``polars.scan_parquet(path)`` read the same table, unchecked. Every chunk file
-    carries the scan's description (:func:`scan_meta`) and is checked against it here
-    before its rows are used; a damaged one (truncated, unreadable, changed since it
+    ``polars.scan_parquet(path)`` read the same table, unchecked. Every chunk file is
+    checked against the scan's description (:func:`scan_meta`) before its rows are
+    used; a damaged one (truncated, unreadable, changed since it
     was written, another scan's or another chunk's, missing points) raises
     :class:`~ballbal.exceptions.ScanStoreError` naming it; running the same scan with
     ``out=path`` again sets it aside and recomputes it. ``lazy=True`` returns a
@@ -986,13 +996,7 @@ def read_scan(  # noqa: E302 - overloads above
     files = _chunk_files(d)
     if not files:
         raise ParameterError("path", f"no scan chunks (chunk-*.parquet) in {d}", value=path)
-    meta = _stored_description(d)
-    if meta is None:
-        # No chunk is whole: each is named with what is wrong with it.
-        raise ScanStoreError(
-            "path: damaged chunk file(s): "
-            + "; ".join(f"{f} ({_whole_problem(f)})" for f in files)
-            + f"; run the same scan with out={str(d)!r} again to recompute them")
+    meta = _read_description(d)
     damaged = []
     for f in files:
         c = _chunk_index(f)
@@ -1005,7 +1009,7 @@ def read_scan(  # noqa: E302 - overloads above
             if why is None:
                 try:
                     ok = (pl.read_parquet_schema(io.BytesIO(data))
-                          == dict(_empty(list(meta["grid"]), meta["model_columns"]).schema))
+                          == dict(_empty(list(meta["grid"]), meta.get("model_columns", [])).schema))
                 except Exception:  # noqa: BLE001 - any failure to read: a damaged file
                     ok = False
                 why = None if ok else "its columns are not a scan table's"
@@ -1024,9 +1028,9 @@ def read_scan(  # noqa: E302 - overloads above
 
 def scan_meta(path: str | os.PathLike[str]) -> dict[str, Any]:
     """The description of the scan written with ``out=path``: what its table was computed
-    for, as every chunk file carries it in its Parquet key-value metadata (key
-    ``ballbal_scan_description``, JSON; ``polars.read_parquet_metadata(file)`` reads it
-    too).
+    for, as the directory's description file ``_scan.parquet`` (no rows, the table's
+    columns) carries it in its Parquet key-value metadata (key
+    ``ballbal_scan_description``, JSON: ``polars.read_parquet_metadata`` reads it too).
 
     Keys: ``balancer`` (every field: ``mu``, ``zeta``, ``zeta_b``, ``delta``, ``Omega``,
     ``eta`` with one value per ball) or, for a :class:`~ballbal.Scene`, ``scene`` (its
@@ -1034,8 +1038,8 @@ def scan_meta(path: str | os.PathLike[str]) -> dict[str, Any]:
     axis' values, in the order given), ``patterns``, ``options`` (what the scan
     computed with), ``block`` and ``chunk``, ``columns`` and ``model_columns`` (the
     table's), ``ballbal`` (the version that wrote it). A grid axis replaces the model's
-    value of that parameter. :class:`~ballbal.exceptions.ScanStoreError` if no chunk
-    file is whole."""
+    value of that parameter. :class:`~ballbal.exceptions.ScanStoreError` naming the file
+    if it is damaged (running the same scan with ``out=path`` again rewrites it)."""
     return _read_description(Path(_check.path("path", path)))
 
 
