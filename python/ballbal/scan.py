@@ -621,9 +621,13 @@ class _Store:
                 meta["chunk"] = stored
             if old != meta:
                 diff = _differences(old, meta)
+                hint = ""
+                if old.get("options", {}).get("hill") is False and "options.hill" in diff:
+                    hint = (" (scans written before 2026-11-24 ran without Hill's "
+                            "cross-check by default: hill=False resumes them)")
                 raise ScanStoreError(
                     f"out: {self.dir} holds a different scan (it differs in "
-                    f"{', '.join(diff)}); choose another directory or delete it")
+                    f"{', '.join(diff)}){hint}; choose another directory or delete it")
             if list(old["grid"]) != list(meta["grid"]):
                 # Same axes, other order: the chunks would be cut along another axis.
                 raise ScanStoreError(
