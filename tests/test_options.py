@@ -118,7 +118,7 @@ def test_scan_with_options_equals_scan_with_keywords(tmp_path):
     new = ballbal.scan(B, options=opts, execution=Execution(threads=1, out=tmp_path / "s"),
                        **grid)
     assert new.drop("seconds").equals(flat.drop("seconds"))
-    meta = json.loads((tmp_path / "s" / "meta.json").read_text())
+    meta = ballbal.scan_meta(tmp_path / "s")
     assert meta["options"]["seeds"] == 2 and "guess_atol" not in meta["options"]
 
 

@@ -1,4 +1,3 @@
-import json
 import os
 import signal
 import subprocess
@@ -251,7 +250,7 @@ def test_command_line_scan_and_plot(tmp_path):
     assert r.returncode == 0, r.stderr
     df = ballbal.read_scan(out)
     assert df.height == 6 and set(df["type"]) == {"R-R"}
-    assert json.loads((out / "meta.json").read_text())["balancer"]["zeta_b"] == 0.1
+    assert ballbal.scan_meta(out)["balancer"]["zeta_b"] == 0.1
     png = tmp_path / "map.png"
     r = subprocess.run(exe + ["plot", str(out), "-o", str(png)], capture_output=True,
                        text=True, timeout=300, env={**os.environ, "MPLBACKEND": "Agg"})

@@ -51,6 +51,13 @@ def chunk_files(d):
     return sorted(Path(d).glob("chunk-*.parquet"))
 
 
+def aside(f):
+    """Where a damaged file of a store directory is set aside: ``<dir>.damaged/<name>``,
+    beside the directory, so that the directory stays one Parquet dataset."""
+    d = Path(f).parent.resolve()
+    return d.with_name(d.name + ".damaged") / Path(f).name
+
+
 def store_warnings(w):
     return [str(x.message) for x in w if issubclass(x.category, ScanStoreWarning)]
 
@@ -123,7 +130,7 @@ def test_damaged_chunks_are_reported_set_aside_and_recomputed(tmp_path, referenc
     assert len(said) == 3
     for f in (truncated, empty, foreign):
         assert any(str(f) in m for m in said), (f, said)
-        assert f.with_name(f.name + ".damaged").exists()
+        assert aside(f).exists()
     assert same(df, reference)
     assert same(ballbal.read_scan(out), reference)
 
@@ -143,15 +150,15 @@ def test_chunk_missing_rows_is_damaged(tmp_path, reference, written):
     assert same(df, reference)
 
 
-@pytest.mark.parametrize("content", [b"", b"{\"grid\": ", b"\xff\xfe\x00garbage", b"[1, 2]"])
-def test_damaged_meta_is_reported_and_rewritten_and_chunks_kept(tmp_path, reference, written,
-                                                               content):
+@pytest.mark.parametrize("content", [b"", b"PAR1", b"\xff\xfe\x00garbage", b"[1, 2]"])
+def test_damaged_description_is_reported_and_rewritten_and_chunks_kept(tmp_path, reference,
+                                                                      written, content):
     out = copy_of(written, tmp_path)
     before = {f.name: f.stat().st_mtime_ns for f in chunk_files(out)}
-    (out / "meta.json").write_bytes(content)
-    with pytest.raises(ScanStoreError, match="meta.json"):
+    (out / "_scan.parquet").write_bytes(content)
+    with pytest.raises(ScanStoreError, match="_scan.parquet"):
         ballbal.read_scan(out)
-    with pytest.raises(ScanStoreError, match="meta.json"):
+    with pytest.raises(ScanStoreError, match="_scan.parquet"):
         ballbal.scan_meta(out)
     progress = []
     with warnings.catch_warnings(record=True) as w:
@@ -159,12 +166,26 @@ def test_damaged_meta_is_reported_and_rewritten_and_chunks_kept(tmp_path, refere
         df = ballbal.scan(ballbal.Balancer(), out=out,
                           progress=lambda d, t: progress.append(d), **KW)
     said = store_warnings(w)
-    assert len(said) == 1 and "meta.json" in said[0]
+    assert len(said) == 1 and "_scan.parquet" in said[0]
     assert same(df, reference)
     # The chunks carry the scan's fingerprint: all were trusted, none recomputed.
     assert progress == []
     assert {f.name: f.stat().st_mtime_ns for f in chunk_files(out)} == before
     assert ballbal.scan_meta(out)["grid"]["Omega"][0] == 1.0
+    assert same(pl.read_parquet(out), reference)
+
+
+def test_meta_json_of_before_0_2_is_set_aside(tmp_path, reference, written):
+    out = copy_of(written, tmp_path)
+    (out / "meta.json").write_text(json.dumps({"grid": {"Omega": [1.0]}}))
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        df = ballbal.scan(ballbal.Balancer(), out=out, **KW)
+    said = store_warnings(w)
+    assert len(said) == 1 and "meta.json" in said[0] and "ballbal 0.1" in said[0]
+    assert aside(out / "meta.json").exists() and not (out / "meta.json").exists()
+    assert same(df, reference)
+    assert same(pl.read_parquet(out), reference)
 
 
 def test_resume_with_axes_in_another_order_is_refused(tmp_path):
@@ -236,7 +257,7 @@ orig = pl.DataFrame.write_parquet
 calls = []
 def torn(self, file, **kw):
     calls.append(1)
-    if len(calls) < 4:
+    if len(calls) < 5:  # the description (a file of no rows), then three chunks
         return orig(self, file, **kw)
     buf = io.BytesIO()
     orig(self, buf, **kw)
@@ -297,14 +318,15 @@ def test_interrupted_command_line_scan_exits_130(tmp_path):
         [sys.executable, "-m", "ballbal.cli", "scan", "--Omega", "1.0:2.0:0.01", "--eta",
          "0.4:1.5:0.01", "--threads", "1", "-o", str(out), "--no-progress"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    wait_for(lambda: (out / "meta.json").exists())
+    wait_for(lambda: len(chunk_files(out)) >= 1)
     time.sleep(0.5)
     p.send_signal(signal.SIGINT)
     stdout, stderr = p.communicate(timeout=60)
     assert p.returncode == 130, (stdout, stderr)
     assert "interrupted" in stderr and "Traceback" not in stderr
     assert "ballbal scan:" not in stdout  # no normal summary line
-    assert json.loads((out / "meta.json").read_text())["grid"]["Omega"][0] == 1.0
+    assert ballbal.scan_meta(out)["grid"]["Omega"][0] == 1.0
+    assert not (out / ".lock").exists()  # however the scan ended, no lock is left
 
 
 # --- memory: lazy tables over the files --------------------------------------------------
@@ -317,7 +339,9 @@ def test_lazy_table_over_the_files(tmp_path, reference):
     assert same(lf.collect(), reference)
     lf2 = ballbal.read_scan(out, lazy=True)
     assert isinstance(lf2, pl.LazyFrame) and same(lf2.collect(), reference)
-    assert os.path.exists(out / ".lock")
+    # The directory holds the table's files only: polars reads it as a dataset.
+    assert not os.path.exists(out / ".lock")
+    assert same(pl.read_parquet(out), reference)
 
 
 def test_command_line_scan_into_another_scans_directory_is_a_clear_error(tmp_path):

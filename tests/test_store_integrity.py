@@ -69,6 +69,13 @@ def chunk_files(d):
     return sorted(Path(d).glob("chunk-*.parquet"))
 
 
+def aside(f):
+    """Where a damaged file of a store directory is set aside: ``<dir>.damaged/<name>``,
+    beside the directory, so that the directory stays one Parquet dataset."""
+    d = Path(f).parent.resolve()
+    return d.with_name(d.name + ".damaged") / Path(f).name
+
+
 def store_warnings(w):
     return [str(x.message) for x in w if issubclass(x.category, ScanStoreWarning)]
 
@@ -132,7 +139,7 @@ def test_scan_resumes_past_flipped_bits(tmp_path, scan_reference, scan_written):
                 ballbal.read_scan(out, lazy=lazy)
         df, said, computed = resume_scan(out)
         assert len(said) == 1 and str(f) in said[0], (k, i, bit, said)
-        assert f.with_name(f.name + ".damaged").exists()
+        assert aside(f).exists()
         assert len(computed) == 1  # only the flipped chunk was recomputed
         assert df.equals(scan_reference), (k, i, bit)
 
@@ -187,7 +194,7 @@ def test_basins_resume_past_flipped_bits(tmp_path, basin_reference, basin_writte
         others = {g.name: g.stat().st_mtime_ns for g in chunk_files(out) if g != f}
         table, said = resume_basins(out)
         assert len(said) == 1 and str(f) in said[0], (k, i, bit, said)
-        assert f.with_name(f.name + ".damaged").exists()
+        assert aside(f).exists()
         assert {g: (out / g).stat().st_mtime_ns for g in others} == others
         assert table.equals(basin_reference), (k, i, bit)
 
@@ -203,6 +210,6 @@ def test_basins_chunk_copied_over_another_is_set_aside(tmp_path, basin_reference
     table, said = resume_basins(out)
     assert len(said) == 1 and str(files[1]) in said[0], said
     assert "holds chunk 2" in said[0] and "not chunk 1" in said[0], said
-    assert files[1].with_name(files[1].name + ".damaged").exists()
+    assert aside(files[1]).exists()
     assert table.equals(basin_reference)
     assert table.select("b1", "b2").unique().height == 16

@@ -21,7 +21,7 @@ from .options import (
     PeriodicOptions,
     ScanOptions,
 )
-from .scan import read_scan, scan, scan_meta
+from .scan import flat, read_scan, scan, scan_meta
 from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene, to_bearing
 from .spectrum import (
     Vibration,
@@ -68,6 +68,7 @@ __all__ = [
     "equilibria",
     "data",
     "exceptions",
+    "flat",
     "from_seed003",
     "label_peaks",
     "line_spectrum",

@@ -60,6 +60,10 @@ ROTATING = ("merged_R-R", "separated_R-R", "R-O")
 #: periods repeat to 1e-3 and agree with the orbits' to about 1e-5; distinct orbits of
 #: one class and winding differ by more). Over it, a new orbit is solved.
 LINK_TOL = 0.01
+#: The columns a chunk's native call returns, none of them filled: a table of no rows.
+_NO_ROWS: dict[str, list[Any]] = {k: [] for k in (
+    "label", "pattern", "omega", "period", "rate1", "rate2", "t_stop", "motion",
+    "winding1", "winding2", "extensions", "long_label", "state")}
 #: Columns of :attr:`Basins.orbits`.
 ORBIT_SCHEMA = {
     "orbit": pl.Int64, "label": pl.Utf8, "pattern": pl.Utf8, "winding1": pl.Int64,
@@ -112,7 +116,9 @@ class BasinOptions:
 class Basins:
     """The result of :func:`basins`.
 
-    ``table``: one row per start (``b1, b2, label, pattern, omega`` (mean ball rate of
+    ``table``: one row per start (``b1, b2, b1_index, b2_index`` (the start's position
+    on each axis, for exact joins; null for random starts), ``label, pattern, omega``
+    (mean ball rate of
     the rotating balls), ``period`` (null unless regular), ``rate1, rate2`` (each
     ball's mean rate), ``t_stop`` (time simulated in all), ``motion`` (``rest``,
     ``periodic``: a period that repeats over the last three periods to 1e-3,
@@ -271,33 +277,23 @@ class _BasinStore:
     locking, atomic writes and setting aside of damaged files it reuses): a later call
     with the same arguments skips the chunks on disk; a chunk file that is unreadable,
     changed since it was written (its checksum), of another grid or another chunk's
-    position, or short is set aside as ``<name>.damaged`` with a
-    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed."""
+    position, or short is set aside in ``<out>.damaged`` beside the directory with a
+    :class:`~ballbal.exceptions.ScanStoreWarning` and recomputed. The grid's description
+    is a Parquet file of no rows (``_scan.parquet``), so the directory holds only the
+    table's files (``polars.read_parquet(out)`` reads them)."""
 
-    def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any]) -> None:
+    def __init__(self, path: str | os.PathLike[str], meta: dict[str, Any],
+                 empty: pl.DataFrame) -> None:
         from .scan import _Store
 
         class Store(_Store):
             def _open(self, job: Any, chunk_given: bool) -> Any:
-                mfile = self.dir / "meta.json"
                 want = json.loads(json.dumps(meta))
-                if mfile.exists():
-                    try:
-                        old = json.loads(mfile.read_text())
-                    except (OSError, ValueError):
-                        old = None
-                    if old is None:
-                        self._set_aside(mfile, "unreadable", "rewritten")
-                    elif old != want:
-                        raise ScanStoreError(f"out: {self.dir} holds a different basin grid; "
-                                             "choose another directory or delete it")
-                if not mfile.exists():
-                    from .scan import _write_atomic
-
-                    _write_atomic(mfile, lambda fh: fh.write(
-                        json.dumps(want, indent=1).encode()))
-                self.meta = want
-                self.fingerprint = hashlib.sha256(json.dumps(want).encode()).hexdigest()
+                old = self._old_description("basins")
+                if old is not None and old != want:
+                    raise ScanStoreError(f"out: {self.dir} holds a different basin grid; "
+                                         "choose another directory or delete it")
+                self._describe(want, empty)
                 return job
 
         self.store = Store(path, None, False)  # type: ignore[arg-type]
@@ -447,6 +443,8 @@ def basins(
         rng = np.random.default_rng(_seed(seed))
         pts = rng.uniform(0.0, 2 * np.pi, size=(k, 2))
         s1, s2 = pts[:, 0], pts[:, 1]
+        # random starts lie on no axis
+        i1 = i2 = np.full(k, None, dtype=object)
     else:
         if seed is not None:
             raise ParameterError("seed", "draws random starts: give it with samples, not "
@@ -464,6 +462,9 @@ def basins(
             a1, a2 = default_grid(20 if n is None else n)
         g1, g2 = np.meshgrid(a1, a2, indexing="xy")
         s1, s2 = g1.ravel(), g2.ravel()
+        # each start's position on its axes: joins on these are exact
+        j1, j2 = np.meshgrid(np.arange(a1.size), np.arange(a2.size), indexing="xy")
+        i1, i2 = j1.ravel(), j2.ravel()
     starts = [[float(x), float(y)] for x, y in zip(s1, s2, strict=True)]
     threads = (os.cpu_count() or 1) if execution.threads is None else execution.threads
     n_chunks = -(-len(starts) // chunk)
@@ -474,7 +475,10 @@ def basins(
         lo = c * chunk
         hi = lo + (sizes[c] if size is None else size)
         return pl.DataFrame({
-            "b1": s1[lo:hi], "b2": s2[lo:hi], "label": pl.Series(cols["label"], dtype=pl.Utf8),
+            "b1": s1[lo:hi], "b2": s2[lo:hi],
+            "b1_index": pl.Series(i1[lo:hi].tolist(), dtype=pl.Int64),
+            "b2_index": pl.Series(i2[lo:hi].tolist(), dtype=pl.Int64),
+            "label": pl.Series(cols["label"], dtype=pl.Utf8),
             "pattern": pl.Series(cols["pattern"], dtype=pl.Utf8),
             "omega": pl.Series(cols["omega"], dtype=pl.Float64),
             "period": pl.Series(cols["period"], dtype=pl.Float64),
@@ -494,8 +498,10 @@ def basins(
         meta = {"ballbal": _native.__version__, "basins": {
             "model": model.to_dict() if isinstance(model, Scene) else asdict(model),
             "starts": hashlib.sha256(np.stack([s1, s2]).tobytes()).hexdigest(),
-            "count": len(starts), "options": asdict(options), "chunk": chunk}}
-        store = _BasinStore(execution.out, meta)
+            "count": len(starts), "options": asdict(options), "chunk": chunk,
+            # chunks written before the index columns hold other columns
+            "columns": ["b1", "b2", "b1_index", "b2_index"]}}
+        store = _BasinStore(execution.out, meta, frame(0, _NO_ROWS, 0))
     done: set[int] = set()
     todo: list[int] = []
     interrupted = False
@@ -553,10 +559,7 @@ def basins(
         if store is not None:
             store.close()
     df = (pl.concat([parts[c] for c in sorted(parts)], how="vertical") if parts
-          else frame(0, {k: [] for k in ("label", "pattern", "omega", "period", "rate1",
-                                         "rate2", "t_stop", "motion", "winding1",
-                                         "winding2", "extensions", "long_label",
-                                         "state")}, 0))
+          else frame(0, _NO_ROWS, 0))
     states = df["state"].to_list()
     df = df.drop("state")
     if settle_check:

@@ -239,8 +239,8 @@ def _plot(a: argparse.Namespace) -> int:
     if not d.is_dir():
         raise ParameterError("scan_dir", f"{d} is not a directory (a scan written by "
                              "'ballbal scan -o DIR')")
-    if not (d / "meta.json").is_file():
-        raise ParameterError("scan_dir", f"{d} holds no scan (no meta.json)")
+    if not any(d.glob("chunk-*.parquet")):
+        raise ParameterError("scan_dir", f"{d} holds no scan (no chunk-*.parquet)")
     try:
         df = read_scan(d)
         names = list(scan_meta(d)["grid"])

@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from types import FrameType
-from typing import IO, Any, Literal, overload
+from typing import Any, Literal, overload
 
 import numpy as np
 import polars as pl
@@ -127,7 +127,12 @@ class _Job:
             # A store written with other columns is not resumed into this table.
             # (the axes' index columns named generically: the axes are compared apart)
             "columns": [_index_name("<axis>"), *_SCHEMA],
+            "model_columns": list(self.model_values()),
         }
+
+    def model_values(self) -> dict[str, float]:
+        """The model's parameters that are not axes, as the table's columns carry them."""
+        return {k: v for k, v in _model_values(self.model).items() if k not in self.names}
 
 
 def _differences(old: Mapping[str, Any], new: Mapping[str, Any], prefix: str = "") -> list[str]:
@@ -144,7 +149,7 @@ def _differences(old: Mapping[str, Any], new: Mapping[str, Any], prefix: str = "
 
 
 def _meta_options(o: ScanOptions) -> dict[str, Any]:
-    """The options as ``meta.json`` records them (the scan's fingerprint): the flat
+    """The options as the scan's description records them (its fingerprint): the flat
     keywords of before the option classes, in their order, so that directories written
     then resume; ``guess_atol`` only where it is not ``guess_rtol / 1000`` (what those
     keywords implied). The Floquet method only where it is not RK45: directories written
@@ -200,6 +205,17 @@ def _multipliers(re_rows: Sequence[Any], im_rows: Sequence[Any]) -> pl.Series:
     return pl.Series("multipliers", mult, dtype=MULTIPLIER)
 
 
+def _model_values(model: Balancer | Scene) -> dict[str, float]:
+    """Every balancer parameter of ``model``, ball-indexed ones per ball (``eta[0]``,
+    ``zeta_b[1]``, the grid axes' spelling), so that a table says what model its rows
+    are of wherever it goes (a CSV file, a join of two scans)."""
+    b = model.balancer if isinstance(model, Scene) else model
+    n = b.n_balls
+    zeta_b = b.zeta_b if isinstance(b.zeta_b, tuple) else (b.zeta_b,) * n
+    return {"mu": b.mu, "zeta": b.zeta, **{f"zeta_b[{i}]": z for i, z in enumerate(zeta_b)},
+            "delta": b.delta, "Omega": b.Omega, **{f"eta[{i}]": e for i, e in enumerate(b.eta)}}
+
+
 def _index_name(axis: str) -> str:
     """The column of an axis value's position on its axis (``Omega_index``)."""
     return f"{axis}_index"
@@ -215,12 +231,19 @@ def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
             list(vals), list(range(len(vals))), return_dtype=pl.Int64).alias(_index_name(n))
     for c, dtype in _SCHEMA.items():
         cols[c] = mult if c == "multipliers" else pl.Series(c, d[c], dtype=dtype)
+    rows = len(d["type"])
+    for k, v in job.model_values().items():
+        family = k.split("[")[0]
+        # A ball's value under an axis that sets every ball's is that axis' value.
+        cols[k] = (cols[family].alias(k) if family in names
+                   else pl.Series(k, [v], dtype=pl.Float64).new_from_index(0, rows))
     return pl.DataFrame(cols)
 
 
-def _empty(names: Sequence[str]) -> pl.DataFrame:
+def _empty(names: Sequence[str], model_columns: Sequence[str]) -> pl.DataFrame:
     return pl.DataFrame(schema={**{n: pl.Float64 for n in names},
-                                **{_index_name(n): pl.Int64 for n in names}, **_SCHEMA})
+                                **{_index_name(n): pl.Int64 for n in names}, **_SCHEMA,
+                                **{k: pl.Float64 for k in model_columns}})
 
 
 def run_chunk(job: _Job, c: int, threads: int = 1) -> pl.DataFrame:
@@ -231,10 +254,22 @@ def run_chunk(job: _Job, c: int, threads: int = 1) -> pl.DataFrame:
 
 
 #: Parquet key-value metadata entry holding the fingerprint of the scan a chunk belongs
-#: to, so that a chunk is trusted only for the scan that wrote it (even when meta.json
-#: itself was damaged and had to be rewritten).
+#: to, so that a chunk is trusted only for the scan that wrote it (even when the
+#: description file itself was damaged and had to be rewritten).
 _FINGERPRINT = "ballbal_scan"
 _CHUNK_FILE = re.compile(r"chunk-(\d{5,})\.parquet")
+#: Parquet key-value entry holding the scan's description (:meth:`_Job.meta` as JSON:
+#: model, grid, patterns, options, layout) in the directory's description file.
+_DESCRIPTION = "ballbal_scan_description"
+#: The description file: a Parquet file of no rows with the table's columns, the
+#: description, the scan's fingerprint and a checksum (as a chunk's) in its key-value
+#: metadata. Not a ``meta.json``: polars reads a directory only when every file in it is
+#: Parquet (it skips no name by default, not even a leading ``.`` or ``_``, only empty
+#: files), and a file of no rows with the same columns adds nothing to the table. The
+#: leading ``_`` is what pyarrow and Spark datasets skip (as their ``_common_metadata``,
+#: the same idea). One file, not a copy in every chunk: the description holds every
+#: axis value, which in every chunk would grow as the square of a long axis.
+_DESCRIPTION_FILE = "_scan.parquet"
 #: Parquet key-value entry holding the chunk's number, so that a chunk copied or renamed
 #: to another position of the same grid is not taken for that position's: the basin
 #: store's rows are checked only by their count, and a checksum travels with its file.
@@ -390,7 +425,7 @@ def _chunk_problem(f: Path, meta: Mapping[str, Any], c: int | None) -> str | Non
         df = pl.read_parquet(io.BytesIO(data))
     except Exception as e:  # noqa: BLE001 - any failure to read means a damaged file
         return f"unreadable: {type(e).__name__}: {str(e).splitlines()[0] if str(e) else ''}"
-    if df.schema != _empty(names).schema:
+    if df.schema != _empty(names, meta.get("model_columns", [])).schema:
         return "its columns are not a scan table's"
     wanted = [set(v) for v in values[:-1]] + [set(values[-1][lo:hi])]
     for n, w in zip(names, wanted, strict=True):
@@ -406,38 +441,67 @@ def _chunk_problem(f: Path, meta: Mapping[str, Any], c: int | None) -> str | Non
     return None
 
 
-def _meta_problem(mfile: Path) -> tuple[dict[str, Any] | None, str | None]:
-    """The scan description in ``mfile``, or why it cannot be read."""
+_LEGACY_META = "meta.json"
+
+
+def _chunk_order(f: Path) -> tuple[int, str]:
+    # In chunk order, also past chunk 99999 (where names stop sorting as numbers).
+    c = _chunk_index(f)
+    return (-1 if c is None else c, f.name)
+
+
+def _chunk_files(d: Path) -> list[Path]:
+    return sorted(d.glob("chunk-*.parquet"), key=_chunk_order)
+
+
+def _description_problem(f: Path, kind: str = "grid") -> tuple[dict[str, Any] | None,
+                                                             str | None]:
+    """The description in the description file ``f`` (see ``_DESCRIPTION_FILE``), or why it
+    cannot be trusted: its bytes changed since written (checksum), no description in its
+    metadata, or not one of ``kind`` (``grid`` for a scan, ``basins`` for a basin grid)."""
     try:
-        meta = json.loads(mfile.read_text())
+        data = f.read_bytes()
     except FileNotFoundError:
         return None, "missing: not a scan directory"
-    except (OSError, UnicodeDecodeError, ValueError) as e:
+    except OSError as e:
         return None, f"unreadable: {type(e).__name__}: {e}"
-    if not isinstance(meta, dict) or not isinstance(meta.get("grid"), dict):
+    why = _checksum_problem(data)
+    if why is not None:
+        return None, why
+    try:
+        meta = json.loads(pl.read_parquet_metadata(io.BytesIO(data))[_DESCRIPTION])
+    except Exception as e:  # noqa: BLE001 - no description, or not JSON: damaged
+        return None, f"unreadable: {type(e).__name__}"
+    if not isinstance(meta, dict) or not isinstance(meta.get(kind), dict):
         return None, "not a scan description"
     return meta, None
 
 
-def _read_meta(mfile: Path) -> dict[str, Any]:
-    """The scan description in ``mfile``; ScanStoreError naming it when it is damaged."""
-    meta, why = _meta_problem(mfile)
+def _read_description(d: Path) -> dict[str, Any]:
+    """The description of the scan in ``d``; ScanStoreError naming its file when it is
+    damaged."""
+    f = d / _DESCRIPTION_FILE
+    meta, why = _description_problem(f)
     if meta is None:
-        raise ScanStoreError(f"path: {mfile} is damaged ({why}); run the same scan with "
+        raise ScanStoreError(f"path: {f} is damaged ({why}); run the same scan with "
                              "out= again to rewrite it")
     return meta
 
 
 class _Store:
-    """Finished chunks as Parquet files in a directory, with the scan's description.
+    """Finished chunks as Parquet files in a directory, with the scan's description in a
+    Parquet file of no rows (``_DESCRIPTION_FILE``), so that the directory holds nothing
+    but the table: ``polars.read_parquet(dir)`` reads it.
 
-    The directory is locked (``fcntl.flock`` on ``.lock``) while a scan uses it; the
-    kernel drops the lock when the process ends, even when killed. Every file is
-    written atomically, and every chunk carries the scan's fingerprint, its chunk number
-    and a checksum of its bytes (``_CHECKSUM``); on opening, a file that cannot be
-    trusted (unreadable, truncated, changed, of another scan or position, missing
-    points) is set aside as ``<name>.damaged`` with a :class:`ScanStoreWarning` and
-    recomputed.
+    The directory itself is locked (``fcntl.flock`` on its descriptor) while a scan uses
+    it: the kernel drops the lock when the process ends, even when killed, and no lock
+    file is needed that polars would have to skip. ``.lock`` only tells another scan
+    which process holds the lock; it is removed when the scan ends, however it ends (a
+    killed process leaves it until the directory's next scan). Every file is written
+    atomically, and every chunk carries the scan's fingerprint, its chunk number and a
+    checksum of its bytes (``_CHECKSUM``); on opening, a file that cannot be trusted
+    (unreadable, truncated, changed, of another scan or position, missing points) is set
+    aside (``_set_aside``) with a :class:`ScanStoreWarning` and recomputed.
     """
 
     def __init__(self, path: str | os.PathLike[str], job: _Job, chunk_given: bool) -> None:
@@ -446,57 +510,106 @@ class _Store:
             self.dir.mkdir(parents=True, exist_ok=True)
         except OSError as e:
             raise ScanStoreError(f"out: cannot create the directory {self.dir}: {e}") from e
-        self._lock = self._acquire()
+        self._lock: int | None = self._acquire()
         try:
             self.job = self._open(job, chunk_given)
         except BaseException:
             self.close()
             raise
 
-    def _acquire(self) -> IO[str]:
+    @property
+    def _holder(self) -> Path:
+        return self.dir / ".lock"
+
+    def _acquire(self) -> int | None:
+        if fcntl is None:
+            return None
         try:
-            fh = open(self.dir / ".lock", "a+")  # noqa: SIM115 - held until close()
+            fd = os.open(self.dir, os.O_RDONLY)
         except OSError as e:
             raise ScanStoreError(f"out: cannot use the directory {self.dir}: {e}") from e
-        if fcntl is not None:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
             try:
-                fcntl.flock(fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except OSError:
-                fh.seek(0)
-                who = fh.read().strip()
-                fh.close()
-                raise ScanStoreError(
-                    f"out: {self.dir} is in use by another scan"
-                    + (f" (process {who})" if who else "")
-                    + "; wait for it to finish or choose another directory") from None
-            fh.seek(0)
-            fh.truncate()
-            fh.write(f"{os.getpid()}\n")
-            fh.flush()
-        return fh
+                who = self._holder.read_text().strip()
+            except (OSError, UnicodeDecodeError):
+                who = ""
+            raise ScanStoreError(
+                f"out: {self.dir} is in use by another scan"
+                + (f" (process {who})" if who.isdigit() else "")
+                + "; wait for it to finish or choose another directory") from None
+        try:
+            self._holder.write_text(f"{os.getpid()}\n")
+        except OSError:
+            pass  # only the message of a refused second scan loses the process number
+        return fd
 
     def close(self) -> None:
-        if self._lock is not None and not self._lock.closed:
-            if fcntl is not None:
-                fcntl.flock(self._lock.fileno(), fcntl.LOCK_UN)
-            self._lock.close()
+        if self._lock is None:
+            return
+        # The holder file goes first, while the lock is still held: a scan that opens
+        # the directory next writes its own.
+        self._holder.unlink(missing_ok=True)
+        fcntl.flock(self._lock, fcntl.LOCK_UN)
+        os.close(self._lock)
+        self._lock = None
+
+    @property
+    def set_aside_dir(self) -> Path:
+        """Where damaged files go: beside the directory, not in it, so that what is in
+        it stays one Parquet dataset (``<out>.damaged``)."""
+        d = self.dir.resolve()
+        return d.with_name(d.name + ".damaged")
 
     def _set_aside(self, f: Path, why: str, then: str) -> None:
-        dest = f.with_name(f.name + ".damaged")
-        os.replace(f, dest)
+        dest = self.set_aside_dir / f.name
+        try:
+            dest.parent.mkdir(exist_ok=True)
+            os.replace(f, dest)
+        except OSError:
+            # Not beside it (another file system, no permission): in place, as before.
+            dest = f.with_name(f.name + ".damaged")
+            os.replace(f, dest)
         warnings.warn(ScanStoreWarning(f"out: {f} is damaged ({why}); set aside as "
-                                       f"{dest.name} and {then}"), stacklevel=_caller())
+                                       f"{dest} and {then}"), stacklevel=_caller())
+
+    def _old_description(self, kind: str) -> dict[str, Any] | None:
+        """The description the directory holds, if it can be trusted; a damaged one is
+        set aside (the chunks are still checked by their fingerprints), and so is a
+        ``meta.json`` of ballbal 0.1, which would stop polars reading the directory."""
+        legacy = self.dir / _LEGACY_META
+        if legacy.exists():
+            self._set_aside(legacy, "the description of ballbal 0.1, which polars cannot "
+                            "read among the chunks", "replaced by "
+                            f"{_DESCRIPTION_FILE}; the chunks are checked by their "
+                            "fingerprints")
+        f = self.dir / _DESCRIPTION_FILE
+        if not f.exists():
+            return None
+        old, why = _description_problem(f, kind)
+        if old is None:
+            self._set_aside(f, why or "", "rewritten; the chunks are checked by their "
+                            "fingerprints")
+        return old
+
+    def _describe(self, meta: dict[str, Any], empty: pl.DataFrame) -> None:
+        """Record ``meta`` as the directory's description, in a file of no rows with the
+        table's columns ``empty``."""
+        self.meta = meta
+        self.fingerprint = _fingerprint(meta)
+        f = self.dir / _DESCRIPTION_FILE
+        if not f.exists():
+            _write_atomic(f, lambda fh: fh.write(_sealed(empty, {
+                _FINGERPRINT: self.fingerprint, _DESCRIPTION: json.dumps(meta)})))
+        for tmp in self.dir.glob(".*.tmp"):  # left by a crash; the lock says nobody writes
+            tmp.unlink(missing_ok=True)
 
     def _open(self, job: _Job, chunk_given: bool) -> _Job:
-        # As it reads back from JSON (tuples become lists), to compare with the file.
+        # As it reads back from JSON (tuples become lists), to compare with the file's.
         meta = json.loads(json.dumps(job.meta()))
-        mfile = self.dir / "meta.json"
-        old: dict[str, Any] | None = None
-        if mfile.exists():
-            old, why = _meta_problem(mfile)
-            if old is None:
-                self._set_aside(mfile, why or "", "rewritten; the chunks are checked by "
-                                "their fingerprints")
+        old = self._old_description("grid")
         if old is not None:
             same = {k: v for k, v in old.items() if k != "chunk"} == {
                 k: v for k, v in meta.items() if k != "chunk"}
@@ -520,12 +633,7 @@ class _Store:
                 raise ScanStoreError(
                     f"out: {self.dir} holds this scan with its axes in the order "
                     f"{', '.join(old['grid'])}; give them in that order to resume it")
-        else:
-            _write_atomic(mfile, lambda fh: fh.write(json.dumps(meta, indent=1).encode()))
-        self.meta = meta
-        self.fingerprint = _fingerprint(meta)
-        for tmp in self.dir.glob(".*.tmp"):  # left by a crash; the lock says nobody writes
-            tmp.unlink(missing_ok=True)
+        self._describe(meta, _empty(job.names, list(job.model_values())))
         return job
 
     def file(self, c: int) -> Path:
@@ -534,7 +642,7 @@ class _Store:
     def done(self) -> set[int]:
         """The chunks on disk that can be trusted; the others are set aside."""
         ok = set()
-        for f in sorted(self.dir.glob("chunk-*.parquet")):
+        for f in _chunk_files(self.dir):
             c = _chunk_index(f)
             why = _chunk_problem(f, self.meta, c)
             if why is None and c is not None:
@@ -695,7 +803,15 @@ def scan(  # noqa: E302 - overloads above
     leading modulus' error (``modulus_error``; a row whose verdict the bound leaves open
     is refined to more harmonics first, see :func:`~ballbal.periodic`). The solution
     columns have the names and meaning of :class:`~ballbal.PeriodicSolution`'s fields
-    (``pivot_ratio``, ...); the multipliers are a list of ``{re, im}``.
+    (``pivot_ratio``, ...); the multipliers are a list of ``{re, im}`` (a nested column,
+    which ``write_csv`` cannot hold: :func:`ballbal.flat` spreads it into
+    ``multipliers_re_0, multipliers_im_0, ...``). After them, the table says what model
+    its rows are of: a column for every balancer parameter that is not an axis (``mu``,
+    ``zeta``, ``zeta_b[i]``, ``delta``, ``Omega``, ``eta[i]``, one per ball; a ball's
+    column repeats an axis that sets every ball, such as ``eta``). Columns rather than
+    metadata, since a polars DataFrame carries none: they survive every format, filter
+    and join. What columns cannot hold (options, a scene's effects) is in the stored
+    scan's description, :func:`scan_meta`.
 
     ``chunk``: values of the last axis per chunk, rounded up to whole blocks (default
     one block): the unit of progress, interruption, resumption, files and executor
@@ -713,11 +829,16 @@ def scan(  # noqa: E302 - overloads above
 
     ``out``: a directory; each finished chunk is written there as Parquet at once
     (atomically), and a later call with the same arguments and ``out`` skips the chunks
-    on disk (resume; the axes must be given in the same order). Only one scan at a time
-    may use a directory (another gets :class:`~ballbal.exceptions.ScanStoreError`). A
-    damaged file found on resuming (truncated, unreadable, changed since it was written
-    -- every chunk carries a SHA-256 of its bytes --, another scan's or another chunk's)
-    is set aside as ``<name>.damaged`` with a
+    on disk (resume; the axes must be given in the same order). The directory is a
+    Parquet dataset: once the scan ends (finished, failed or interrupted) it holds only
+    Parquet files, so ``polars.read_parquet(out)`` and ``polars.scan_parquet(out)`` read
+    the table: the chunks, and ``_scan.parquet`` (no rows, the table's columns), which
+    carries the scan's description in its Parquet metadata (:func:`scan_meta`). Only
+    one scan at a time may use a directory (another gets
+    :class:`~ballbal.exceptions.ScanStoreError`). A damaged file found on resuming
+    (truncated, unreadable, changed since it was written -- every chunk carries a
+    SHA-256 of its bytes --, another scan's or another chunk's) is set aside in
+    ``<out>.damaged`` beside the directory with a
     :class:`~ballbal.exceptions.ScanStoreWarning` naming it, and recomputed. With
     ``out``, only one chunk per thread is held in memory while the scan runs;
     ``lazy=True`` returns a ``polars.LazyFrame`` over the files instead of reading them
@@ -851,10 +972,11 @@ def _run(job: _Job, store: _Store | None, executor: Any, threads: int | None,
     if store is not None:
         files = store.files(finished)
         if lazy:
-            return (pl.scan_parquet(files) if files else _empty(job.names).lazy())
+            return (pl.scan_parquet(files) if files
+                    else _empty(job.names, list(job.model_values())).lazy())
         frames = {c: pl.read_parquet(f) for c, f in zip(sorted(finished), files, strict=True)}
     if not frames:
-        return _empty(job.names)
+        return _empty(job.names, list(job.model_values()))
     return pl.concat([frames[c] for c in sorted(frames)], how="vertical")
 
 
@@ -867,24 +989,21 @@ def read_scan(  # noqa: E302 - overloads above
 ) -> pl.DataFrame | pl.LazyFrame:
     """The table of a scan written with ``out=path`` (the finished chunks, in order).
 
-    Every chunk file is checked against the scan's ``meta.json`` before its rows are
-    used; a damaged one (truncated, unreadable, changed since it was written, another
-    scan's or another chunk's, missing points) raises
+    The directory is also a Parquet dataset: ``polars.read_parquet(path)`` and
+    ``polars.scan_parquet(path)`` read the same table, unchecked. Every chunk file is
+    checked against the scan's description (:func:`scan_meta`) before its rows are
+    used; a damaged one (truncated, unreadable, changed since it
+    was written, another scan's or another chunk's, missing points) raises
     :class:`~ballbal.exceptions.ScanStoreError` naming it; running the same scan with
     ``out=path`` again sets it aside and recomputes it. ``lazy=True`` returns a
     ``polars.LazyFrame`` over the files (checked by their checksums and footers, one
     file in memory at a time; the rows are decoded when the frame is collected).
     """
     d = Path(_check.path("path", path))
-    # In chunk order, also past chunk 99999 (where names stop sorting as numbers).
-    def order(f: Path) -> tuple[int, str]:
-        c = _chunk_index(f)
-        return (-1 if c is None else c, f.name)
-
-    files = sorted(d.glob("chunk-*.parquet"), key=order)
+    files = _chunk_files(d)
     if not files:
         raise ParameterError("path", f"no scan chunks (chunk-*.parquet) in {d}", value=path)
-    meta = _read_meta(d / "meta.json")
+    meta = _read_description(d)
     damaged = []
     for f in files:
         c = _chunk_index(f)
@@ -897,7 +1016,7 @@ def read_scan(  # noqa: E302 - overloads above
             if why is None:
                 try:
                     ok = (pl.read_parquet_schema(io.BytesIO(data))
-                          == dict(_empty(list(meta["grid"])).schema))
+                          == dict(_empty(list(meta["grid"]), meta.get("model_columns", [])).schema))
                 except Exception:  # noqa: BLE001 - any failure to read: a damaged file
                     ok = False
                 why = None if ok else "its columns are not a scan table's"
@@ -915,6 +1034,49 @@ def read_scan(  # noqa: E302 - overloads above
 
 
 def scan_meta(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """The description (balancer, grid, options) stored with a scan written with ``out=``;
-    :class:`~ballbal.exceptions.ScanStoreError` naming ``meta.json`` if it is damaged."""
-    return _read_meta(Path(path) / "meta.json")
+    """The description of the scan written with ``out=path``: what its table was computed
+    for, as the directory's description file ``_scan.parquet`` (no rows, the table's
+    columns) carries it in its Parquet key-value metadata (key
+    ``ballbal_scan_description``, JSON: ``polars.read_parquet_metadata`` reads it too).
+
+    Keys: ``balancer`` (every field: ``mu``, ``zeta``, ``zeta_b``, ``delta``, ``Omega``,
+    ``eta`` with one value per ball) or, for a :class:`~ballbal.Scene`, ``scene`` (its
+    :meth:`~ballbal.Scene.to_dict`: the balancer and every effect); ``grid`` (each
+    axis' values, in the order given), ``patterns``, ``options`` (what the scan
+    computed with), ``block`` and ``chunk``, ``columns`` and ``model_columns`` (the
+    table's), ``ballbal`` (the version that wrote it). A grid axis replaces the model's
+    value of that parameter. :class:`~ballbal.exceptions.ScanStoreError` naming the file
+    if it is damaged (running the same scan with ``out=path`` again rewrites it)."""
+    return _read_description(Path(_check.path("path", path)))
+
+
+def flat(table: pl.DataFrame) -> pl.DataFrame:
+    """``table`` with its nested columns spread into plain ones, for formats that hold
+    only those (``write_csv``): a list of structs ``x`` (a scan's ``multipliers``, a
+    list of ``{re, im}``) becomes ``x_re_0, x_im_0, x_re_1, ...``, a list of numbers
+    ``x_0, x_1, ...``, a struct ``x_<field>``. Lists are padded with nulls to the longest
+    row's length; a row without the list (null) gets nulls. Other columns keep their
+    place and values."""
+    if not isinstance(table, pl.DataFrame):
+        raise ParameterTypeError("table", "must be a polars DataFrame (collect a LazyFrame "
+                                 f"first), got {type(table).__name__}")
+    out: list[pl.Expr] = []
+    for name, dtype in table.schema.items():
+        col = pl.col(name)
+        if isinstance(dtype, (pl.List, pl.Array)):
+            inner = dtype.inner
+            longest = table.select(col.list.len().max() if isinstance(dtype, pl.List)
+                                   else pl.lit(dtype.size)).item() or 0
+            for i in range(longest):
+                item = col.list.get(i, null_on_oob=True) if isinstance(dtype, pl.List) \
+                    else col.arr.get(i, null_on_oob=True)
+                if isinstance(inner, pl.Struct):
+                    out += [item.struct.field(f.name).alias(f"{name}_{f.name}_{i}")
+                            for f in inner.fields]
+                else:
+                    out.append(item.alias(f"{name}_{i}"))
+        elif isinstance(dtype, pl.Struct):
+            out += [col.struct.field(f.name).alias(f"{name}_{f.name}") for f in dtype.fields]
+        else:
+            out.append(col)
+    return table.select(out)

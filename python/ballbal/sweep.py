@@ -69,7 +69,8 @@ def carry_over(y: np.ndarray, omega_from: float, omega_to: float, n_balls: int,
 @dataclass(frozen=True)
 class Sweep:
     """The result of :func:`speed_sweep`: ``table`` (one row per step: ``step,
-    direction, Omega, label, omega`` (mean ball rate), ``period``, ``rotating``, and
+    direction, Omega, Omega_index`` (the speed's position on the ``speeds`` axis, for
+    exact joins), ``label, omega`` (mean ball rate), ``period``, ``rotating``, and
     ``vibration`` (mean ``|Z''|`` over the last ``record`` time units of the dwell) when
     recorded); ``up`` and ``down``: the transition speeds (the thesis' critical speeds:
     the first speed going up at which the motion is at rest on an equilibrium after
@@ -160,35 +161,38 @@ def speed_sweep(
     o = _check.option("options", options, BasinOptions, BasinOptions(),
                       "ballbal.basins.BasinOptions")
     o = replace(o, t_end=dwell, window=min(o.window, dwell), settle_factor=None)
+    # (position on the speeds axis, direction): the index column makes joins exact
     if direction == "up":
-        path = [(float(s), "up") for s in sp]
+        path = [(i, "up") for i in range(sp.size)]
     elif direction == "down":
-        path = [(float(s), "down") for s in sp[::-1]]
+        path = [(i, "down") for i in range(sp.size)[::-1]]
     else:
-        path = [(float(s), "up") for s in sp] + [(float(s), "down") for s in sp[-2::-1]]
+        path = ([(i, "up") for i in range(sp.size)]
+                + [(i, "down") for i in range(sp.size - 1)[::-1]])
     n = model.n_balls
     d = len(model.coordinates)
     if y0 is None:
         y = np.zeros(2 * d)
         y[d - n:d] = 0.3
-        y[2 * d - n:] = -path[0][0]
+        y[2 * d - n:] = -float(sp[path[0][0]])
     else:
         y = _check.vector("y0", y0, 2 * d).copy()
         if y.size != 2 * d:
             raise ParameterError("y0", f"needs {2 * d} values ({', '.join(model.coordinates)} "
                                  f"and their rates), got {y.size}",
                                  allowed=f"{2 * d} values", value=y.size)
-    prev = path[0][0]
+    prev = float(sp[path[0][0]])
     rows: list[dict[str, Any]] = []
     spectra: list[pl.DataFrame] = []
-    for k, (om, dirn) in enumerate(path):
+    for k, (i, dirn) in enumerate(path):
+        om = float(sp[i])
         y = carry_over(y, prev, om, n, d)
         if kick and n >= 2:
             y[d - n] += kick
             y[d - n + 1] -= kick
         m = model.replace(Omega=om)
         cols, y = _native.classify_state(m, np.ascontiguousarray(y), o)
-        row: dict[str, Any] = {"step": k, "direction": dirn, "Omega": om,
+        row: dict[str, Any] = {"step": k, "direction": dirn, "Omega": om, "Omega_index": i,
                                "label": cols["label"][0], "omega": cols["omega"][0],
                                "period": cols["period"][0]}
         row["rotating"] = row["label"] in ROTATING
