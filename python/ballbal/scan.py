@@ -226,9 +226,13 @@ def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
     names = job.names
     cols: dict[str, pl.Series] = {n: pl.Series(n, d[n], dtype=pl.Float64) for n in names}
     for n, vals in zip(names, job.values, strict=True):
-        # the rows carry the grid's own floats, so each maps to its position exactly
-        cols[_index_name(n)] = cols[n].replace_strict(
-            list(vals), list(range(len(vals))), return_dtype=pl.Int64).alias(_index_name(n))
+        # The rows carry the grid's own floats, so each maps to its position exactly.
+        # With numpy, not a polars expression: executors run this in forked workers,
+        # where polars' thread pool (started in the parent) never answers.
+        grid = np.asarray(vals, dtype=np.float64)
+        order = np.argsort(grid, kind="stable")
+        at = order[np.searchsorted(grid[order], np.asarray(d[n], dtype=np.float64))]
+        cols[_index_name(n)] = pl.Series(_index_name(n), at, dtype=pl.Int64)
     for c, dtype in _SCHEMA.items():
         cols[c] = mult if c == "multipliers" else pl.Series(c, d[c], dtype=dtype)
     rows = len(d["type"])
