@@ -155,7 +155,8 @@ def test_method_option_is_checked():
     b = ballbal.Balancer()
     with pytest.raises(ParameterError) as e:
         ballbal.periodic(b, "R-R", N=3, floquet_method="euler")
-    assert e.value.parameter == "method"
+    # the keyword the call used (its options object is made, and checked, from it)
+    assert e.value.parameter == "floquet_method"
     with pytest.raises(ParameterTypeError) as e:
         ballbal.Floquet(method=3)  # type: ignore[arg-type]
     assert e.value.parameter == "method"

@@ -182,7 +182,10 @@ def test_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
     kept = len(list(out.glob("chunk-*.parquet")))
     assert 3 <= kept < 21, kept
     rows, warned = int(stdout.split()[1]), int(stdout.split()[3])
-    assert warned == 1 and rows == 7 * kept  # 7 Omega values, one type, a row each
+    # 7 Omega values per chunk, one type: a row each, or more where orbits coexist
+    on_disk = ballbal.read_scan(out)
+    assert warned == 1 and rows == on_disk.height >= 7 * kept
+    assert on_disk.select("Omega", "eta").unique().height == 7 * kept
     resumed = ballbal.scan(ballbal.Balancer(), out=out, **kw)
     whole = ballbal.scan(ballbal.Balancer(), **kw)
     assert resumed.drop("seconds").equals(whole.drop("seconds"))
