@@ -147,11 +147,10 @@ def test_periodic_and_scan_share_the_solution_schema():
     assert np.allclose(np.sort_complex(tab), np.sort_complex(s.multipliers), atol=1e-6)
 
 
-def test_condition_is_a_deprecated_alias_of_pivot_ratio():
+def test_the_pivot_ratio_has_one_name():
+    # 0.1's deprecated alias `condition` is gone (there are no 0.1 users to keep).
     s = ballbal.periodic(B, "R-R", hill=False)
-    with pytest.warns(DeprecationWarning, match="pivot_ratio"):
-        c = s.condition
-    assert c == s.pivot_ratio and c >= 1
+    assert not hasattr(s, "condition") and s.pivot_ratio >= 1
 
 
 CALLS = {
@@ -163,15 +162,14 @@ CALLS = {
 
 
 @pytest.mark.parametrize("which", sorted(CALLS))
-def test_first_argument_is_model_and_the_old_name_warns(which):
+def test_first_argument_is_model_and_the_old_name_is_gone(which):
     f, old, kw = CALLS[which]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         f(model=B, **kw)
-    with pytest.warns(DeprecationWarning, match="'model'"):
+    # 0.1's keyword is refused, not translated with a warning.
+    with pytest.raises(TypeError):
         f(**{old: B}, **kw)
-    with pytest.raises(TypeError, match="multiple values"):
-        f(B, **{old: B}, **kw)
 
 
 def test_the_flattened_native_arguments_are_gone():

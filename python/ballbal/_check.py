@@ -12,12 +12,10 @@ conversion to ``usize``.
 
 from __future__ import annotations
 
-import functools
 import math
 import numbers
 import os
-import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any, ParamSpec, TypeVar
 
 import numpy as np
@@ -294,24 +292,6 @@ def sequence(name: str, v: Any, *, empty: bool = False) -> list[Any]:
 _T = TypeVar("_T")
 _P = ParamSpec("_P")
 _R = TypeVar("_R")
-
-
-def renamed_model(old: str) -> Callable[[Callable[_P, _R]], Callable[_P, _R]]:
-    """Accepts the first argument's former keyword name ``old`` (``balancer=``,
-    ``scene=``) with a :class:`DeprecationWarning`; the argument is now ``model``
-    in every analysis."""
-    def wrap(f: Callable[_P, _R]) -> Callable[_P, _R]:
-        @functools.wraps(f)
-        def call(*args: _P.args, **kwargs: _P.kwargs) -> _R:
-            if old in kwargs:
-                if args or "model" in kwargs:
-                    raise TypeError(f"{f.__name__}() got multiple values for argument 'model'")
-                warnings.warn(f"{f.__name__}({old}=...) is deprecated: the first argument "
-                              "is called 'model'", DeprecationWarning, stacklevel=2)
-                kwargs["model"] = kwargs.pop(old)
-            return f(*args, **kwargs)
-        return call
-    return wrap
 
 
 # --- Sizes of the analyses: sweeps, basins, balance maps, accuracy_cost, continuation

@@ -47,7 +47,6 @@ def _knob(name: str, v: Any) -> list[Any]:
     return items
 
 
-@_check.renamed_model("balancer")
 def accuracy_cost(
     model: Balancer | Scene,
     pattern: str = "R-R",

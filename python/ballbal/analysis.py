@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal, overload
@@ -61,7 +60,6 @@ def simulate(
     max_steps: int = 10_000_000,
     stats: Literal[True],
 ) -> tuple[pl.DataFrame, dict[str, int]]: ...
-@_check.renamed_model("balancer")
 def simulate(
     model: Balancer | Scene,
     y0: Sequence[float] | np.ndarray | None = None,
@@ -175,7 +173,6 @@ class Equilibrium:
     residual_imbalance: float = float("nan")
 
 
-@_check.renamed_model("balancer")
 def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
     """All equilibria (perfect balance first), with eigenvalues, the relative-stability
     index (largest real part) and, where defined, the Routh–Hurwitz verdict.
@@ -292,13 +289,6 @@ class PeriodicSolution:
     #: about the frequency's.
     omega_error: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def condition(self) -> float:
-        """Deprecated name of :attr:`pivot_ratio`."""
-        warnings.warn("PeriodicSolution.condition is deprecated: use pivot_ratio (the scan "
-                      "tables' name)", DeprecationWarning, stacklevel=2)
-        return self.pivot_ratio
 
     @property
     def converged(self) -> bool:
@@ -431,7 +421,6 @@ def _homotopy(model: Balancer | Scene, homotopy: Any) -> list[tuple[str, float]]
     return out
 
 
-@_check.renamed_model("balancer")
 def periodic(
     model: Balancer | Scene,
     pattern: str = "R-R",

@@ -725,7 +725,6 @@ def scan(model: Balancer | Scene, *, lazy: Literal[False] = ...,
          **kwargs: Any) -> pl.DataFrame: ...
 @overload
 def scan(model: Balancer | Scene, *, lazy: Literal[True], **kwargs: Any) -> pl.LazyFrame: ...
-@_check.renamed_model("balancer")
 def scan(  # noqa: E302 - overloads above
     model: Balancer | Scene,
     *,

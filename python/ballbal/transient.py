@@ -47,7 +47,6 @@ def _balanced_start(model: Balancer | Scene) -> np.ndarray:
     return np.asarray(e.q, dtype=float)
 
 
-@_check.renamed_model("balancer")
 def disturbance_response(
     model: Balancer | Scene,
     to: float,
@@ -101,7 +100,6 @@ def disturbance_response(
                                trajectory=df)
 
 
-@_check.renamed_model("balancer")
 def track_damping_study(
     model: Balancer | Scene,
     zeta_b: Sequence[float],
@@ -146,7 +144,6 @@ class RunUp:
     trajectory: pl.DataFrame
 
 
-@_check.renamed_model("scene")
 def run_up(
     model: Scene | Balancer,
     to: float,
