@@ -107,6 +107,13 @@ pub fn plain_windings(rotating: &[bool]) -> Vec<f64> {
         .collect()
 }
 
+/// Whether the balls' windings are a pattern's usual ones ([`plain_windings`]): one
+/// turn per period for each rotating ball, none for the others.
+pub fn is_plain(winding: &[f64]) -> bool {
+    let rotating: Vec<bool> = winding.iter().map(|w| *w != 0.0).collect();
+    *winding == plain_windings(&rotating)
+}
+
 /// A solution type as a scan asks for it: a pattern (`"R-R"`), or a pattern with the
 /// balls' windings in brackets (`"R-R[-2,-2]"`, the period-doubled R-R orbit;
 /// `"O-R[0,-2]"`), checked as [`parse_windings`] checks them. Returns the balls'
@@ -121,7 +128,7 @@ pub fn parse_solution_type(spec: &str, n_balls: usize) -> crate::Result<Vec<f64>
         vec!["R"; n_balls.max(1)].join("-"),
         vec!["-2"; n_balls.max(1)].join(",")
     );
-    let rotating = parse_pattern(pattern, n_balls)?;
+    parse_pattern(pattern, n_balls)?;
     let inner = rest.strip_suffix(']').ok_or_else(|| {
         crate::Error::param_range("pattern", format!("{spec:?} must end with ']'"), &allowed)
     })?;
@@ -137,7 +144,7 @@ pub fn parse_solution_type(spec: &str, n_balls: usize) -> crate::Result<Vec<f64>
             )
         })?;
     let wound = parse_windings(pattern, Some(&w), n_balls)?;
-    if wound == plain_windings(&rotating) {
+    if is_plain(&wound) {
         return Err(crate::Error::param_range(
             "pattern",
             format!("write {spec:?} as \"{pattern}\" (these are its usual windings)"),

@@ -377,13 +377,7 @@ pub fn switch_periodic<D: Parametric>(
     opts: &PeriodicOptions,
 ) -> Result<Switched> {
     let fo = opts.floquet.clone().unwrap_or_default();
-    let (lam, e) = critical_mode(model, sol, kind, &fo)?;
-    let m = match kind {
-        Switch::PeriodDoubling => 2,
-        Switch::BranchPoint => 1,
-    };
-    let base = repeated(sol, m);
-    let dir = variational_series(model, sol, &e, m, base.n_harm, &fo)?;
+    let (lam, base, dir) = leaving_direction(model, sol, kind, &fo)?;
     let o = model.first_ball();
     match kind {
         Switch::PeriodDoubling => {
@@ -407,6 +401,25 @@ pub fn switch_periodic<D: Parametric>(
     }
 }
 
+/// Where a branch switched at `kind` leaves `sol`: the critical multiplier, the orbit in
+/// the new branch's unknowns (written over two periods at a period doubling) and the
+/// direction, the series of `Phi(t) e` over as many periods.
+fn leaving_direction<D: Dynamics + ?Sized>(
+    model: &D,
+    sol: &HbSolution,
+    kind: Switch,
+    fo: &FloquetOptions,
+) -> Result<(f64, HbSolution, Vec<f64>)> {
+    let (lam, e) = critical_mode(model, sol, kind, fo)?;
+    let m = match kind {
+        Switch::PeriodDoubling => 2,
+        Switch::BranchPoint => 1,
+    };
+    let base = repeated(sol, m);
+    let dir = variational_series(model, sol, &e, m, base.n_harm, fo)?;
+    Ok((lam, base, dir))
+}
+
 /// Starts for an orbit born in a period doubling of `sol`, at `sol`'s own parameters
 /// (no continuation in a parameter, as a scan needs at a grid point): the orbit written
 /// over two periods ([`repeated`]) displaced along the critical mode (the series of
@@ -422,9 +435,7 @@ pub fn period_doubling_starts<D: Dynamics + ?Sized>(
     fo: &FloquetOptions,
     amplitudes: &[f64],
 ) -> Option<Vec<HbSolution>> {
-    let (_, e) = critical_mode(model, sol, Switch::PeriodDoubling, fo).ok()?;
-    let base = repeated(sol, 2);
-    let dir = variational_series(model, sol, &e, 2, base.n_harm, fo).ok()?;
+    let (_, base, dir) = leaving_direction(model, sol, Switch::PeriodDoubling, fo).ok()?;
     let norm = dir.iter().map(|x| x * x).sum::<f64>().sqrt();
     if !(norm > 0.0 && norm.is_finite()) {
         return None;

@@ -7,9 +7,10 @@
 //! orbit it doubles is on the map already: the doubled orbit exists wherever a
 //! supercritical period doubling has left that orbit with a multiplier below -1.
 
+use super::seeding::new_orbit;
 use super::waves::{accept, admit, orbit_key};
 use super::{count, work, Family, Found, Origin, ScanSpec};
-use crate::analysis::periodic::{plain_windings, repetitions};
+use crate::analysis::periodic::{is_plain, repetitions};
 use crate::analysis::switch::period_doubling_starts;
 use crate::hb::{solve, Status};
 use crate::periodic::finish;
@@ -25,37 +26,29 @@ const AMPLITUDES: [f64; 3] = [0.03, 0.1, 0.3];
 /// that single-turn type: `(doubled, single)`. The single-turn types must be among
 /// `patterns` (a scan adds them, unreported, where they were not asked for).
 pub(super) fn doubled_types(patterns: &[Vec<f64>]) -> Vec<(usize, usize)> {
-    let mut out = vec![];
-    for (k, w) in patterns.iter().enumerate() {
-        if repetitions(w) != 2 {
-            continue;
-        }
-        let single: Vec<f64> = w.iter().map(|x| x / 2.0).collect();
-        let rotating: Vec<bool> = single.iter().map(|x| *x != 0.0).collect();
-        if single != plain_windings(&rotating) {
-            continue;
-        }
-        if let Some(j) = patterns.iter().position(|p| *p == single) {
-            out.push((k, j));
-        }
-    }
-    out
+    patterns
+        .iter()
+        .enumerate()
+        .filter_map(|(k, w)| {
+            let single = single_of(w)?;
+            Some((k, patterns.iter().position(|p| *p == single)?))
+        })
+        .collect()
+}
+
+/// The single-turn type whose period doubling has the windings `w`, if `w` are a
+/// single-turn type's windings doubled.
+fn single_of(w: &[f64]) -> Option<Vec<f64>> {
+    let single: Vec<f64> = w.iter().map(|x| x / 2.0).collect();
+    (repetitions(w) == 2 && is_plain(&single)).then_some(single)
 }
 
 /// The single-turn types a scan of `patterns` needs besides them: those doubled by a
 /// requested type but not requested themselves.
 pub fn parents_needed(patterns: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let mut out: Vec<Vec<f64>> = vec![];
-    for w in patterns {
-        if repetitions(w) != 2 {
-            continue;
-        }
-        let single: Vec<f64> = w.iter().map(|x| x / 2.0).collect();
-        let rotating: Vec<bool> = single.iter().map(|x| *x != 0.0).collect();
-        if single == plain_windings(&rotating)
-            && !patterns.contains(&single)
-            && !out.contains(&single)
-        {
+    for single in patterns.iter().filter_map(|w| single_of(w)) {
+        if !patterns.contains(&single) && !out.contains(&single) {
             out.push(single);
         }
     }
@@ -121,8 +114,9 @@ pub(super) fn doubling_seeds<D: Family>(
                     continue;
                 }
                 let key = orbit_key(&sol, model.layout().support());
-                let known: Vec<Found> = out.iter().map(|c| c.2.clone()).collect();
-                if !admit(&sols[p], k, &key) || !admit(&known, k, &key) {
+                let known: Vec<(usize, &[f64])> =
+                    out.iter().map(|c| (c.1, c.2.key.as_slice())).collect();
+                if !admit(&sols[p], k, &key) || !new_orbit(&known, k, &key) {
                     continue;
                 }
                 count(work::FINISH);
@@ -146,15 +140,16 @@ pub(super) fn doubling_seeds<D: Family>(
             out
         })
         .collect();
-    // Kept in task order, an orbit already kept at its point dropped.
+    // Kept in task order, an orbit already kept at its point (from another orbit it
+    // doubles) dropped; each task checked its own against `sols` already.
     let mut kept: Vec<(usize, Found)> = vec![];
     for (p, k, f) in cands.into_iter().flatten() {
-        let here: Vec<Found> = kept
+        let here: Vec<(usize, &[f64])> = kept
             .iter()
             .filter(|(q, _)| *q == p)
-            .map(|(_, g)| g.clone())
+            .map(|(_, g)| (g.pattern, g.key.as_slice()))
             .collect();
-        if admit(&here, k, &f.key) && admit(&sols[p], k, &f.key) {
+        if new_orbit(&here, k, &f.key) {
             kept.push((p, f));
         }
     }

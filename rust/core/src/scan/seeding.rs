@@ -5,7 +5,7 @@ use super::grid::Local;
 use super::waves::{accept, admit, orbit_key, same_orbit, MAX_PER_TYPE};
 use super::{count, profile, work, Family, Found, Origin, ScanSpec};
 use crate::analysis::attractors::{seed_guess, Capture};
-use crate::analysis::periodic::{pattern_whirl_starts, plain_windings, repetitions};
+use crate::analysis::periodic::{is_plain, pattern_whirl_starts, repetitions};
 use crate::continuation::Lattice;
 use crate::hb::{solve, HbOptions, HbSolution, Status};
 use crate::periodic::is_repeated;
@@ -90,10 +90,10 @@ pub(super) fn whirl_tasks<D: Family>(
 /// The whirl starts of a solution type: [`pattern_whirl_starts`] of its pattern for the
 /// usual windings, none for an orbit winding more than once per period.
 fn whirl_starts_of<D: Family>(model: &D, winding: &[f64]) -> Vec<Vec<f64>> {
-    let rotating: Vec<bool> = winding.iter().map(|w| *w != 0.0).collect();
-    if *winding != plain_windings(&rotating) {
+    if !is_plain(winding) {
         return vec![];
     }
+    let rotating: Vec<bool> = winding.iter().map(|w| *w != 0.0).collect();
     pattern_whirl_starts(model, &rotating)
 }
 
@@ -102,11 +102,10 @@ fn whirl_starts_of<D: Family>(model: &D, winding: &[f64]) -> Vec<Vec<f64>> {
 /// the same pattern, winding once, for a plain type (a ball that turns forwards is
 /// still an R ball).
 fn of_type(w: &[f64], want: &[f64]) -> bool {
-    let rotating: Vec<bool> = want.iter().map(|x| *x != 0.0).collect();
-    if *want != plain_windings(&rotating) {
+    if !is_plain(want) {
         return w == want;
     }
-    repetitions(w) == 1 && w.iter().zip(&rotating).all(|(a, r)| (*a != 0.0) == *r)
+    repetitions(w) == 1 && w.iter().zip(want).all(|(a, b)| (*a != 0.0) == (*b != 0.0))
 }
 
 /// The candidate a simulated start `y0` gives at the point of `model`: the attractor it
@@ -347,7 +346,7 @@ pub(super) fn run_seeds<D: Family>(
 }
 
 /// [`admit`] on (type, key) pairs.
-fn new_orbit(have: &[(usize, &[f64])], pattern: usize, key: &[f64]) -> bool {
+pub(super) fn new_orbit(have: &[(usize, &[f64])], pattern: usize, key: &[f64]) -> bool {
     let mut n = 0;
     for (_, h) in have.iter().filter(|(k, _)| *k == pattern) {
         if same_orbit(h, key) {
