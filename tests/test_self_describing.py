@@ -1,11 +1,13 @@
 """Tables that say what they are (issue 32): a scan directory is a Parquet dataset polars
 reads by itself, with no lock left however the scan ended; every scan table carries the
-model it was computed for (columns in memory, the whole description in every chunk's
-Parquet metadata on disk); nested columns have a flat export that ``write_csv`` takes."""
+model it was computed for (columns in memory and in every chunk; the whole description
+in the directory's ``_scan.parquet``); nested columns have a flat export that
+``write_csv`` takes."""
 
 import json
 import math
 import os
+import shutil
 import warnings
 from pathlib import Path
 
@@ -113,9 +115,7 @@ def test_the_directory_is_locked_while_a_scan_uses_it(tmp_path):
 def test_damaged_files_are_set_aside_outside_the_dataset(tmp_path, written):
     src, df = written
     out = tmp_path / "fine.parquet"
-    out.mkdir()
-    for f in src.iterdir():
-        (out / f.name).write_bytes(f.read_bytes())
+    shutil.copytree(src, out)
     f = out / "chunk-00001.parquet"
     f.write_bytes(f.read_bytes()[:100])
     (out / "meta.json").write_text("{}")  # the description of ballbal before 0.2
@@ -192,9 +192,7 @@ def test_stored_scan_says_model_options_and_scene(tmp_path):
 def test_a_description_without_a_description_is_damaged(tmp_path, written):
     src, _ = written
     out = tmp_path / "s"
-    out.mkdir()
-    for f in src.iterdir():
-        (out / f.name).write_bytes(f.read_bytes())
+    shutil.copytree(src, out)
     # A readable Parquet file with the right columns but no description in it.
     pl.read_parquet(out / "_scan.parquet").write_parquet(out / "_scan.parquet")
     for call in (ballbal.read_scan, ballbal.scan_meta):
