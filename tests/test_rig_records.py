@@ -76,9 +76,11 @@ def test_steps_are_the_plateaus() -> None:
     assert st.height == len(plateaus)
     np.testing.assert_allclose(st["speed_rpm"].to_numpy(), [p[2] for p in plateaus],
                                atol=1e-9)
-    # each plateau found within one averaging window of where it is
-    np.testing.assert_allclose(st["start"].to_numpy(), [p[0] for p in plateaus], atol=0.06)
-    np.testing.assert_allclose(st["stop"].to_numpy(), [p[1] for p in plateaus], atol=0.06)
+    # each plateau found within two averaging windows (0.05 s) of where it is, inside it
+    start, stop = st["start"].to_numpy(), st["stop"].to_numpy()
+    want0, want1 = np.array([p[0] for p in plateaus]), np.array([p[1] for p in plateaus])
+    assert np.all((start >= want0) & (start < want0 + 0.11)), start - want0
+    assert np.all((stop <= want1) & (stop > want1 - 0.11)), want1 - stop
     assert st["direction"].to_list()[:3] == ["first", "up", "up"]
     assert st["direction"].to_list()[-1] == "down"
 

@@ -1,0 +1,120 @@
+"""Calibration (ballbal.calibrate) recovers model parameters from synthetic stepped-sweep
+records made independently: scipy's DOP853 on the model's equations written in
+tests/reference.py, the ground-frame acceleration formed here, sensor noise added; the
+95 % intervals are checked for coverage over noise draws and the estimates for bias."""
+
+from __future__ import annotations
+
+import math
+from functools import cache
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import ballbal
+from ballbal.calibration import calibrate
+from ballbal.exceptions import ParameterError
+from ballbal.rig import Sensor, read_record
+
+from reference import rhs, rhs_many
+
+FN = 513.0  # rpm, the thesis rig's natural frequency
+WN = FN * 2 * math.pi / 60
+TRUE = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, Omega=1.0, eta=(1.0, 1.0))
+OMEGAS = (1.0, 1.05, 1.1, 1.15, 1.2, 1.25)
+SETTLE, RECORD, DT = 500.0, 1300.0, 0.05  # model time units
+NOISE = 1.0  # the main line's acceleration amplitude is 1.6-3.2
+
+
+@cache
+def clean_sweep() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Time (s), speed (rpm), ground-frame acceleration X'' (in e w_n^2) and the rotor
+    angle, step after step, each step settled from the previous step's end state (the
+    first from the balls turning slowly against the disk, which the chasing motion
+    attracts)."""
+    n = 2
+    s = np.array([0.0, 0.0, 0.0, 0.05, 0.0, 0.0, -0.07, -0.07])
+    ts, rpm, acc, ang = [], [], [], []
+    t_off = 0.0
+    for Om in OMEGAS:
+        b = TRUE.replace(Omega=Om)
+        s = solve_ivp(lambda t, y, b=b: rhs(b, t, y), (0, SETTLE), s, method="DOP853",
+                      rtol=1e-9, atol=1e-11).y[:, -1]
+        grid = np.arange(0.0, RECORD, DT)
+        r = solve_ivp(lambda t, y, b=b: rhs(b, t, y), (0, RECORD), s, method="DOP853",
+                      rtol=1e-9, atol=1e-11, t_eval=grid)
+        Y = r.y
+        dd = rhs_many(b, Y)[n + 2 : n + 4]
+        x, y, vx, vy = Y[0], Y[1], Y[n + 2], Y[n + 3]
+        # Z'' = e^{i Om t} ((x'' + i y'') + 2 i Om (x' + i y') - Om^2 (x + i y))
+        Z2 = np.exp(1j * Om * grid) * ((dd[0] + 1j * dd[1]) + 2j * Om * (vx + 1j * vy)
+                                       - Om**2 * (x + 1j * y))
+        ts.append(t_off + grid / WN)
+        rpm.append(np.full(grid.size, Om * FN))
+        acc.append(Z2.real)
+        ang.append(Om * grid)
+        t_off += grid.size * DT / WN
+        s = r.y[:, -1]
+    return np.concatenate(ts), np.concatenate(rpm), np.concatenate(acc), np.concatenate(ang)
+
+
+def noisy(seed: int) -> dict[str, np.ndarray]:
+    t, v, a, ang = clean_sweep()
+    noise = NOISE * np.random.default_rng(seed).standard_normal(t.size)
+    return {"t": t, "rpm": v, "acc": a + noise, "tacho": (np.mod(ang, 2 * np.pi) < 0.4) * 5.0}
+
+
+SENSOR = {"acc": Sensor(unit="m/s^2")}
+STEPS = {"settle": 0.05, "min_duration": 5.0}
+
+
+def test_the_synthetic_record_is_the_chasing_motion() -> None:
+    rec = read_record(noisy(0), speed="rpm", channels=SENSOR)
+    ft = rec.features(**STEPS)
+    assert ft.height == len(OMEGAS) and ft["status"].to_list() == ["ok"] * len(OMEGAS)
+    assert not any(ft["synchronous"].to_list())  # the balls chase at every step
+
+
+def test_zeta_b_intervals_cover_the_truth_over_noise_draws() -> None:
+    start = TRUE.replace(zeta_b=0.08)
+    est, covered, se = [], 0, []
+    for seed in range(20):
+        ft = read_record(noisy(seed), speed="rpm", channels=SENSOR).features(**STEPS)
+        fit = calibrate(start, ft, ["zeta_b"], natural_frequency_rpm=FN)
+        row = fit.estimates.row(0, named=True)
+        assert row["determined"], fit
+        est.append(row["value"])
+        se.append(row["std_error"])
+        covered += row["ci_low"] <= TRUE.zeta_b <= row["ci_high"]
+    est_a = np.array(est)
+    assert covered >= 17, (covered, est, se)
+    # unbiased within the spread of the 20 estimates
+    assert abs(est_a.mean() - TRUE.zeta_b) < 3 * est_a.std(ddof=1) / math.sqrt(20), est
+    # the quoted errors are the scatter's size (within a factor of two)
+    assert 0.5 < np.mean(se) / est_a.std(ddof=1) < 2.0, (se, est)
+
+
+def test_calibration_from_tacho_pulses() -> None:
+    rec = read_record(noisy(100), tacho="tacho", channels=SENSOR)
+    ft = rec.features(**STEPS)
+    fit = calibrate(TRUE.replace(zeta_b=0.13), ft, ["zeta_b"], natural_frequency_rpm=FN)
+    row = fit.estimates.row(0, named=True)
+    assert row["ci_low"] <= TRUE.zeta_b <= row["ci_high"], fit
+    assert "zeta_b" in repr(fit) and "<table>" in fit._repr_html_()
+
+
+def test_calibration_refuses_what_it_cannot_fit() -> None:
+    ft = read_record(noisy(0), speed="rpm", channels=SENSOR).features(**STEPS)
+    with pytest.raises(ParameterError) as e:
+        calibrate(TRUE, ft, ["Omega"], natural_frequency_rpm=FN)
+    assert e.value.parameter == "free"
+    with pytest.raises(ParameterError) as e:
+        calibrate(TRUE, ft, ["zeta_b", "zeta_b"], natural_frequency_rpm=FN)
+    assert e.value.parameter == "free"
+    with pytest.raises(ParameterError) as e:
+        calibrate(TRUE, ft.head(1), ["zeta_b"], natural_frequency_rpm=FN)
+    assert e.value.parameter == "features"
+    with pytest.raises(ParameterError) as e:
+        calibrate(TRUE, ft, ["zeta_b"], natural_frequency_rpm=-1.0)
+    assert e.value.parameter == "natural_frequency_rpm"
