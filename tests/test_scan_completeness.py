@@ -119,3 +119,32 @@ def test_stable_rows_do_not_depend_on_the_grid_step(name: str) -> None:
     assert sum(t == "R-O" for v in a.values() for t, _ in v) >= 10
     if name == "issue_map":
         assert any(t == "R-O" for t, _ in a.get((1.4, 1.4), []))
+
+
+#: A narrow stable R-R band in a 1-D speed scan: from below Omega 1.0 up to about 1.149,
+#: where the merged orbit's separation multiplier reaches +1. The perfect balance is
+#: unstable below Omega about 1.09. At step 0.01 no seed point lay in the band and the
+#: scan listed no stable R-R; at step 0.02 a seed point did and it listed eight.
+NARROW = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.16, delta=50.0, Omega=1.05,
+                          eta=(0.66, 0.66))
+
+
+def test_a_narrow_band_is_listed_at_every_grid_step() -> None:
+    hb8 = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8))
+    sol = ballbal.periodic(NARROW, "R-R", options=hb8)
+    assert sol.converged
+    # The orbit at Omega 1.05 shot independently: a real orbit, stable by a wide margin.
+    y0, T = shoot(NARROW, sol.state(0.0), sol.period, [0, 0, -1, -1], 2)
+    ev = monodromy_multipliers(NARROW, y0, T)
+    trivial = int(np.argmin(np.abs(ev - 1.0)))
+    assert abs(ev[trivial] - 1.0) < 1e-4
+    assert float(np.max(np.abs(np.delete(ev, trivial)))) < 0.5
+    for step in (0.01, 0.02, 0.05):
+        df = ballbal.scan(NARROW, Omega=(1.0, 2.2, step), patterns=["R-R"])
+        rows = _stable(df, "R-R")
+        listed = set(np.round(rows["Omega"].to_numpy(), 9))
+        band = set(np.round(np.arange(1.0, 1.14 + 1e-9, step), 9))
+        assert band <= listed, (step, sorted(band - listed))
+        at = rows.filter((pl.col("Omega") - 1.05).abs() < 1e-9)
+        if at.height:
+            assert abs(float(at["omega"][0]) - 2 * np.pi / T) < 1e-3

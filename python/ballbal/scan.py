@@ -788,8 +788,12 @@ def scan(  # noqa: E302 - overloads above
     balls turning at the natural frequency in the ground frame, the disk on its resonant
     response to them), since such stable orbits are reached from rest only from a
     sliver of starts; then every solution is continued to its grid neighbours until
-    nothing new appears. ``origin`` says how a row's solution was reached: ``seed``
-    (simulated start at that point), ``continuation`` (from a neighbour),
+    nothing new appears. Then every point where the perfect balance is not stable and a
+    type has no stable row yet is simulated from a start at rest (a *gap seed*: a
+    narrow stable band between seed points would otherwise be missed), and what it
+    finds is continued in turn. ``origin`` says how a row's solution was reached:
+    ``seed`` (simulated start at that point), ``gap_seed`` (a gap seed at that point),
+    ``continuation`` (from a neighbour),
     ``period_doubling`` (from the orbit it doubles, see ``patterns``), ``none`` (no
     solution). Continuation does not cross block edges, so
     ``block`` is a numerical option (smaller blocks find fewer continued solutions);

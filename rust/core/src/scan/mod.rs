@@ -152,6 +152,16 @@ pub(crate) struct Found {
     seconds: f64,
 }
 
+impl Found {
+    /// Stable by its Floquet verdict (undetermined is not stable).
+    fn is_stable(&self) -> bool {
+        self.res
+            .floquet
+            .as_ref()
+            .is_some_and(|f| f.stability == crate::floquet::Stability::Stable)
+    }
+}
+
 fn scan_chunk<D: Family>(
     spec: &ScanSpec<'_, D>,
     range: Range<usize>,
@@ -224,6 +234,20 @@ fn scan_chunk<D: Family>(
     };
     let t = std::time::Instant::now();
     continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
+    check()?;
+    // Gap seeds where nothing stable of a type is listed yet, continued in turn.
+    let mut seeded: Vec<usize> = tasks.iter().map(|t| t.0).collect();
+    seeded.dedup();
+    let gaps = seeding::gap_tasks(spec, np, &sols, &pb, &seeded);
+    let mut frontier = vec![];
+    for (p, f) in seeding::run_gap_seeds(spec, &params, &gaps, starts[0], cancel) {
+        if waves::admit(&sols[p], f.pattern, &f.key) {
+            sols[p].push(f);
+            frontier.push((p, sols[p].len() - 1));
+        }
+    }
+    check()?;
+    continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
     // Period-doubled orbits from the orbits they double, continued in turn.
     let mut frontier = vec![];
     for (p, f) in doubling::doubling_seeds(spec, &params, &sols, cancel) {
@@ -234,7 +258,15 @@ fn scan_chunk<D: Family>(
     continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
     add_stage(2, t);
     let t = std::time::Instant::now();
-    let whirls: Vec<(usize, usize, usize)> = whirls.into_iter().filter(|w| w.1 < np).collect();
+    // Each gap seed counts as one run for every type it was asked for.
+    let whirls: Vec<(usize, usize, usize)> = whirls
+        .into_iter()
+        .filter(|w| w.1 < np)
+        .chain(
+            gaps.iter()
+                .flat_map(|(p, ks)| ks.iter().map(move |&k| (*p, k, 0))),
+        )
+        .collect();
     let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &whirls, &pb);
     profile::serial(profile::ROWS, t.elapsed());
     add_stage(3, t);

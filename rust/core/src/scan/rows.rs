@@ -11,6 +11,9 @@ use crate::periodic::Periodic;
 pub enum Origin {
     /// From a simulated start at this point.
     Seed,
+    /// From a simulated start at a point where the perfect balance is not stable and no
+    /// stable solution of this type had been found by the seeds and their continuation.
+    GapSeed,
     /// Continued from a neighbouring point.
     Continuation,
     /// Started at this point from an orbit of the single-turn type it doubles, displaced
@@ -25,6 +28,7 @@ impl Origin {
     pub fn as_str(&self) -> &'static str {
         match self {
             Origin::Seed => "seed",
+            Origin::GapSeed => "gap_seed",
             Origin::Continuation => "continuation",
             Origin::PeriodDoubling => "period_doubling",
             Origin::None => "none",

@@ -110,14 +110,14 @@ fn of_type(w: &[f64], want: &[f64]) -> bool {
 
 /// The candidate a simulated start `y0` gives at the point of `model`: the attractor it
 /// settles on (or stops at on reaching one of `captures`), if periodic and of a
-/// requested type (type `only`, where given), solved from its fitted series and
+/// requested type (one of `only`, where given), solved from its fitted series and
 /// accepted ([`accept`]): its type's index, the series and its orbit key.
 fn simulated_candidate<D: Family>(
     spec: &ScanSpec<'_, D>,
     model: &D,
     y0: &[f64],
     captures: &[Capture],
-    only: Option<usize>,
+    only: Option<&[usize]>,
 ) -> Option<(usize, HbSolution, Vec<f64>)> {
     // Observed over as many turns as the most wound type asks for.
     let max_turns = spec
@@ -136,7 +136,7 @@ fn simulated_candidate<D: Family>(
     )?;
     let w = &g.winding[model.layout().balls()];
     let k = match only {
-        Some(k) => of_type(w, &spec.patterns[k]).then_some(k)?,
+        Some(ks) => *ks.iter().find(|&&k| of_type(w, &spec.patterns[k]))?,
         None => spec.patterns.iter().position(|want| of_type(w, want))?,
     };
     count(work::SEED_SOLVE);
@@ -271,7 +271,8 @@ pub(super) fn run_seeds<D: Family>(
                 let t = Instant::now();
                 let model = &params[p];
                 let y0 = &whirl_starts_of(model, &spec.patterns[k])[start];
-                let (k, sol, key) = simulated_candidate(spec, model, y0, captures_of(p), Some(k))?;
+                let (k, sol, key) =
+                    simulated_candidate(spec, model, y0, captures_of(p), Some(&[k]))?;
                 let secs = t.elapsed().as_secs_f64();
                 Some((tasks.len() + j, (p, k, sol, key, secs)))
             })
@@ -343,6 +344,87 @@ pub(super) fn run_seeds<D: Family>(
         }
     }
     (sols, frontier)
+}
+
+/// Gap seeds: the points of a block where the perfect balance is not stable and a
+/// requested single-turn type has no stable solution after the seeds and their
+/// continuation, with the types missing there. Something attracts the motion at such a
+/// point, and a stable orbit of the type may be that attractor although no seed lattice
+/// point or stability-boundary point lies in its band: a 1-D speed scan at step 0.01
+/// listed no stable R-R (zeta_b 0.16, eta 0.66) where step 0.02 listed eight, because
+/// the band (Omega 1.0-1.15) held a seed point only on the coarser grid. Points already
+/// simulated (`seeded`) are left out. A type is missing at a point by its own rows and
+/// the perfect balance only, so that the gaps of a type do not depend on which other
+/// types were asked for.
+pub(super) fn gap_tasks<D: Family>(
+    spec: &ScanSpec<'_, D>,
+    reported: usize,
+    sols: &[Vec<Found>],
+    pb: &[(bool, bool)],
+    seeded: &[usize],
+) -> Vec<(usize, Vec<usize>)> {
+    let plain: Vec<usize> = (0..reported)
+        .filter(|&k| is_plain(&spec.patterns[k]))
+        .collect();
+    (0..sols.len())
+        .filter(|&p| !pb[p].1 && seeded.binary_search(&p).is_err())
+        .filter_map(|p| {
+            let missing: Vec<usize> = plain
+                .iter()
+                .copied()
+                .filter(|&k| !sols[p].iter().any(|f| f.pattern == k && f.is_stable()))
+                .collect();
+            (!missing.is_empty()).then_some((p, missing))
+        })
+        .collect()
+}
+
+/// Runs the gap seeds: the first start at rest at each point, accepted only as one of
+/// the types missing there ([`gap_tasks`]), solved, resolved and analysed. Returns the
+/// solutions found, in task order.
+pub(super) fn run_gap_seeds<D: Family>(
+    spec: &ScanSpec<'_, D>,
+    params: &[D],
+    gaps: &[(usize, Vec<usize>)],
+    start: usize,
+    cancel: &AtomicBool,
+) -> Vec<(usize, Found)> {
+    let t = Instant::now();
+    let (found, times): (Vec<Option<(usize, Found)>>, Vec<profile::Task>) = gaps
+        .par_iter()
+        .with_max_len(1)
+        .map(|(p, missing)| {
+            profile::timed(|| {
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let t = Instant::now();
+                let model = &params[*p];
+                let captures: Vec<Capture> = model
+                    .attracting_rests()
+                    .iter()
+                    .filter_map(|(q, rate)| Capture::new(model, q, *rate))
+                    .collect();
+                let y0 = &initial_states(model)[start];
+                let (k, sol, key) = simulated_candidate(spec, model, y0, &captures, Some(missing))?;
+                count(work::FINISH);
+                let res = finish(model, sol, &spec.opts);
+                (res.sol.status == Status::Converged).then(|| {
+                    let f = Found {
+                        pattern: k,
+                        res,
+                        origin: Origin::GapSeed,
+                        parent: None,
+                        key,
+                        seconds: t.elapsed().as_secs_f64(),
+                    };
+                    (*p, f)
+                })
+            })
+        })
+        .unzip();
+    profile::step(profile::SEEDS, t.elapsed(), &times);
+    found.into_iter().flatten().collect()
 }
 
 /// [`admit`] on (type, key) pairs.
