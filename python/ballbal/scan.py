@@ -790,8 +790,9 @@ def scan(  # noqa: E302 - overloads above
     sliver of starts; then every solution is continued to its grid neighbours until
     nothing new appears. Then every point where the perfect balance is not stable and a
     type has no stable row yet is simulated from a start at rest (a *gap seed*: a
-    narrow stable band between seed points would otherwise be missed), and what it
-    finds is continued in turn. ``origin`` says how a row's solution was reached:
+    narrow stable band between seed points would otherwise be missed; on grids of two
+    or more axes, the points of even index along every axis), and what it finds is
+    continued in turn. ``origin`` says how a row's solution was reached:
     ``seed`` (simulated start at that point), ``gap_seed`` (a gap seed at that point),
     ``continuation`` (from a neighbour),
     ``period_doubling`` (from the orbit it doubles, see ``patterns``), ``none`` (no

@@ -238,7 +238,7 @@ fn scan_chunk<D: Family>(
     // Gap seeds where nothing stable of a type is listed yet, continued in turn.
     let mut seeded: Vec<usize> = tasks.iter().map(|t| t.0).collect();
     seeded.dedup();
-    let gaps = seeding::gap_tasks(spec, np, &sols, &pb, &seeded);
+    let gaps = seeding::gap_tasks(spec, &geo, np, &sols, &pb, &seeded);
     let mut frontier = vec![];
     for (p, f) in seeding::run_gap_seeds(spec, &params, &gaps, starts[0], cancel) {
         if waves::admit(&sols[p], f.pattern, &f.key) {
