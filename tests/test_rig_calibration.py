@@ -118,3 +118,55 @@ def test_calibration_refuses_what_it_cannot_fit() -> None:
     with pytest.raises(ParameterError) as e:
         calibrate(TRUE, ft, ["zeta_b"], natural_frequency_rpm=-1.0)
     assert e.value.parameter == "natural_frequency_rpm"
+
+
+# --- the transition speed: where a sweep up leaves the chasing motion -----------------
+
+BAND = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.16, delta=50.0, Omega=1.1, eta=(0.66, 0.66))
+
+
+@cache
+def sweep_up() -> list[tuple[float, bool]]:
+    """A sweep up simulated here (DOP853 on tests/reference.py), the state carried from
+    step to step as a rig carries it (the ground-frame state is continuous: x' -= D y,
+    y' += D x, b' += D for a speed step D = Omega_before - Omega_after): (Omega, chasing)
+    per step, chasing when the balls still turn against the disk at the step's end."""
+    n = 2
+    s = np.array([0.0, 0.0, 0.0, 0.05, 0.0, 0.0, -0.1, -0.1])
+    out, prev = [], None
+    for Om in (1.10, 1.12, 1.14, 1.16, 1.18):
+        if prev is not None:
+            D = prev - Om
+            s = s.copy()
+            s[n + 2] -= D * s[1]
+            s[n + 3] += D * s[0]
+            s[n + 4 :] += D
+        b = BAND.replace(Omega=Om)
+        r = solve_ivp(lambda t, y, b=b: rhs(b, t, y), (0, 3000.0), s, method="DOP853",
+                      rtol=1e-8, atol=1e-10, dense_output=True)
+        s = r.y[:, -1]
+        tail = r.sol(np.linspace(2500.0, 3000.0, 2001))
+        chasing = bool(np.abs(tail[n + 4 :].mean(axis=1)).max() > 1e-3)
+        out.append((Om, chasing))
+        prev = Om
+    return out
+
+
+def test_band_end_is_where_a_simulated_sweep_stops_chasing() -> None:
+    from ballbal.calibration import calibrate_transition, stable_band_end
+
+    steps = sweep_up()
+    chasing = [c for _, c in steps]
+    # the simulated sweep chases, then balances, once
+    k = chasing.index(False)
+    assert all(chasing[:k]) and not any(chasing[k:]), steps
+    om_lo, om_hi = steps[k - 1][0], steps[k][0]
+    end = stable_band_end(BAND)
+    assert end is not None and om_lo <= end < om_hi, (end, steps)
+    # Calibrated from that transition (the midpoint, half a step either side), zeta_b
+    # holds the simulated model's value.
+    tr = calibrate_transition(BAND.replace(zeta_b=0.05), 0.5 * (om_lo + om_hi) * FN,
+                              natural_frequency_rpm=FN, uncertainty_rpm=0.5 * (om_hi - om_lo) * FN,
+                              bracket=(0.05, 0.4))
+    assert tr.status == "ok" and tr.low is not None and tr.high is not None, tr
+    assert tr.low <= BAND.zeta_b <= tr.high, tr

@@ -6,13 +6,19 @@
 (:meth:`ballbal.rig.Record.features`), with the model as the forward model and
 nonlinear least squares (scipy's trust-region reflective ``least_squares``).
 
-What is fitted, step by step:
+What is fitted:
 
-- ``main_frequency``: at every step whose motion was non-synchronous (the balls chasing
-  round the track), the frequency of the model's largest ground-frame acceleration line
-  of its periodic solution of ``pattern`` (default ``"R-R"``) at that speed, against
+- ``main_frequency`` (:func:`calibrate`): at every step whose motion was
+  non-synchronous (the balls chasing round the track), the frequency of the model's
+  largest ground-frame acceleration line of its periodic solution of ``pattern``
+  (default ``"R-R"``) at that speed, against
   the measured main frequency. Each step's solution starts from the same step's
   solution at the previous parameters, so that the fit follows one branch.
+- a transition speed (:func:`calibrate_transition`): the speed at which the balls
+  stopped chasing round the track in a sweep up, against the model's
+  :func:`stable_band_end`, the largest speed at which the model has a stable chasing
+  motion; one parameter is solved for, and the interval is the speeds' uncertainty
+  carried through the model.
 
 The uncertainty is the classical one of nonlinear least squares: the residuals' scale
 ``s^2 = RSS / (m - p)`` (``m`` measurements, ``p`` parameters), the covariance ``s^2
@@ -40,7 +46,8 @@ from .model import Balancer
 from .options import Floquet, HarmonicBalance, PeriodicOptions
 from .rig import Record
 
-__all__ = ["Calibration", "calibrate", "CALIBRATABLE"]
+__all__ = ["Calibration", "calibrate", "CALIBRATABLE", "stable_band_end", "Transition",
+           "calibrate_transition"]
 
 #: Parameters :func:`calibrate` can fit, with the range each is kept in.
 CALIBRATABLE: dict[str, tuple[float, float]] = {
@@ -267,3 +274,125 @@ def calibrate(
     return Calibration(model=fitted, natural_frequency_rpm=fn,
                        estimates=pl.DataFrame(rows), residuals=resid, level=lvl, dof=dof,
                        scale=s, evaluations=count[0], message=str(res.message))
+
+
+def stable_band_end(model: Balancer, pattern: str = "R-R", *,
+                    Omega: Any = (1.0, 2.5, 0.01), refine: int = 12) -> float | None:
+    """The largest speed ``Omega`` (the model's, a ratio to the natural frequency) in the
+    grid ``Omega`` at which ``model`` has a stable motion of ``pattern``, from a speed
+    scan (:func:`ballbal.scan`), refined between that grid point and the next by
+    ``refine`` bisections of :func:`ballbal.periodic` continued from the stable side.
+    ``None`` when no grid point has one. The end of the chasing band in a sweep up: past
+    it the balls leave the chasing motion (for the perfect balance where it is
+    stable)."""
+    from .analysis import periodic
+    from .scan import scan
+
+    _check.model("model", model)
+    n_refine = _check.integer("refine", refine, 0, 60)
+    df = scan(model, Omega=Omega, patterns=[pattern])
+    st = df.filter(pl.col("stability") == "stable")
+    if st.height == 0:
+        return None
+    grid = np.unique(df["Omega"].to_numpy())
+    hi_k = int(np.searchsorted(grid, st["Omega"].to_numpy().max()))
+    lo = float(grid[hi_k])
+    if hi_k + 1 >= grid.size or n_refine == 0:
+        return lo
+    hi = float(grid[hi_k + 1])
+    opts = PeriodicOptions(harmonic_balance=HarmonicBalance(N=8))
+    last = periodic(model.replace(Omega=lo), pattern, options=opts)
+    if last.stability != "stable":
+        return lo
+    for _ in range(n_refine):
+        mid = 0.5 * (lo + hi)
+        s = periodic(model.replace(Omega=mid), pattern, options=opts, guess=last)
+        if s.status == "converged" and s.stability == "stable":
+            lo, last = mid, s
+        else:
+            hi = mid
+    return lo
+
+
+@dataclass(frozen=True, repr=False)
+class Transition:
+    """What :func:`calibrate_transition` found: ``value`` of ``parameter`` at which the
+    model's stable band ends at the measured ``speed_rpm``, and ``low``/``high`` at the
+    speeds ``speed_rpm -+ uncertainty_rpm`` (``None`` where the band cannot end there
+    for any value in ``bracket``); ``status`` is ``"ok"`` or ``"unreachable"`` (then
+    ``value`` is None and ``reach_rpm`` gives the band ends at the bracket's ends)."""
+
+    parameter: str
+    speed_rpm: float
+    uncertainty_rpm: float
+    value: float | None
+    low: float | None
+    high: float | None
+    status: str
+    reach_rpm: tuple[float | None, float | None]
+
+    def __repr__(self) -> str:
+        if self.value is None:
+            return (f"Transition({self.parameter}: {self.speed_rpm:.0f} rpm {self.status}; "
+                    f"the band ends at {self.reach_rpm} rpm over the bracket)")
+        return (f"Transition({self.parameter}={self.value:.4g} "
+                f"[{self.low if self.low is not None else float('nan'):.4g}, "
+                f"{self.high if self.high is not None else float('nan'):.4g}] "
+                f"for {self.speed_rpm:.0f} ± {self.uncertainty_rpm:g} rpm)")
+
+
+def calibrate_transition(
+    model: Balancer,
+    speed_rpm: float,
+    *,
+    parameter: str = "zeta_b",
+    natural_frequency_rpm: float,
+    uncertainty_rpm: float = 0.0,
+    bracket: tuple[float, float] = (0.005, 0.5),
+    pattern: str = "R-R",
+    Omega: Any = (1.0, 2.5, 0.01),  # noqa: N803 - the model's symbol
+) -> Transition:
+    """The value of ``parameter`` at which ``model``'s stable ``pattern`` band ends
+    (:func:`stable_band_end`) at the measured transition speed ``speed_rpm``, solved by
+    Brent's method over ``bracket``; with ``uncertainty_rpm``, the values at the speeds
+    either side too (the interval). The band's end must change monotonically over the
+    bracket for the answer to be unique: the function checks the ends' order."""
+    from scipy import optimize
+
+    _check.model("model", model)
+    _check.string("parameter", parameter)
+    if parameter not in CALIBRATABLE or parameter == "natural_frequency_rpm":
+        allowed = ", ".join(k for k in CALIBRATABLE if k != "natural_frequency_rpm")
+        raise ParameterError("parameter", f"{parameter!r:.40} cannot be solved for; choose "
+                             f"from {allowed}", allowed=allowed)
+    fn = _check.real("natural_frequency_rpm", natural_frequency_rpm, 0.0, math.inf,
+                     lo_open=True, hi_open=True)
+    sp = _check.real("speed_rpm", speed_rpm, 0.0, math.inf, lo_open=True, hi_open=True)
+    du = _check.real("uncertainty_rpm", uncertainty_rpm, 0.0, sp, hi_open=True)
+    a, b = (_check.real("bracket", v, *CALIBRATABLE[parameter]) for v in bracket)
+    if not a < b:
+        raise ParameterError("bracket", f"must be (low, high) with low < high, got {bracket}")
+    cache: dict[float, float] = {}
+
+    def end_rpm(v: float) -> float:
+        if v not in cache:
+            e = stable_band_end(model.replace(**{parameter: v}), pattern, Omega=Omega)
+            cache[v] = -math.inf if e is None else e * fn
+        return cache[v]
+
+    ea, eb = end_rpm(a), end_rpm(b)
+    reach = (None if ea == -math.inf else ea, None if eb == -math.inf else eb)
+
+    def solve(target: float) -> float | None:
+        if not min(ea, eb) <= target <= max(ea, eb):
+            return None
+        return float(optimize.brentq(lambda v: end_rpm(v) - target, a, b, xtol=1e-5))
+
+    value = solve(sp)
+    if value is None:
+        return Transition(parameter, sp, du, None, None, None, "unreachable", reach)
+    ends = [solve(sp - du), solve(sp + du)] if du > 0 else [value, value]
+    known = [e for e in ends if e is not None]
+    low = min(known) if len(known) == 2 else None
+    high = max(known) if len(known) == 2 else None
+    return Transition(parameter, sp, du, value, low, high, "ok", reach)
