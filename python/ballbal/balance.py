@@ -60,8 +60,7 @@ def balance_map(
         raise ParameterError("axes", "give at least one parameter to vary, e.g. Omega=[...]")
     scene = model if isinstance(model, Scene) else Scene(balancer=model)
     names = list(axes)
-    allowed = (_MAP_AXES | (_TILT_AXES if scene.tilt is not None else set())
-               | (_BEARING_AXES if scene.support is not None else set()))
+    allowed = set(_native.parameter_keys(scene))
     values: list[list[float]] = []
     for name in names:
         if name not in allowed:
@@ -104,10 +103,9 @@ def balance_map(
     return pl.DataFrame(cols, schema=schema)
 
 
-_MAP_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta", "springs"}
 #: The planar balancer's axes: the core sets them on each point's scene without checking
 #: them (issue 30: ``Omega=[-1.0]`` gave rows with verdicts), so they are checked here.
-_PLANAR_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta"}
+_PLANAR_AXES = {p["key"] for p in _native.parameters() if p["key"] and p["planar"]}
 
 
 def _planar_range(balancer: Balancer, name: str, values: np.ndarray) -> None:
@@ -123,9 +121,6 @@ def _planar_range(balancer: Balancer, name: str, values: np.ndarray) -> None:
         except ParameterError as e:
             raise ParameterError(name, f"{x:g} is outside its range: {e.message}",
                                  allowed=e.allowed, value=x) from None
-_TILT_AXES = {"a", "b", "j_t", "j_z", "zeta_r"}
-#: On a bearing support: ``rho = e / c``, and the grooves' depth ratio and angle (degrees).
-_BEARING_AXES = {"rho", "depth_ratio", "groove_angle"}
 
 
 def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: str = "",

@@ -45,39 +45,35 @@ try:
 except ImportError:  # pragma: no cover - not on POSIX: scan directories are not locked
     fcntl = None  # type: ignore[assignment]
 
-SCANNABLE = ("mu", "zeta", "zeta_b", "delta", "Omega", "eta")
-#: Scene parameters a scan can vary besides the balancer's (tilt fields need a tilt; the
-#: bearing's ``rho`` and groove ``depth_ratio``, ``groove_angle`` need a bearing support).
-SCENE_SCANNABLE = ("springs", "a", "b", "j_t", "j_z", "zeta_r", "rho", "depth_ratio",
-                   "groove_angle")
-_INDEXED = ("eta[", "zeta_b[")
+#: The parameter registry as the core serves it (``_native.parameters()``): the names,
+#: owners and ranges every model's parameters are checked with.
+PARAMETERS: tuple[dict[str, Any], ...] = tuple(_native.parameters())
+#: The planar balancer's parameters a scan can vary (per-ball ones also one ball at a
+#: time, ``eta[1]``).
+SCANNABLE: tuple[str, ...] = tuple(p["key"] for p in PARAMETERS if p["key"] and p["planar"])
+#: Scene parameters a scan can vary besides the balancer's: the core takes each only from
+#: a scene that has its component (the tilt's with a tilting disk, ``rho``,
+#: ``depth_ratio`` and ``groove_angle`` on a bearing support) and refuses a value that
+#: makes the scene time-dependent (gravity above 0).
+SCENE_SCANNABLE: tuple[str, ...] = tuple(p["key"] for p in PARAMETERS
+                                         if p["key"] and not p["planar"])
 
 GridSpec = Sequence[float] | np.ndarray | tuple[float, float, float] | str
 
 MULTIPLIER = pl.List(pl.Struct({"re": pl.Float64, "im": pl.Float64}))
-_SCHEMA: dict[str, Any] = {
-    "type": pl.Utf8, "solution": pl.Int64, "status": pl.Utf8, "omega": pl.Float64,
-    "omega_error": pl.Float64, "stability": pl.Utf8, "max_modulus": pl.Float64,
-    "modulus_error": pl.Float64, "modulus_error_source": pl.Utf8, "trivial_error": pl.Float64,
-    "multipliers": MULTIPLIER, "residual": pl.Float64, "tail": pl.Float64,
-    "closure": pl.Float64, "separation_error": pl.Float64,
-    "pivot_ratio": pl.Float64, "iterations": pl.Int64, "floquet_steps": pl.Int64,
-    "floquet_error": pl.Utf8, "N": pl.Int64, "attempts": pl.Int64, "seconds": pl.Float64,
-    "origin": pl.Utf8, "pb_exists": pl.Boolean, "pb_stable": pl.Boolean,
-    "target_met": pl.Boolean, "hill_stability": pl.Utf8, "verdicts_disagree": pl.Boolean,
-}
+#: polars' dtype for each column type of the core's schema.
+_DTYPES: dict[str, Any] = {"float": pl.Float64, "count": pl.Int64, "flag": pl.Boolean,
+                           "label": pl.Utf8, "multipliers": MULTIPLIER}
+#: A scan table's columns after the axes and their index columns, as the core serves
+#: them (``_native.scan_schema()``), with their polars dtypes.
+SCHEMA: dict[str, Any] = {name: _DTYPES[kind] for name, kind in _native.scan_schema()}
 
 
 def grid_values(name: str, spec: GridSpec) -> np.ndarray:
     """The values of one grid axis (:func:`ballbal._check.axis`, shared by every gridded
     function): ``(start, stop, step)`` or ``"start:stop:step"`` (both ends included),
-    or a sequence or array of explicit values."""
-    if not (name in SCANNABLE or name in SCENE_SCANNABLE
-            or (name.startswith(_INDEXED) and name.endswith("]"))):
-        raise ParameterError(
-            name, f"not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
-            f"eta[i], zeta_b[i]; for scenes also {', '.join(SCENE_SCANNABLE)})"
-        )
+    or a sequence or array of explicit values. Whether a model has the parameter
+    ``name`` is the core's to say (:func:`scan` asks it before any work)."""
     if spec is None or isinstance(spec, (bool, np.bool_)):
         raise ParameterTypeError(name, f"grid values must be numbers, got {spec!r}")
     return _check.axis(name, spec)
@@ -126,7 +122,7 @@ class _Job:
             "block": self.block, "chunk": self.chunk,
             # A store written with other columns is not resumed into this table.
             # (the axes' index columns named generically: the axes are compared apart)
-            "columns": [_index_name("<axis>"), *_SCHEMA],
+            "columns": [_index_name("<axis>"), *SCHEMA],
             "model_columns": list(self.model_values()),
         }
 
@@ -233,7 +229,7 @@ def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
         order = np.argsort(grid, kind="stable")
         at = order[np.searchsorted(grid[order], np.asarray(d[n], dtype=np.float64))]
         cols[_index_name(n)] = pl.Series(_index_name(n), at, dtype=pl.Int64)
-    for c, dtype in _SCHEMA.items():
+    for c, dtype in SCHEMA.items():
         cols[c] = mult if c == "multipliers" else pl.Series(c, d[c], dtype=dtype)
     rows = len(d["type"])
     for k, v in job.model_values().items():
@@ -246,7 +242,7 @@ def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
 
 def _empty(names: Sequence[str], model_columns: Sequence[str]) -> pl.DataFrame:
     return pl.DataFrame(schema={**{n: pl.Float64 for n in names},
-                                **{_index_name(n): pl.Int64 for n in names}, **_SCHEMA,
+                                **{_index_name(n): pl.Int64 for n in names}, **SCHEMA,
                                 **{k: pl.Float64 for k in model_columns}})
 
 
@@ -886,6 +882,8 @@ def scan(  # noqa: E302 - overloads above
     if (isinstance(model, Scene) and not model._effects_on()
             and not set(names) & set(SCENE_SCANNABLE)):
         model = model.balancer  # the same table, and a scan directory it can resume
+    # The core's own refusal of a name, before any value is read or file written.
+    _native.check_axes(model, list(names))
     values = tuple(tuple(grid_values(n, s).tolist()) for n, s in axes_all.items())
     ex = execution
     _check.grid_points([len(v) for v in values], names, streamed=ex.out is not None)
