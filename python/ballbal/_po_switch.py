@@ -14,7 +14,7 @@ from .analysis import Equilibrium, PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer, Seed003
 from .options import PERIODIC_DEFAULTS, PERIODIC_KEYWORDS, PeriodicOptions, with_keywords
-from .scene import Scene
+from .scene import Scene, model_argument
 
 
 def _from_branch(branch: Branch, event: Any, kind: str | None, parameter: str | None,
@@ -125,7 +125,7 @@ def switch(
         kind = "hopf"
         if model is None:
             raise ParameterError("model", "give the model the equilibrium belongs to")
-        base = _check.model("model", model)
+        base = model_argument("model", model)
         d, p, crit = _native.switch_hopf(base, parameter, [float(v) for v in solution.q],
                                          amp, options)
     else:

@@ -16,7 +16,7 @@ from . import _check
 from .analysis import PeriodicSolution, periodic
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
-from .scene import Scene
+from .scene import Scene, model_argument
 
 
 def _match_error(a: np.ndarray, ref: np.ndarray) -> float:
@@ -91,7 +91,7 @@ def accuracy_cost(
     giving at most 65536 samples, ``tol > 0``, ``rtol`` and ``magnus_rtol`` in (0, 1),
     ``neighbour <= Omega``.
     """
-    _check.model("model", model)
+    model_argument("model", model)
     _check.string("pattern", pattern)
     N = [_check.integer("N", n, 1, 256) for n in _knob("N", N)]
     base_N = _check.integer("base_N", base_N, 1, 255)

@@ -14,7 +14,7 @@ from . import _check, _native
 from .analysis import Equilibrium, _equilibrium, capacities
 from .exceptions import ParameterError
 from .model import Balancer
-from .scene import Scene
+from .scene import Scene, model_argument
 
 
 def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
@@ -25,7 +25,7 @@ def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
     rest spacing is not the balancing spacing leave a nearly balanced state whose
     residual whirl is ``hypot(x, y)`` (in units of ``e``); it is followed from zero
     spring stiffness. Needs an autonomous scene."""
-    _check.model("model", model)
+    model_argument("model", model)
     d = _native.balanced_states([model])[0]
     return None if d is None else _equilibrium(d, capacities(model))
 
@@ -55,7 +55,7 @@ def balance_map(
     a list or array explicit values; finite, inside the parameter's range (a value
     outside it raises :class:`~ballbal.exceptions.ParameterError` naming the axis); the
     grid has at most :data:`~ballbal._check.MAX_MAP_POINTS` points."""
-    _check.model("model", model)
+    model_argument("model", model)
     if not axes:
         raise ParameterError("axes", "give at least one parameter to vary, e.g. Omega=[...]")
     scene = model if isinstance(model, Scene) else Scene(balancer=model)

@@ -38,7 +38,7 @@ from .exceptions import (
 )
 from .model import Balancer
 from .options import SCAN_DEFAULTS, SCAN_KEYWORDS, Execution, ScanOptions, with_keywords
-from .scene import Scene
+from .scene import Scene, model_argument
 
 try:
     import fcntl
@@ -851,7 +851,7 @@ def scan(  # noqa: E302 - overloads above
     Limits (checked before any work): at most 1e6 values per axis, 5e6 grid points for a
     table held in memory and 1e9 for one streamed to ``out=``.
     """
-    _check.model("model", model)
+    model_argument("model", model)
     options = _check.option("options", options, ScanOptions, SCAN_DEFAULTS,
                             "ballbal.ScanOptions")
     execution = _check.option("execution", execution, Execution, Execution(),
