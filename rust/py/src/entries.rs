@@ -520,14 +520,6 @@ pub fn parameters(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
         .collect()
 }
 
-/// Whether the model takes the parameter `name` by name (as a scan sets it): Ok, or the
-/// error a scan of `name` stops with. A name the model has is set to its own value; one
-/// it does not have fails before any value is looked at (so the NaN is never checked).
-fn check_key<D: Family>(m: &D, name: &str) -> Result<(), Error> {
-    let v = m.param_value(name).unwrap_or(f64::NAN);
-    m.with_param(name, v).map(|_| ())
-}
-
 /// The model built as a scan builds it (a scene stays a scene).
 fn scanned_model(model: &ModelArgs) -> PyResult<Model> {
     model.build(matches!(model, ModelArgs::Scene(_))).py()
@@ -539,7 +531,7 @@ fn scanned_model(model: &ModelArgs) -> PyResult<Model> {
 pub fn check_axes(model: ModelArgs, names: Vec<String>) -> PyResult<()> {
     let m = scanned_model(&model)?;
     for n in &names {
-        dispatch!(&m, d => check_key(d, n)).py()?;
+        dispatch!(&m, d => d.check_param(n)).py()?;
     }
     Ok(())
 }
@@ -553,6 +545,6 @@ pub fn parameter_keys(model: ModelArgs) -> PyResult<Vec<&'static str>> {
     Ok(REGISTRY
         .iter()
         .filter_map(|s| s.key)
-        .filter(|k| dispatch!(&m, d => check_key(d, k)).is_ok())
+        .filter(|k| dispatch!(&m, d => d.check_param(k)).is_ok())
         .collect())
 }
