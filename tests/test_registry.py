@@ -55,6 +55,9 @@ def test_every_listed_name_is_one_the_core_varies_and_no_other():
     assert listed == accepted
     # The planar balancer's are exactly SCANNABLE, in the registry's order.
     assert tuple(_native.parameter_keys(BAL)) == scan_module.SCANNABLE
+    # A name is checked as a name: every ball's eta on balls of different eta (no one
+    # value of the model's) is a name the core varies.
+    _native.check_axes(BAL.replace(eta=(0.8, 1.2)), ["eta", "eta[1]", "zeta_b"])
     # Gravity is varied by the core (at 0: above it a scene is time-dependent); the
     # hand-kept list of before left it out.
     assert "gravity" in scan_module.SCENE_SCANNABLE

@@ -12,7 +12,7 @@ import polars as pl
 from . import _check, _native
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
-from .options import PERIODIC_DEFAULTS, PERIODIC_KEYWORDS, PeriodicOptions, with_keywords
+from .options import PERIODIC_DEFAULTS, PeriodicOptions, refuses_keywords, with_harmonics
 from .scene import Scene, model_argument
 from .spectrum import LineSource, Vibration, line_spectrum, vibration
 
@@ -445,27 +445,28 @@ def _homotopy(model: Balancer | Scene, homotopy: Any) -> list[tuple[str, float]]
     return out
 
 
+@refuses_keywords(PeriodicOptions)
 def periodic(
     model: Balancer | Scene,
     pattern: str = "R-R",
     *,
+    N: int | Literal["auto"] | None = None,  # noqa: N803
     options: PeriodicOptions | None = None,
     guess: PeriodicSolution | tuple[float, np.ndarray] | None = None,
     windings: Sequence[int] | None = None,
     homotopy: bool | dict[str, float] | Sequence[tuple[str, float]] | None = None,
-    **keywords: Any,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
     per ball) by Newton–IHB with ``N`` harmonics, and its Floquet multipliers.
 
     ``options``: a :class:`~ballbal.PeriodicOptions` (harmonic balance, Floquet, guess
-    search, certificates; default :data:`ballbal.options.PERIODIC_DEFAULTS`). The flat
-    keywords below are still accepted and change those options: ``N, target, N_max,
-    samples, tol, step_tol, max_iter`` (:class:`~ballbal.HarmonicBalance`), ``floquet``
-    (its ``monodromy``), ``hill, hill_band, rtol, atol, margin, max_steps, max_trivial,
-    refine`` (:class:`~ballbal.Floquet`; ``hill_band`` limits Hill to verdicts in doubt, as in
-    scans, and ``hill_stability`` is then None elsewhere), ``settle, window, guess_rtol,
-    guess_atol`` (:class:`~ballbal.GuessSearch`), ``max_closure, max_tail``.
+    search, certificates; default :data:`ballbal.options.PERIODIC_DEFAULTS`); the option
+    names below are its fields' (``hill`` is ``options.floquet.hill``, ``settle``
+    ``options.guess.settle``, ``max_closure`` ``options.max_closure``; ``hill_band``
+    limits Hill to verdicts in doubt, as in scans, and ``hill_stability`` is then None
+    elsewhere). ``N``: the harmonics (``options.harmonic_balance.N`` when given). The
+    flat option keywords of before (``hill=``, ``rtol=``, ...) are refused with a
+    :class:`~ballbal.exceptions.ParameterTypeError` naming the field that replaces each.
 
     Without ``guess`` the start comes from a time simulation (``settle`` time units for
     transients, then up to ``window`` to measure the period). One ball, when no start at
@@ -566,7 +567,7 @@ def periodic(
     _check.string("pattern", pattern)
     options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
                             "ballbal.PeriodicOptions")
-    options = with_keywords(options, "periodic", keywords, PERIODIC_KEYWORDS)
+    options = with_harmonics(options, N)
     wind = None if windings is None else _windings(windings)
     go: float | None = None
     gc: np.ndarray | None = None

@@ -37,7 +37,14 @@ from .exceptions import (
     ScanStoreWarning,
 )
 from .model import Balancer
-from .options import SCAN_DEFAULTS, SCAN_KEYWORDS, Execution, ScanOptions, with_keywords
+from .options import (
+    REMOVED_KEYWORDS,
+    SCAN_DEFAULTS,
+    Execution,
+    ScanOptions,
+    refuse_keywords,
+    with_harmonics,
+)
 from .scene import Scene, model_argument
 
 try:
@@ -624,7 +631,7 @@ class _Store:
                 hint = ""
                 if old.get("options", {}).get("hill") is False and "options.hill" in diff:
                     hint = (" (scans written before 2026-11-24 ran without Hill's "
-                            "cross-check by default: hill=False resumes them)")
+                            "cross-check by default: Floquet(hill=False) resumes them)")
                 raise ScanStoreError(
                     f"out: {self.dir} holds a different scan (it differs in "
                     f"{', '.join(diff)}){hint}; choose another directory or delete it")
@@ -725,6 +732,7 @@ def scan(  # noqa: E302 - overloads above
     model: Balancer | Scene,
     *,
     patterns: Sequence[str] = ("R-R",),
+    N: int | Literal["auto"] | None = None,  # noqa: N803
     options: ScanOptions | None = None,
     execution: Execution | None = None,
     chunk: int | None = None,
@@ -734,7 +742,7 @@ def scan(  # noqa: E302 - overloads above
     lazy: bool = False,
     executor: Any = None,
     grid: Mapping[str, GridSpec] | None = None,
-    **axes_and_options: Any,
+    **axes: GridSpec,
 ) -> pl.DataFrame | pl.LazyFrame:
     """Scan parameters of ``model`` over a grid and return one row per solution found.
 
@@ -760,11 +768,11 @@ def scan(  # noqa: E302 - overloads above
 
     ``options``: a :class:`~ballbal.ScanOptions` (what is computed; default
     :data:`ballbal.options.SCAN_DEFAULTS`, whose tolerances and guess search differ from
-    :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`). The flat keywords
-    of :func:`~ballbal.periodic` (``N, target, N_max, hill, hill_band, samples, tol, step_tol,
-    max_iter, floquet, rtol, atol, margin, max_steps, settle, window, guess_rtol,
-    guess_atol, max_tail, max_closure, max_trivial, refine``) and ``seeds, starts, block`` are
-    still accepted beside the axes and change those options. ``execution``: an
+    :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`); ``N``: the
+    harmonics (``options.harmonic_balance.N`` when given). The flat option keywords of
+    before (``hill=``, ``seeds=``, ``block=``, ...) are refused with a
+    :class:`~ballbal.exceptions.ParameterTypeError` naming the field that replaces each
+    (they are no parameters, so never axes). ``execution``: an
     :class:`~ballbal.Execution` (where it runs: ``threads, chunk, executor, progress,
     out, lazy``); the keywords of the same names override it. Execution never changes
     the table.
@@ -821,10 +829,11 @@ def scan(  # noqa: E302 - overloads above
     ``N_max``): easy points stay cheap; ``N`` and ``target_met`` say what each row got.
     Hill's method cross-checks the verdicts where they are in doubt: a row whose
     monodromy gives no verdict, or whose leading non-trivial multiplier lies within
-    ``hill_band`` (default 0.2) of the unit circle or within ten times the monodromy's
-    own error estimate, gets Hill's verdict (``hill_stability``) and a flag where the
-    two contradict each other (``verdicts_disagree``); elsewhere both are null.
-    ``hill=True`` cross-checks every solution (``hill_band=None``), ``hill=False`` none.
+    ``floquet.hill_band`` (default 0.2) of the unit circle or within ten times the
+    monodromy's own error estimate, gets Hill's verdict (``hill_stability``) and a flag
+    where the two contradict each other (``verdicts_disagree``); elsewhere both are null.
+    ``hill_band=None`` cross-checks every solution, ``hill=False`` none (both fields of
+    ``options.floquet``).
 
     ``out``: a directory; each finished chunk is written there as Parquet at once
     (atomically), and a later call with the same arguments and ``out`` skips the chunks
@@ -865,13 +874,13 @@ def scan(  # noqa: E302 - overloads above
         given["lazy"] = lazy
     if given:
         execution = replace(execution, **given)
-    opts = {k: axes_and_options.pop(k) for k in list(axes_and_options) if k in SCAN_KEYWORDS}
-    options = with_keywords(options, "scan", opts, SCAN_KEYWORDS)
+    refuse_keywords("scan", ScanOptions, [k for k in axes if k in REMOVED_KEYWORDS])
+    options = with_harmonics(options, N)
     p = _check.patterns("patterns", patterns)
     if not p:
         raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
     axes_all: dict[str, GridSpec] = dict(grid or {})
-    for k, v in axes_and_options.items():
+    for k, v in axes.items():
         if k in axes_all:
             raise ParameterError(k, "given twice (keyword and grid)")
         axes_all[k] = v
