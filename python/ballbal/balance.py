@@ -35,9 +35,11 @@ def balance_map(
     **axes: Sequence[float] | np.ndarray | tuple[float, float, float] | str,
 ) -> pl.DataFrame:
     """The balanced state's stability over a grid: one row per point of the product of
-    ``axes`` (parameter name = values; balancer fields such as ``Omega``, ``eta``,
+    ``axes`` (parameter name = values; the names the scene takes, as the core lists them
+    in ``_native.parameter_keys``: balancer fields such as ``Omega``, ``eta``,
     ``zeta_b``, ``zeta``, the scene's ``springs`` and tilt fields ``j_t``, ``j_z``,
-    ``zeta_r``, ``a``, ``b``; on a bearing ``rho``, ``depth_ratio``, ``groove_angle``).
+    ``zeta_r``, ``a``, ``b``; on a bearing ``rho``, ``depth_ratio``, ``groove_angle``;
+    ``gravity`` only at 0, where the scene stays autonomous).
     Points are solved in parallel in the core, each on its own, so the table does not
     depend on the thread count.
 
