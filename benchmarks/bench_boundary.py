@@ -46,13 +46,15 @@ def measure() -> dict[str, float]:
     else:
         out["validate_1000"] = best(lambda: [native.validate(scene) for _ in range(1000)])
     b = ballbal.Balancer()
-    seed = ballbal.periodic(b, "R-R", N=3, hill=False)
+    seed = ballbal.periodic(b, "R-R", N=3,
+                            options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
 
-    def loop(n: int, **kw: object) -> None:
+    def loop(n: int, options: ballbal.PeriodicOptions) -> None:
         for _ in range(n):
-            ballbal.periodic(b, "R-R", N=3, guess=seed, **kw)
+            ballbal.periodic(b, "R-R", N=3, guess=seed, options=options)
 
-    out["periodic_1000_hb_only"] = best(lambda: loop(1000, floquet=False, hill=False))
+    hb_only = ballbal.PeriodicOptions(floquet=ballbal.Floquet(monodromy=False, hill=False))
+    out["periodic_1000_hb_only"] = best(lambda: loop(1000, hb_only))
     out["periodic_100_default"] = best(lambda: loop(100))
     return out
 

@@ -52,11 +52,14 @@ def separation() -> None:
     reproduction, certificates off, so that both sides of the threshold show."""
     b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, Omega=1.0, eta=(1.0, 1.0))
     for n in (8, 3):
-        prev = ballbal.periodic(b, "R-R", N=n, max_closure=1e300, max_tail=1e300)
+        prev = ballbal.periodic(b, "R-R", N=n,
+                                options=ballbal.PeriodicOptions(max_closure=1e300, max_tail=1e300))
         for k in range(1, 20):
             w = round(1.0 - 0.02 * k, 3)
             s = ballbal.periodic(b.replace(Omega=w), "R-R", N=n, guess=prev,
-                                 max_closure=1e300, max_tail=1e300, hill=False)
+                                 options=ballbal.PeriodicOptions(
+                                     floquet=ballbal.Floquet(hill=False), max_closure=1e300,
+                                     max_tail=1e300))
             if s.omega is None:
                 break
             print(f"N={n} Omega={w:.2f}: omega {s.omega:.2e}, closure certificate "

@@ -25,6 +25,7 @@ core's ``hill_profile`` test, which times both on the same series:
 
 from __future__ import annotations
 
+import dataclasses
 import subprocess
 import sys
 import time
@@ -64,18 +65,22 @@ SCAN_CALLGRIND = {"standard N=3, per call": 4.3e6, "thesis grid, per solution": 
 
 
 def case(name: str, b: ballbal.Balancer, seed: ballbal.PeriodicSolution, N: int) -> None:
-    sol = ballbal.periodic(b, "R-R", N=N, guess=seed, hill=False)
-    ref = ballbal.periodic(b, "R-R", N=N, guess=sol, rtol=1e-12, atol=1e-14,
-                           max_steps=10_000_000, hill=False)
+    sol = ballbal.periodic(b, "R-R", N=N, guess=seed,
+                           options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
+    ref = ballbal.periodic(b, "R-R", N=N, guess=sol,
+                           options=ballbal.PeriodicOptions(
+                               floquet=ballbal.Floquet(rtol=1e-12, atol=1e-14, max_steps=10_000_000,
+                                                       hill=False)))
 
-    def run(**kw):
-        return ballbal.periodic(b, "R-R", N=N, guess=sol, **kw)
+    def run(**floquet):
+        options = ballbal.PeriodicOptions(floquet=ballbal.Floquet(**floquet))
+        return ballbal.periodic(b, "R-R", N=N, guess=sol, options=options)
 
-    t_hb, _ = median_time(lambda: run(floquet=False, hill=False), 15)
+    t_hb, _ = median_time(lambda: run(monodromy=False, hill=False), 15)
     t_rk, _ = median_time(lambda: run(rtol=1e-6, atol=1e-9, hill=False), 15)
-    t_mg, _ = median_time(lambda: run(rtol=1e-6, hill=False, floquet_method="magnus"), 15)
-    t_hill, h = median_time(lambda: run(floquet=False, hill=True), 15)
-    t_hv, hv = median_time(lambda: run(floquet=False, hill=True, hill_target="verdict"), 15)
+    t_mg, _ = median_time(lambda: run(rtol=1e-6, hill=False, method="magnus"), 15)
+    t_hill, h = median_time(lambda: run(monodromy=False, hill=True), 15)
+    t_hv, hv = median_time(lambda: run(monodromy=False, hill=True, hill_target="verdict"), 15)
     rk, mg, hl, hvl = t_rk - t_hb, t_mg - t_hb, t_hill - t_hb, t_hv - t_hb
     err = match_error(h.hill_multipliers, ref.multipliers)
     err_v = match_error(hv.hill_multipliers, ref.multipliers)
@@ -90,13 +95,16 @@ def scan_settings() -> None:
     b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0)
     grid = {"Omega": (1.0, 2.0, 0.01), "eta": (0.4, 1.5, 0.01)}
     ballbal.scan(b, patterns=["R-R"], threads=1, Omega=[1.2], eta=[1.0])
-    settings = {"hill=False": {"hill": False}, "default (band)": {}, "hill=True": {"hill": True}}
+    fl = ballbal.options.SCAN_DEFAULTS.floquet
+    settings = {"hill=False": dataclasses.replace(fl, hill=False), "default (band)": fl,
+                "hill=True": dataclasses.replace(fl, hill=True, hill_band=None)}
     cpu: dict[str, list[float]] = {k: [] for k in settings}
     checked: dict[str, int] = {}
     for _ in range(2):
-        for k, kw in settings.items():
+        for k, floquet in settings.items():
             t = time.process_time()
-            df = ballbal.scan(b, patterns=["R-R"], N=3, threads=1, **grid, **kw)
+            df = ballbal.scan(b, patterns=["R-R"], N=3, threads=1, **grid,
+                              options=ballbal.ScanOptions(floquet=floquet))
             cpu[k].append(time.process_time() - t)
             ok = df.filter(pl.col("status") == "converged")
             checked[k] = int(ok["hill_stability"].is_not_null().sum())
@@ -112,9 +120,12 @@ def scan_settings() -> None:
 def main() -> None:
     base = dict(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, eta=(1.0, 1.0))
     b = ballbal.Balancer(**base, Omega=1.2)
-    seed = ballbal.periodic(b, "R-R", N=8, hill=False)
+    seed = ballbal.periodic(b, "R-R", N=8,
+                            options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
     hard = ballbal.Balancer(**{**base, "eta": (0.7, 0.7)}, Omega=1.0)
-    hard_seed = ballbal.periodic(hard.replace(Omega=0.99), "R-R", N=8, hill=False)
+    hard_seed = ballbal.periodic(hard.replace(Omega=0.99), "R-R", N=8,
+                                 options=ballbal.PeriodicOptions(
+                                     floquet=ballbal.Floquet(hill=False)))
     print("Hill's method beside the monodromy it cross-checks (wall clock, medians):")
     for N in (3, 8):
         case("standard", b, seed, N)

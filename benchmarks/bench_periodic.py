@@ -77,7 +77,9 @@ def harmonic_balance(b, seed) -> None:
     rows = []
     for N in (3, 6, 8, 12):
         def solve(N=N):
-            return ballbal.periodic(b, "R-R", N=N, guess=seed, floquet=False, hill=False)
+            return ballbal.periodic(b, "R-R", N=N, guess=seed,
+                                    options=ballbal.PeriodicOptions(
+                                        floquet=ballbal.Floquet(monodromy=False, hill=False)))
         t_hb, sol = median_time(solve, 50)
         _native.hb_stage_profile(True)
         c0 = _native.certificate_seconds()
@@ -109,18 +111,22 @@ def harmonic_balance(b, seed) -> None:
 def floquet_methods(name, b, seed, N) -> None:
     """Both monodromies on the same series: Floquet time = (HB + Floquet) - HB."""
     t_hb, _ = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed,
-                                                   floquet=False, hill=False))
-    ref = ballbal.periodic(b, "R-R", N=N, guess=seed, rtol=1e-12, atol=1e-14,
-                           max_steps=10_000_000, hill=False)
+                                                   options=ballbal.PeriodicOptions(
+                                                       floquet=ballbal.Floquet(monodromy=False,
+                                                                               hill=False))))
+    ref = ballbal.periodic(b, "R-R", N=N, guess=seed,
+                           options=ballbal.PeriodicOptions(
+                               floquet=ballbal.Floquet(rtol=1e-12, atol=1e-14, max_steps=10_000_000,
+                                                       hill=False)))
     print(f"\n{name}, N = {N} (period {ref.period:.1f}); Floquet cost and the multipliers' "
           "error against RK45 at rtol 1e-12")
     print(f"{'method':>7} {'rtol':>6} {'Floquet [us]':>13} {'steps':>6} {'error':>9}")
     rows = {}
     for method in ("rk45", "magnus"):
         for rtol in (1e-5, 1e-6, 1e-7, 1e-8):
+            fl = ballbal.Floquet(rtol=rtol, atol=rtol * 1e-3, hill=False, method=method)
             t_all, s = median_time(lambda: ballbal.periodic(
-                b, "R-R", N=N, guess=seed, rtol=rtol, atol=rtol * 1e-3, hill=False,
-                floquet_method=method))
+                b, "R-R", N=N, guess=seed, options=ballbal.PeriodicOptions(floquet=fl)))
             err = match_error(s.multipliers, ref.multipliers)
             rows[method, rtol] = (t_all - t_hb, err)
             print(f"{method:>7} {rtol:6.0e} {(t_all - t_hb) * 1e6:13.0f} "
@@ -158,18 +164,25 @@ def main() -> None:
 
     print()
     for N in (3, 8):
-        t_h, h = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed, rtol=1e-6,
-                                                      atol=1e-9), 10)
-        t_n, _ = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed, rtol=1e-6,
-                                                      atol=1e-9, hill=False), 10)
+        t_h, h = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed,
+                                                      options=ballbal.PeriodicOptions(
+                                                          floquet=ballbal.Floquet(rtol=1e-6,
+                                                                                  atol=1e-9))), 10)
+        t_n, _ = median_time(lambda: ballbal.periodic(b, "R-R", N=N, guess=seed,
+                                                      options=ballbal.PeriodicOptions(
+                                                          floquet=ballbal.Floquet(
+                                                              rtol=1e-6, atol=1e-9,
+                                                              hill=False))), 10)
         d = np.max(np.abs(np.sort(np.abs(h.multipliers)) - np.sort(np.abs(h.hill_multipliers))))
         print(f"N = {N:2d}: Hill's-method check adds {(t_h - t_n) * 1e3:.1f} ms "
               f"(HB + RK45 Floquet {t_n * 1e3:.2f} ms); moduli agree to {d:.1e}")
     t0 = time.perf_counter()
     mult = scipy_point()
     t_sp = time.perf_counter() - t0
-    t6, _ = median_time(lambda: ballbal.periodic(b, "R-R", N=6, guess=seed, rtol=1e-6,
-                                                 hill=False, floquet_method="magnus"), 30)
+    t6, _ = median_time(lambda: ballbal.periodic(b, "R-R", N=6, guess=seed,
+                                                 options=ballbal.PeriodicOptions(
+                                                     floquet=ballbal.Floquet(rtol=1e-6, hill=False,
+                                                                             method="magnus"))), 30)
     print(f"scipy shooting + finite-difference monodromy: {t_sp * 1e3:.0f} ms "
           f"(max modulus {np.sort(np.abs(mult))[-2]:.4f}); ballbal N = 6 (Magnus): "
           f"{t6 * 1e6:.0f} us; ratio {t_sp / t6:.0f}")

@@ -54,7 +54,7 @@ FINE = {"Omega": (1.0, 2.0, 0.01), "eta": (0.4, 1.5, 0.01)}
 ALL = ("R-R", "O-O", "R-O")
 
 CHILD = r"""
-import json, sys, time
+import dataclasses, json, sys, time
 import ballbal
 from ballbal import _native
 grid, pats, N, zb, repeat = json.loads(sys.argv[1])
@@ -81,13 +81,17 @@ if stages is not None and not light:
     s1 = stages()
     out["stages"] = [y - x for x, y in zip(s0, s1)] + [total]
     t = time.perf_counter()
-    ballbal.scan(b, patterns=pats, N=N, threads=1, floquet=False, **grid)
+    fl = ballbal.options.SCAN_DEFAULTS.floquet
+    def floquet(**changes):
+        return ballbal.ScanOptions(floquet=dataclasses.replace(fl, **changes))
+    ballbal.scan(b, patterns=pats, N=N, threads=1, options=floquet(monodromy=False), **grid)
     out["no_floquet"] = time.perf_counter() - t
     t = time.perf_counter()
-    ballbal.scan(b, patterns=pats, N=N, threads=1, hill=True, **grid)
+    ballbal.scan(b, patterns=pats, N=N, threads=1, options=floquet(hill=True, hill_band=None),
+                 **grid)
     out["hill"] = time.perf_counter() - t
     t = time.perf_counter()
-    ballbal.scan(b, patterns=pats, N=N, threads=1, hill=False, **grid)
+    ballbal.scan(b, patterns=pats, N=N, threads=1, options=floquet(hill=False), **grid)
     out["no_hill"] = time.perf_counter() - t
 prof = getattr(_native, "scan_profile", None)
 if prof is not None:

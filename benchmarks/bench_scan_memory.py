@@ -37,12 +37,15 @@ import sys
 import tempfile
 
 CHILD = r"""
-import json, resource, sys, time
+import dataclasses, json, resource, sys, time
 import numpy as np, polars as pl, ballbal
 side, mode, setting, out = int(sys.argv[1]), sys.argv[2], sys.argv[3], sys.argv[4]
 grid = dict(Omega=np.linspace(1.0, 2.0, side), eta=np.linspace(0.4, 1.5, side))
 seeds = 2 if setting == "solved" else 1
-kw = dict(patterns=["R-R"], floquet=False, seeds=seeds, starts=seeds, threads=2, **grid)
+d = ballbal.options.SCAN_DEFAULTS
+options = ballbal.ScanOptions(floquet=dataclasses.replace(d.floquet, monodromy=False),
+                              guess=dataclasses.replace(d.guess, seeds=seeds, starts=seeds))
+kw = dict(patterns=["R-R"], options=options, threads=2, **grid)
 model = ballbal.Balancer(zeta_b=0.1)
 if setting == "floquet":
     kw = dict(patterns=["R-R"], N=3, threads=2, **grid)

@@ -32,9 +32,13 @@ def main() -> None:
     y0 = np.array([0.1, 0.0, 0.3, 2.0, 0.0, 0.0, -1.2, -1.2])
     t = np.linspace(0, 1000, 2001)
     sim = best_time(lambda: ballbal.simulate(b, y0, t, rtol=1e-8, atol=1e-10))
-    seed = ballbal.periodic(b.replace(Omega=1.19), "R-R", N=12, hill=False)
-    hb = {N: best_time(lambda N=N: ballbal.periodic(b, "R-R", N=N, guess=seed, floquet=False,
-                                                      hill=False), 40) for N in (3, 8)}
+    seed = ballbal.periodic(b.replace(Omega=1.19), "R-R", N=12,
+                            options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
+    hb = {N: best_time(lambda N=N: ballbal.periodic(b, "R-R", N=N, guess=seed,
+                                                    options=ballbal.PeriodicOptions(
+                                                        floquet=ballbal.Floquet(
+                                                            monodromy=False, hill=False))), 40)
+          for N in (3, 8)}
     # right-hand sides the integrator evaluated: time per evaluation, all else included
     evals = ballbal.simulate(b, y0, t, rtol=1e-8, atol=1e-10, stats=True)[1]["nfev"]
     print(f"ballbal {ballbal.__version__}: planar balancer")
@@ -46,9 +50,13 @@ def main() -> None:
         sc = ballbal.Scene(balancer=b, springs=1e-5)
         ssim = best_time(lambda: ballbal.simulate(sc, y0, t, rtol=1e-8, atol=1e-10))
         near = ballbal.Scene(balancer=b.replace(Omega=1.19), springs=1e-5)
-        sseed = ballbal.periodic(near, "R-R", N=12, guess=seed, hill=False)
+        sseed = ballbal.periodic(near, "R-R", N=12, guess=seed,
+                                 options=ballbal.PeriodicOptions(
+                                     floquet=ballbal.Floquet(hill=False)))
         shb = best_time(lambda: ballbal.periodic(sc, "R-R", N=8, guess=sseed,
-                                                   floquet=False, hill=False), 40)
+                                                 options=ballbal.PeriodicOptions(
+                                                     floquet=ballbal.Floquet(monodromy=False,
+                                                                             hill=False))), 40)
         print("scene with ball springs (k_d / k = 1e-5):")
         print(f"  simulate 1000 time units (rtol 1e-8):  {ssim * 1e3:8.3f} ms "
               f"({ssim / sim:.2f} x planar)")
@@ -60,9 +68,13 @@ def main() -> None:
         ts = ballbal.Scene(balancer=b, tilt=tl)
         ty0 = np.concatenate([y0[:2], [0.0, 0.0], y0[2:6], [0.0, 0.0], y0[6:]])
         tsim = best_time(lambda: ballbal.simulate(ts, ty0, t, rtol=1e-8, atol=1e-10))
-        tseed = ballbal.periodic(ts.replace(Omega=1.19), "R-R", N=12, hill=False)
+        tseed = ballbal.periodic(ts.replace(Omega=1.19), "R-R", N=12,
+                                 options=ballbal.PeriodicOptions(
+                                     floquet=ballbal.Floquet(hill=False)))
         thb = best_time(lambda: ballbal.periodic(ts, "R-R", N=8, guess=tseed,
-                                                   floquet=False, hill=False), 40)
+                                                 options=ballbal.PeriodicOptions(
+                                                     floquet=ballbal.Floquet(monodromy=False,
+                                                                             hill=False))), 40)
         grid = np.linspace(0.5, 3.0, 200)
         tmap = best_time(lambda: ballbal.balance_map(ts, Omega=grid), 5)
         print("tilting disk on a flexible shaft (seed 004):")

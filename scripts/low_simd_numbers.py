@@ -70,7 +70,8 @@ def libm_checksums() -> None:
 def periodic_numbers(b: Any, tag: str, N: int, guess: Any) -> Any:
     import ballbal
 
-    sol = ballbal.periodic(b, "R-R", N=N, guess=guess, hill=True)
+    sol = ballbal.periodic(b, "R-R", N=N, guess=guess,
+                           options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=True)))
     print(f"# {tag}: status {sol.status}, iterations {sol.iterations}, "
           f"start {sol.info.get('guess_source')}")
     emit(f"{tag}.omega", sol.omega if sol.omega is not None else np.nan)

@@ -63,9 +63,10 @@ def test_periodic_bounds_the_parameters_of_its_start_search():
                                           rtol=[], magnus_rtol=[], base_N=3,
                                           reference_N=4), "Omega")
     # with a guess there is no search, and no bound: Newton runs (whatever it finds)
-    opts = dict(N=3, hill=False, floquet=False, max_iter=5)
-    s = ballbal.periodic(Balancer(), "R-R", **opts)
-    r = ballbal.periodic(Balancer(Omega=31.0), "R-R", guess=s, **opts)
+    opts = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(max_iter=5),
+                                   floquet=ballbal.Floquet(monodromy=False, hill=False))
+    s = ballbal.periodic(Balancer(), "R-R", N=3, options=opts)
+    r = ballbal.periodic(Balancer(Omega=31.0), "R-R", N=3, guess=s, options=opts)
     assert isinstance(r, ballbal.PeriodicSolution) and r.info["guess_source"] == "guess"
 
 

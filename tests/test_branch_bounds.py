@@ -58,7 +58,8 @@ def _check_rows(br: ballbal.continuation.Branch) -> None:
 
 @cache
 def across_the_period_doubling() -> ballbal.continuation.Branch:
-    s = ballbal.periodic(replace(ISSUE, Omega=1.30), "R-R", N=3, refine=False)
+    s = ballbal.periodic(replace(ISSUE, Omega=1.30), "R-R", N=3,
+                         options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
     return periodic_branch(s, "Omega", range=(1.30, 1.42),
                            options=Continuation(ds=0.02, ds_max=0.02, max_points=80))
 
@@ -84,7 +85,8 @@ def test_the_issues_point_on_a_branch_is_unstable_or_undetermined() -> None:
     """A branch started at the issue's Omega and continued down into the unstable side,
     its points within 1e-4 of the crossing: each verdict is the shooting's or
     undetermined, and where a bound was computed it holds."""
-    s = ballbal.periodic(ISSUE, "R-R", N=3, refine=False)
+    s = ballbal.periodic(ISSUE, "R-R", N=3,
+                         options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
     br = periodic_branch(s, "Omega", range=(1.3584, ISSUE.Omega),
                          options=Continuation(ds=1e-5, ds_max=1e-5, forward=False,
                                               max_points=4))

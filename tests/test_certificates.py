@@ -5,6 +5,7 @@ closed form."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -78,20 +79,25 @@ def test_not_closed_series_is_no_orbit_by_simulation():
     assert simulated_closure(prev) > 1.0
 
 
-@pytest.mark.parametrize(("kw", "name"), [
-    ({"rtol": 1e300}, "rtol"), ({"rtol": 1.0}, "rtol"), ({"rtol": 0.0}, "rtol"),
-    ({"atol": -1.0}, "atol"), ({"margin": -1e-3}, "margin"), ({"margin": math.nan}, "margin"),
-    ({"tol": math.nan}, "tol"), ({"step_tol": -1.0}, "step_tol"),
-    ({"N": "auto", "target": 2.0}, "target"), ({"N": "auto", "target": math.nan}, "target"),
-    ({"settle": 1e300}, "settle"), ({"window": math.inf}, "window"),
-    ({"max_closure": -1.0}, "max_closure"), ({"max_trivial": math.nan}, "max_trivial"),
+@pytest.mark.parametrize(("make", "name"), [
+    (lambda: ballbal.Floquet(rtol=1e300), "rtol"), (lambda: ballbal.Floquet(rtol=1.0), "rtol"),
+    (lambda: ballbal.Floquet(rtol=0.0), "rtol"), (lambda: ballbal.Floquet(atol=-1.0), "atol"),
+    (lambda: ballbal.Floquet(margin=-1e-3), "margin"),
+    (lambda: ballbal.Floquet(margin=math.nan), "margin"),
+    (lambda: ballbal.HarmonicBalance(tol=math.nan), "tol"),
+    (lambda: ballbal.HarmonicBalance(step_tol=-1.0), "step_tol"),
+    (lambda: ballbal.HarmonicBalance(N="auto", target=2.0), "target"),
+    (lambda: ballbal.HarmonicBalance(N="auto", target=math.nan), "target"),
+    (lambda: ballbal.GuessSearch(settle=1e300), "settle"),
+    (lambda: ballbal.GuessSearch(window=math.inf), "window"),
+    (lambda: ballbal.PeriodicOptions(max_closure=-1.0), "max_closure"),
+    (lambda: ballbal.Floquet(max_trivial=math.nan), "max_trivial"),
 ])
-def test_tolerances_outside_their_ranges_are_refused(kw, name):
+def test_tolerances_outside_their_ranges_are_refused(make, name):
     # Before: rtol=1e300 answered "unstable" with a multiplier of 2.4e11, settle=1e300
-    # ran for minutes.
-    b = ballbal.Balancer(**REPRO, Omega=1.2, eta=(1.0, 1.0))
+    # ran for minutes. Refused when the option is made, before any solve.
     with pytest.raises(ParameterError) as e:
-        ballbal.periodic(b, "R-R", **kw)
+        make()
     assert e.value.parameter == name
 
 
@@ -117,7 +123,9 @@ def test_merged_balls_separation_product_is_exp_minus_two_zeta_b_t():
     zeta_b = 0.05
     b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=zeta_b, delta=50.0, Omega=1.2,
                          eta=(1.0, 1.0))
-    s = ballbal.periodic(b, "R-R", N=10, rtol=1e-10, atol=1e-12)
+    s = ballbal.periodic(b, "R-R", N=10,
+                         options=ballbal.PeriodicOptions(
+                             floquet=ballbal.Floquet(rtol=1e-10, atol=1e-12)))
     assert s.converged and np.allclose(s.coeffs[2], s.coeffs[3], atol=1e-10)
     assert s.separation_error is not None and s.separation_error < 1e-6
     exact = math.exp(-2 * zeta_b * s.period)
@@ -145,7 +153,9 @@ def test_scan_rows_are_certified():
     b = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
     # refine=False: the N = 3 rows themselves (the verdict's bound refines these to N = 5).
     df = ballbal.scan(b, Omega=(1.0, 1.2, 0.1), eta=(0.6, 1.1, 0.1), patterns=["R-R"],
-                      refine=False)
+                      options=ballbal.ScanOptions(
+                          floquet=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.floquet,
+                                                      refine=False)))
     assert {"closure", "separation_error"} <= set(df.columns)
     ok = df.filter(df["status"] == "converged")
     assert ok.height >= 10
@@ -156,7 +166,8 @@ def test_scan_rows_are_certified():
     # independent: the slowest rows reported as orbits close under scipy simulation
     for row in ok.sort("omega").head(3).iter_rows(named=True):
         s = ballbal.periodic(b.replace(Omega=row["Omega"], eta=(row["eta"],) * 2), "R-R",
-                             N=3, rtol=1e-6, atol=1e-9, refine=False)
+                             N=3, options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(
+                                 rtol=1e-6, atol=1e-9, refine=False)))
         assert s.converged and abs(s.omega - row["omega"]) < 1e-6
         assert simulated_closure(s, rtol=1e-9) < 0.75
 
@@ -169,14 +180,16 @@ def test_scan_certificate_thresholds_are_options():
     kw = dict(Omega=[1.1, 1.2], eta=[0.9, 1.0], patterns=["R-R"], threads=1)
     default = ballbal.scan(b, **kw)
     assert (default["status"] == "converged").sum() >= 3
-    tight = ballbal.scan(b, max_closure=1e-12, **kw)
+    d = ballbal.options.SCAN_DEFAULTS
+    tight = ballbal.scan(b, options=dataclasses.replace(d, max_closure=1e-12), **kw)
     assert (tight["status"] == "converged").sum() == 0
-    verdictless = ballbal.scan(b, max_trivial=1e-14, **kw)
+    verdictless = ballbal.scan(b, options=dataclasses.replace(
+        d, floquet=dataclasses.replace(d.floquet, max_trivial=1e-14)), **kw)
     ok = verdictless.filter(verdictless["status"] == "converged")
     assert ok.height == (default["status"] == "converged").sum()
     assert (ok["stability"] == "undetermined").all()
     with pytest.raises(ParameterError) as info:
-        ballbal.scan(b, max_trivial=2.0, **kw)
+        dataclasses.replace(d.floquet, max_trivial=2.0)
     assert info.value.parameter == "max_trivial"
 
 
@@ -197,7 +210,9 @@ def test_random_continuation_paths_are_certified(p):
     eta = (p["eta"], p["eta"]) if p["equal"] else (p["eta"], 0.9 * p["eta"])
     b = ballbal.Balancer(mu=p["mu"], zeta=p["zeta"], zeta_b=p["zeta_b"], delta=p["delta"],
                          Omega=p["start"], eta=eta)
-    s = ballbal.periodic(b, "R-R", N=p["N"], settle=800, window=1500)
+    s = ballbal.periodic(b, "R-R", N=p["N"],
+                         options=ballbal.PeriodicOptions(
+                             guess=ballbal.GuessSearch(settle=800, window=1500)))
     assume(s.omega is not None)
     W = p["start"]
     for dw in [0.0, *p["steps"]]:
@@ -216,8 +231,11 @@ def test_random_continuation_paths_are_certified(p):
         if s.max_modulus is not None and s.max_modulus < 2 and s.period < 250:
             assert simulated_closure(s, rtol=1e-9) < 0.75, (W, s.omega, s.closure)
         # the verdict does not flip under much tighter tolerances
-        t = ballbal.periodic(b.replace(Omega=W), "R-R", N=p["N"], guess=s, rtol=1e-10,
-                             atol=1e-12, tol=1e-12, step_tol=1e-10)
+        t = ballbal.periodic(b.replace(Omega=W), "R-R", N=p["N"], guess=s,
+                             options=ballbal.PeriodicOptions(
+                                 harmonic_balance=ballbal.HarmonicBalance(tol=1e-12,
+                                                                          step_tol=1e-10),
+                                 floquet=ballbal.Floquet(rtol=1e-10, atol=1e-12)))
         if t.converged and abs(t.omega - s.omega) < 1e-6:
             assert {t.stability, s.stability} != {"stable", "unstable"}
 
@@ -248,11 +266,13 @@ def test_auto_harmonics_from_a_non_orbit_certifies_after_refinement():
         # refine=False: the N = 8 series, which the verdict's bound would raise to an
         # orbit at N = 18.
         prev = ballbal.periodic(b.replace(Omega=W), "R-R", N=8, guess=prev,
-                                max_closure=1e300, refine=False)
+                                options=ballbal.PeriodicOptions(
+                                    floquet=ballbal.Floquet(refine=False), max_closure=1e300))
     assert prev.converged and simulated_closure(prev, rtol=1e-9) > 1.0  # certificate off
     outcomes = set()
     for W in (0.92, 0.915, 0.9):
-        s = ballbal.periodic(b.replace(Omega=W), "R-R", N="auto", guess=prev, hill=False)
+        s = ballbal.periodic(b.replace(Omega=W), "R-R", N="auto", guess=prev,
+                             options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
         check_verdict(s)
         outcomes.add(s.converged)
         if s.converged:

@@ -35,6 +35,14 @@ def raises(exc: type[BaseException], parameter: str, f: Any, *args: Any,
     return e
 
 
+#: The option class that holds each option (the options are passed as these).
+OPTION = {"max_iter": bb.HarmonicBalance, "N_max": bb.HarmonicBalance,
+          "samples": bb.HarmonicBalance, "tol": bb.HarmonicBalance,
+          "step_tol": bb.HarmonicBalance, "target": bb.HarmonicBalance,
+          "max_steps": bb.Floquet, "rtol": bb.Floquet, "margin": bb.Floquet,
+          "seeds": bb.GuessSearch, "starts": bb.GuessSearch, "settle": bb.GuessSearch,
+          "window": bb.GuessSearch}
+
 # --- counts: negative values were OverflowError, non-integers were truncated ---------
 
 @pytest.mark.parametrize("kw", ["max_iter", "max_steps", "N_max", "samples"])
@@ -42,7 +50,7 @@ def raises(exc: type[BaseException], parameter: str, f: Any, *args: Any,
 def test_periodic_counts(kw: str, value: Any) -> None:
     exc = ParameterTypeError if not isinstance(value, int) or isinstance(value, bool) \
         else ParameterError
-    raises(exc, kw, bb.periodic, B, "R-R", floquet=False, **{kw: value})
+    raises(exc, kw, OPTION[kw], **{kw: value})
 
 
 @pytest.mark.parametrize("value", [-1, 0, 257, 2.0, True])
@@ -54,7 +62,10 @@ def test_periodic_N(value: Any) -> None:
                                 "max_steps", "samples"])
 @pytest.mark.parametrize("value", [-1, 1.5, False])
 def test_scan_counts(kw: str, value: Any) -> None:
-    raises(ParameterError, kw, bb.scan, B, Omega=[1.2], **{kw: value})
+    if kw in OPTION:  # refused when the option is made
+        raises(ParameterError, kw, OPTION[kw], **{kw: value})
+    else:
+        raises(ParameterError, kw, bb.scan, B, Omega=[1.2], **{kw: value})
 
 
 def test_scan_threads_upper_bound() -> None:
@@ -67,7 +78,7 @@ def test_scan_threads_upper_bound() -> None:
                                 "target"])
 @pytest.mark.parametrize("value", ["abc", None, [1e-8]])
 def test_periodic_reals(kw: str, value: Any) -> None:
-    raises(ParameterTypeError, kw, bb.periodic, B, "R-R", N="auto", **{kw: value})
+    raises(ParameterTypeError, kw, OPTION[kw], **{kw: value})
 
 
 @pytest.mark.parametrize("kw", ["rtol", "atol", "t0"])
@@ -163,7 +174,8 @@ def test_simulate_huge_span_ends_at_the_budget() -> None:
 
 @pytest.mark.parametrize("pattern", ["RR", "r-r", " R-R ", "R_R", "R--R"])
 def test_pattern_canonical_form(pattern: str) -> None:
-    e = raises(ParameterError, "pattern", bb.periodic, B, pattern, floquet=False)
+    e = raises(ParameterError, "pattern", bb.periodic, B, pattern,
+               options=bb.PeriodicOptions(floquet=bb.Floquet(monodromy=False)))
     assert '"R-R"' in str(e)  # shows the canonical form
 
 

@@ -26,7 +26,8 @@ def solutions():
     out = {}
     for om, eta, pattern in POINTS:
         b = ballbal.Balancer(**THESIS, Omega=om, eta=(eta, eta))
-        s = ballbal.periodic(b, pattern, N=3, hill=False)
+        s = ballbal.periodic(b, pattern, N=3,
+                             options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
         assert s.converged, (om, eta, pattern, s.status)
         out[om, eta, pattern] = (b, s)
     return out
@@ -37,11 +38,14 @@ def solutions():
 def test_magnus_matches_tight_rk45(solutions, point, N):
     b, s3 = solutions[point]
     pattern = point[2]
-    tight = ballbal.periodic(b, pattern, N=N, guess=s3, rtol=1e-11, atol=1e-13, hill=False)
+    tight = ballbal.periodic(b, pattern, N=N, guess=s3,
+                             options=ballbal.PeriodicOptions(
+                                 floquet=ballbal.Floquet(rtol=1e-11, atol=1e-13, hill=False)))
     assert tight.converged
     for rtol in (1e-6, 1e-8):
-        m = ballbal.periodic(b, pattern, N=N, guess=s3, rtol=rtol, hill=False,
-                             floquet_method="magnus")
+        m = ballbal.periodic(b, pattern, N=N, guess=s3,
+                             options=ballbal.PeriodicOptions(
+                                 floquet=ballbal.Floquet(rtol=rtol, hill=False, method="magnus")))
         # the same series: Newton does not see the Floquet method
         assert m.omega == tight.omega
         assert m.multipliers is not None and m.info["floquet_error"] is None
@@ -51,8 +55,9 @@ def test_magnus_matches_tight_rk45(solutions, point, N):
             m.stability, tight.stability)
         # and the scan's RK45 setting needs several times the steps for less accuracy
         if rtol == 1e-6:
-            rk = ballbal.periodic(b, pattern, N=N, guess=s3, rtol=1e-6, atol=1e-9,
-                                  hill=False)
+            rk = ballbal.periodic(b, pattern, N=N, guess=s3,
+                                  options=ballbal.PeriodicOptions(
+                                      floquet=ballbal.Floquet(rtol=1e-6, atol=1e-9, hill=False)))
             assert match_error(rk.multipliers, tight.multipliers) > err
             assert rk.floquet_steps > 2 * m.floquet_steps
 
@@ -103,8 +108,9 @@ def shooting_multipliers(b, y0, T, h=1e-6):
 
 def test_magnus_against_shooting_on_the_standard_case(solutions):
     b, s3 = solutions[1.2, 1.0, "R-R"]
-    s = ballbal.periodic(b, "R-R", N=12, guess=s3, rtol=1e-9, floquet_method="magnus",
-                         hill=False)
+    s = ballbal.periodic(b, "R-R", N=12, guess=s3,
+                         options=ballbal.PeriodicOptions(
+                             floquet=ballbal.Floquet(rtol=1e-9, method="magnus", hill=False)))
     y0, T = s.state(0.0), s.period
     shift = np.zeros(8)
     shift[2:4] = -2 * np.pi
@@ -118,9 +124,11 @@ def test_magnus_against_shooting_on_the_hard_case(solutions):
     b, s3 = solutions[1.0, 0.7, "R-R"]
     s = s3
     for N in (8, 16, 24):
-        s = ballbal.periodic(b, "R-R", N=N, guess=s, hill=False)
-    m = ballbal.periodic(b, "R-R", N=24, guess=s, rtol=1e-8, floquet_method="magnus",
-                         hill=False)
+        s = ballbal.periodic(b, "R-R", N=N, guess=s,
+                             options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
+    m = ballbal.periodic(b, "R-R", N=24, guess=s,
+                         options=ballbal.PeriodicOptions(
+                             floquet=ballbal.Floquet(rtol=1e-8, method="magnus", hill=False)))
     assert 106 < m.period < 107 and m.trivial_error < 1e-5
     y0, T = m.state(0.0), m.period
     shift = np.zeros(8)
@@ -132,8 +140,9 @@ def test_magnus_against_shooting_on_the_hard_case(solutions):
 
 def test_magnus_step_budget_gives_no_verdict(solutions):
     b, s3 = solutions[1.0, 0.7, "R-R"]
-    s = ballbal.periodic(b, "R-R", N=8, guess=s3, floquet_method="magnus", max_steps=20,
-                         hill=False)
+    s = ballbal.periodic(b, "R-R", N=8, guess=s3,
+                         options=ballbal.PeriodicOptions(
+                             floquet=ballbal.Floquet(method="magnus", max_steps=20, hill=False)))
     assert s.converged and s.multipliers is None
     assert "max_steps" in s.info["floquet_error"]
     assert s.stability == "undetermined"
@@ -144,19 +153,22 @@ def test_loose_magnus_never_gives_the_opposite_verdict(solutions, point):
     """At rtol 0.3 the grids are coarse and the estimated error large: it widens the
     margin, so the verdict is the tight one or undetermined, never the opposite."""
     b, s3 = solutions[point]
-    tight = ballbal.periodic(b, point[2], N=8, guess=s3, rtol=1e-11, atol=1e-13,
-                             hill=False)
-    loose = ballbal.periodic(b, point[2], N=8, guess=s3, rtol=0.3,
-                             floquet_method="magnus", hill=False)
+    tight = ballbal.periodic(b, point[2], N=8, guess=s3,
+                             options=ballbal.PeriodicOptions(
+                                 floquet=ballbal.Floquet(rtol=1e-11, atol=1e-13, hill=False)))
+    loose = ballbal.periodic(b, point[2], N=8, guess=s3,
+                             options=ballbal.PeriodicOptions(
+                                 floquet=ballbal.Floquet(rtol=0.3, method="magnus", hill=False)))
     assert loose.stability in (tight.stability, "undetermined")
 
 
 def test_method_option_is_checked():
     b = ballbal.Balancer()
     with pytest.raises(ParameterError) as e:
-        ballbal.periodic(b, "R-R", N=3, floquet_method="euler")
-    # the keyword the call used (its options object is made, and checked, from it)
-    assert e.value.parameter == "floquet_method"
+        ballbal.periodic(b, "R-R", N=3,
+                         options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(method="euler")))
+    # the field of the option that holds it
+    assert e.value.parameter == "method"
     with pytest.raises(ParameterTypeError) as e:
         ballbal.Floquet(method=3)  # type: ignore[arg-type]
     assert e.value.parameter == "method"

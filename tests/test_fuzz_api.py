@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import collections
 import contextlib
+import dataclasses
 import math
 import re
 import signal
@@ -307,9 +308,37 @@ def test_periodic(model: Any, pattern: Any, kw: dict[str, Any]) -> None:
     kw.setdefault("window", 20.0)
     kw.setdefault("max_steps", 2000)
     kw.setdefault("max_iter", 5)
-    s = check(bb.periodic, model, pattern, **kw)
+    options = built_options(bb.PeriodicOptions(), kw)
+    if isinstance(options, BallbalError):
+        return
+    s = check(bb.periodic, model, pattern, options=options, **kw)
     if isinstance(s, bb.PeriodicSolution):
         assert s.status in ("converged",) or s.omega is None
+
+
+#: Where each fuzzed option keyword goes in the option classes.
+OPTION_FIELDS = {
+    "harmonic_balance": ("target", "N_max", "samples", "tol", "step_tol", "max_iter"),
+    "floquet": ("hill", "rtol", "atol", "margin", "max_steps", "monodromy"),
+    "guess": ("settle", "window", "seeds", "starts"),
+}
+
+
+def built_options(base: Any, kw: dict[str, Any]) -> Any:
+    """``base`` with the option keywords taken out of ``kw`` set in its parts (``floquet``
+    is ``Floquet.monodromy``), built under ``check`` (their own checks are part of what
+    is fuzzed): the options, or the ballbal error that refused them."""
+    if "floquet" in kw:
+        kw["monodromy"] = kw.pop("floquet")
+    parts = {part: {k: kw.pop(k) for k in names if k in kw}
+             for part, names in OPTION_FIELDS.items()}
+    top = {k: kw.pop(k) for k in ("max_tail",) if k in kw}
+    for part, changes in parts.items():
+        if changes:
+            top[part] = check(dataclasses.replace, getattr(base, part), **changes)
+            if isinstance(top[part], BallbalError):
+                return top[part]
+    return check(dataclasses.replace, base, **top)
 
 
 GRID_VALUES = st.one_of(
@@ -336,7 +365,10 @@ def test_scan(model: Any, axes: dict[str, Any], kw: dict[str, Any]) -> None:
     kw.setdefault("max_steps", 1000)
     kw.setdefault("seeds", 1)
     kw.setdefault("starts", 1)
-    check(bb.scan, model, grid=axes, **kw)
+    options = built_options(bb.options.SCAN_DEFAULTS, kw)
+    if isinstance(options, BallbalError):
+        return
+    check(bb.scan, model, grid=axes, options=options, **kw)
 
 
 @FEW
@@ -427,8 +459,11 @@ SCAN_OPTIONS = dict(
            lambda k: SCAN_OPTIONS[k].map(lambda v: {k: v})))
 def test_scan_one_option(model: bb.Balancer, omegas: list[float], kw: dict[str, Any]) -> None:
     """A tiny valid scan with one option fuzzed: the valid paths are reached too."""
-    r = check(bb.scan, model, Omega=omegas, threads=1, settle=3.0, window=10.0,
-              **{"max_steps": 2000, **kw})
+    kw = {"settle": 3.0, "window": 10.0, "max_steps": 2000, **kw}
+    options = built_options(bb.options.SCAN_DEFAULTS, kw)
+    if isinstance(options, BallbalError):
+        return
+    r = check(bb.scan, model, Omega=omegas, threads=1, options=options, **kw)
     if not isinstance(r, BaseException):
         assert set(r["Omega"].to_list()) <= set(omegas)
 

@@ -20,6 +20,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_api import BAD, FUZZ, NAMES, check, count, kwargs, num, sometimes
 
+import ballbal
 import ballbal as bb
 from ballbal import _check, data, spectrum
 from ballbal import bearing as br
@@ -294,7 +295,9 @@ def solutions() -> dict[str, Any]:
     """A converged periodic solution, an unconverged one, an equilibrium, a simulation."""
     b = bb.Balancer()
     return {"converged": bb.periodic(b, "R-R", N=3),
-            "failed": bb.periodic(b, "R-R", N=3, max_iter=1),
+            "failed": bb.periodic(b, "R-R", N=3,
+                                  options=ballbal.PeriodicOptions(
+                                      harmonic_balance=ballbal.HarmonicBalance(max_iter=1))),
             "equilibrium": bb.equilibria(b)[0],
             "simulation": bb.simulate(b, t_span=(0.0, 20.0), t_eval=np.arange(0, 20, 0.05))}
 

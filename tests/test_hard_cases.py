@@ -1,6 +1,7 @@
 """Hard parameter points (issue 5): each asserts the right answer from an independent
 method (time simulation of the orbit, Hill's method, closed forms) or a clean status."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -20,25 +21,33 @@ def genuine(s, closure=1e-6):
 
 
 def test_thesis_hard_case_auto_N_meets_its_target():
-    s = ballbal.periodic(HARD, "R-R", N="auto", target=1e-7)
+    s = ballbal.periodic(HARD, "R-R", N="auto",
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(target=1e-7)))
     assert s.target_met and s.N >= 8
     assert s.trivial_error < 1e-7
     # the thesis' period and an independent closure check by time simulation
     assert abs(2 * math.pi / s.omega - 106.5) < 0.1
     assert genuine(s, 1e-7)
-    low = ballbal.periodic(HARD, "R-R", N=3, guess=s, refine=False)
+    low = ballbal.periodic(HARD, "R-R", N=3, guess=s,
+                           options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
     assert abs(abs(low.multipliers[0]) - 1.1808) < 2e-3  # thesis table 3-1, N = 3
 
 
 def test_auto_N_stays_low_where_the_point_is_easy():
-    s = ballbal.periodic(STD, "R-R", N="auto", target=1e-5)
-    h = ballbal.periodic(HARD, "R-R", N="auto", target=1e-5)
+    s = ballbal.periodic(STD, "R-R", N="auto",
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(target=1e-5)))
+    h = ballbal.periodic(HARD, "R-R", N="auto",
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(target=1e-5)))
     assert s.target_met and h.target_met and s.N < h.N
 
 
 def test_scan_with_auto_N_adapts_point_by_point():
     df = ballbal.scan(STD.replace(eta=(0.7, 0.7)), Omega=[1.0, 1.05, 1.2], N="auto",
-                      target=1e-6)
+                      options=ballbal.ScanOptions(harmonic_balance=dataclasses.replace(
+                          ballbal.options.SCAN_DEFAULTS.harmonic_balance, target=1e-6)))
     n = dict(zip(df["Omega"], df["N"], strict=True))
     assert df["target_met"].all()
     assert n[1.0] > n[1.2]
@@ -47,7 +56,9 @@ def test_scan_with_auto_N_adapts_point_by_point():
 @pytest.mark.parametrize(("Omega", "eta"), [(1.0, 1.0), (1.0, 0.7), (1.2, 3.0)])
 def test_omega_exactly_one_and_large_eta(Omega, eta):
     b = STD.replace(Omega=Omega, eta=(eta, eta))
-    s = ballbal.periodic(b, "R-R", N="auto", target=1e-6)
+    s = ballbal.periodic(b, "R-R", N="auto",
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(target=1e-6)))
     # the tail measures coefficients; the state's error is a few times larger
     assert genuine(s, 1e-5), (s.status, s.omega)
     assert not s.verdicts_disagree
@@ -66,7 +77,9 @@ def test_far_above_resonance(Omega):
     # the balls sit at +-arccos(-1/(2 eta)), in either order, modulo whole turns
     ends = sorted(abs(math.remainder(end[k], 2 * math.pi)) for k in ("b1", "b2"))
     assert np.allclose(ends, abs(pb.q[2]), atol=1e-3), (ends, pb.q)
-    s = ballbal.periodic(b, "R-R", settle=500, window=800)
+    s = ballbal.periodic(b, "R-R",
+                         options=ballbal.PeriodicOptions(
+                             guess=ballbal.GuessSearch(settle=500, window=800)))
     assert s.status == "no_guess" or genuine(s)
 
 
@@ -99,7 +112,9 @@ def test_very_light_damping_verdict_is_right_or_undetermined():
     assert not s.verdicts_disagree
     if s.stability != "undetermined":
         assert s.stability == hill or hill == "undetermined"
-    tight = ballbal.periodic(b, "R-R", N=24, guess=s, rtol=1e-11, atol=1e-13)
+    tight = ballbal.periodic(b, "R-R", N=24, guess=s,
+                             options=ballbal.PeriodicOptions(
+                                 floquet=ballbal.Floquet(rtol=1e-11, atol=1e-13)))
     assert {s.stability, tight.stability} != {"stable", "unstable"}
 
 
@@ -135,15 +150,17 @@ def test_long_period_monodromy_keeps_its_accuracy():
     b = HARD
     s = ballbal.periodic(b, "R-R", N=16)
     for om in (0.99, 0.98, 0.976, 0.9715):
-        s = ballbal.periodic(b.replace(Omega=om), "R-R", N=48, guess=s, hill=False)
+        s = ballbal.periodic(b.replace(Omega=om), "R-R", N=48, guess=s,
+                             options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
         assert s.converged, (om, s.status)
     assert s.omega < 0.035 and s.period > 175
     assert s.floquet_steps is not None and s.floquet_steps < 20_000
     assert s.trivial_error < 1e-9
     assert genuine(s, 1e-7)
     # a step budget too small ends in a message and an undetermined verdict, not a hang
-    cut = ballbal.periodic(b.replace(Omega=0.9715), "R-R", N=48, guess=s, max_steps=100,
-                           hill=False)
+    cut = ballbal.periodic(b.replace(Omega=0.9715), "R-R", N=48, guess=s,
+                           options=ballbal.PeriodicOptions(
+                               floquet=ballbal.Floquet(max_steps=100, hill=False)))
     assert cut.converged and cut.stability == "undetermined"
     assert "max_steps" in cut.info["floquet_error"]
 
@@ -152,7 +169,10 @@ def test_long_period_monodromy_keeps_its_accuracy():
                                            (50.0, 0.9)])
 def test_extreme_but_valid_parameters(delta, mu):
     b = ballbal.Balancer(mu=mu, delta=delta, Omega=1.2, eta=(1.0, 1.0))
-    s = ballbal.periodic(b, "R-R", N="auto", target=1e-6, settle=800, window=1500)
+    s = ballbal.periodic(b, "R-R", N="auto",
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(target=1e-6),
+                             guess=ballbal.GuessSearch(settle=800, window=1500)))
     assert s.status in {"converged", "no_guess", "diverged", "max_iterations", "singular"}
     if s.converged:
         assert genuine(s, 1e-5)
@@ -172,7 +192,11 @@ params = st.fixed_dictionaries({
 def test_random_points_never_lie(p):
     b = ballbal.Balancer(**{**p, "eta": (p["eta"], p["eta"])})
     df = ballbal.scan(b, Omega=[p["Omega"]], eta=[p["eta"]], patterns=["R-R", "O-O"],
-                      N="auto", target=1e-6, hill=True)
+                      N="auto", options=ballbal.ScanOptions(
+                          harmonic_balance=dataclasses.replace(
+                              ballbal.options.SCAN_DEFAULTS.harmonic_balance, target=1e-6),
+                          floquet=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.floquet,
+                                                      hill=True, hill_band=None)))
     ok = df.filter(df["status"] == "converged")
     for c in ("omega", "residual", "max_modulus", "trivial_error"):
         assert ok[c].null_count() == 0 and not ok[c].is_nan().any(), c
@@ -182,8 +206,10 @@ def test_random_points_never_lie(p):
         if row["target_met"]:
             assert row["trivial_error"] <= 1e-4  # max(target, 100 rtol) with rtol 1e-6
         # the verdict survives much tighter tolerances
-        s = ballbal.periodic(b, row["type"], N=row["N"], rtol=1e-10, atol=1e-12,
-                             guess=None if row["type"] != "R-R" else None, settle=800,
-                             window=1500, hill=False)
+        s = ballbal.periodic(b, row["type"], N=row["N"],
+                             guess=None if row["type"] != "R-R" else None,
+                             options=ballbal.PeriodicOptions(
+                                 floquet=ballbal.Floquet(rtol=1e-10, atol=1e-12, hill=False),
+                                 guess=ballbal.GuessSearch(settle=800, window=1500)))
         if s.converged and abs(s.omega - row["omega"]) < 1e-6:
             assert {s.stability, row["stability"]} != {"stable", "unstable"}

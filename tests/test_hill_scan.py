@@ -5,6 +5,7 @@ RK45 at tight tolerances across a thesis map."""
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import subprocess
 import sys
@@ -36,8 +37,10 @@ def _check_against_shooting(b: ballbal.Balancer, s: ballbal.PeriodicSolution) ->
     shift[2:4] = -2 * np.pi
     assert np.max(np.abs(flow(b, y0, T) - y0 - shift)) < 1e-7
     ref = shooting_multipliers(b, y0, T)
-    v = ballbal.periodic(b, "R-R", N=s.N, guess=s, floquet=False, hill=True,
-                         hill_target="verdict")
+    v = ballbal.periodic(b, "R-R", N=s.N, guess=s,
+                         options=ballbal.PeriodicOptions(
+                             floquet=ballbal.Floquet(monodromy=False, hill=True,
+                                                     hill_target="verdict")))
     assert v.hill_multipliers is not None
     lead = _lead(ref)
     # The verdict target stops once its estimate (which bounds the error) is a tenth
@@ -48,16 +51,19 @@ def _check_against_shooting(b: ballbal.Balancer, s: ballbal.PeriodicSolution) ->
 
 def test_verdict_target_against_shooting_on_the_standard_case():
     b = ballbal.Balancer(**THESIS, Omega=1.2, eta=(1.0, 1.0))
-    s = ballbal.periodic(b, "R-R", N=12, hill=False)
+    s = ballbal.periodic(b, "R-R", N=12,
+                         options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
     _check_against_shooting(b, s)
 
 
 def test_verdict_target_against_shooting_on_the_hard_case():
     """Period ~106: the multipliers target needs H = 13 to 15 here; the verdict H = 5."""
     b = ballbal.Balancer(**THESIS, Omega=1.0, eta=(0.7, 0.7))
-    s = ballbal.periodic(b, "R-R", N=3, hill=False)
+    s = ballbal.periodic(b, "R-R", N=3,
+                         options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
     for N in (8, 16, 24):
-        s = ballbal.periodic(b, "R-R", N=N, guess=s, hill=False)
+        s = ballbal.periodic(b, "R-R", N=N, guess=s,
+                             options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
     assert 106 < s.period < 107
     _check_against_shooting(b, s)
 
@@ -73,11 +79,13 @@ def thesis_map() -> dict[str, pl.DataFrame]:
     b = ballbal.Balancer(**THESIS)
     grid = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
     pats = ("R-R", "O-O", "R-O")
-    runs = {"all": dict(hill=True), "default": {},
-            "tight": dict(hill=False, floquet_method="rk45", rtol=1e-10, atol=1e-12,
-                          max_steps=1_000_000)}
-    return {k: ballbal.scan(b, patterns=pats, N=3, **grid, **kw)
-            .filter(pl.col("status") == "converged") for k, kw in runs.items()}
+    fl = ballbal.options.SCAN_DEFAULTS.floquet
+    runs = {"all": dataclasses.replace(fl, hill=True, hill_band=None), "default": fl,
+            "tight": dataclasses.replace(fl, hill=False, method="rk45", rtol=1e-10,
+                                         atol=1e-12, max_steps=1_000_000)}
+    return {k: ballbal.scan(b, patterns=pats, N=3, **grid,
+                            options=ballbal.ScanOptions(floquet=floquet))
+            .filter(pl.col("status") == "converged") for k, floquet in runs.items()}
 
 
 def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map(
@@ -136,27 +144,25 @@ def test_default_scan_cross_checks_the_doubtful_verdicts(
 def test_hill_target_option_is_checked():
     b = ballbal.Balancer()
     with pytest.raises(ParameterError) as e:
-        ballbal.periodic(b, "R-R", N=3, hill_target="eigenvalues")
+        ballbal.periodic(b, "R-R", N=3,
+                         options=ballbal.PeriodicOptions(
+                             floquet=ballbal.Floquet(hill_target="eigenvalues")))
     assert e.value.parameter == "hill_target"
 
 
 def test_hill_band_option() -> None:
-    """``hill=True`` keeps its meaning (Hill beside every monodromy) unless a band is
-    given with it; a band must be a number of at least 0."""
-    from ballbal.options import SCAN_DEFAULTS, SCAN_KEYWORDS, Floquet, with_keywords
+    """A scan cross-checks within its band by default, periodic() every solution; a band
+    must be a number of at least 0."""
+    from ballbal.options import SCAN_DEFAULTS, Floquet
 
-    def band(**kw: object) -> object:
-        return with_keywords(SCAN_DEFAULTS, "scan", kw, SCAN_KEYWORDS).floquet.hill_band
-
-    assert band() == ballbal.options.SCAN_HILL_BAND
-    assert band(hill=True) is None
-    assert band(hill=np.True_) is None
-    assert band(hill=True, hill_band=0.05) == 0.05
-    assert band(hill_band=0.05) == 0.05
+    assert SCAN_DEFAULTS.floquet.hill_band == ballbal.options.SCAN_HILL_BAND == 0.2
     assert Floquet().hill_band is None  # periodic(): every solution
     b = ballbal.Balancer()
     with pytest.raises(ParameterError) as e:
-        ballbal.scan(b, patterns=["R-R"], Omega=[1.2], eta=[1.0], hill_band=-0.1)
+        ballbal.scan(b, patterns=["R-R"], Omega=[1.2], eta=[1.0],
+                     options=ballbal.ScanOptions(
+                         floquet=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.floquet,
+                                                     hill_band=-0.1)))
     assert e.value.parameter == "hill_band"
     with pytest.raises(ballbal.exceptions.ParameterTypeError) as t:
         Floquet(hill_band="wide")  # type: ignore[arg-type]
@@ -179,15 +185,17 @@ def test_main_job_reports_the_cross_check() -> None:
 def test_scans_written_without_hill_resume_with_hill_off(tmp_path: Path) -> None:
     """A directory written with Hill off (the default before 2026-11-24) is refused by
     the new defaults with a message saying how to resume it, and resumes with
-    ``hill=False`` (from Python and with ``ballbal scan --hill off``) to the same
+    ``Floquet(hill=False)`` (from Python and with ``ballbal scan --hill off``) to the same
     table."""
     b = ballbal.Balancer(**THESIS)
     grid = {"Omega": [1.2, 1.3], "eta": [1.0]}
-    first = ballbal.scan(b, patterns=["R-R"], threads=1, hill=False, out=tmp_path / "s",
+    off = ballbal.ScanOptions(floquet=dataclasses.replace(
+        ballbal.options.SCAN_DEFAULTS.floquet, hill=False))
+    first = ballbal.scan(b, patterns=["R-R"], threads=1, options=off, out=tmp_path / "s",
                          **grid)
-    with pytest.raises(ballbal.exceptions.ScanStoreError, match="hill=False resumes"):
+    with pytest.raises(ballbal.exceptions.ScanStoreError, match=r"Floquet\(hill=False\) resumes"):
         ballbal.scan(b, patterns=["R-R"], threads=1, out=tmp_path / "s", **grid)
-    again = ballbal.scan(b, patterns=["R-R"], threads=1, hill=False, out=tmp_path / "s",
+    again = ballbal.scan(b, patterns=["R-R"], threads=1, options=off, out=tmp_path / "s",
                          **grid)
     assert again.drop("seconds").equals(first.drop("seconds"))
     r = subprocess.run([sys.executable, "-m", "ballbal.cli", "scan", "--Omega", "1.2:1.31:0.1",

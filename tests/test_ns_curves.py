@@ -92,7 +92,9 @@ def shot_at(sol: ballbal.PeriodicSolution, zeta: float, rho: float) -> tuple[com
 @cache
 def whirl_branch() -> ballbal.continuation.Branch:
     # zeta 0.3: the whirl attracts strongly (pair 0.95), a short simulation finds it
-    start = ballbal.periodic(scene(0.3), "O-O", N=N, settle=200.0, window=100.0)
+    start = ballbal.periodic(scene(0.3), "O-O", N=N,
+                             options=ballbal.PeriodicOptions(
+                                 guess=ballbal.GuessSearch(settle=200.0, window=100.0)))
     assert start.status == "converged" and start.stability == "stable"
     return periodic_branch(start, "zeta", range=(0.115, 0.3),
                            options=Continuation(ds=0.02, ds_max=0.05, max_points=40,

@@ -1,6 +1,7 @@
 """The options as frozen dataclasses (ballbal.options), read by the native module by
-attribute; the flat keywords of before still work and mean the same; one schema for a
-periodic solution in periodic() and scan(); the first argument is ``model`` everywhere."""
+attribute, the one way to pass them: the flat keywords of before are refused with the
+field that replaces each; one schema for a periodic solution in periodic() and scan();
+the first argument is ``model`` everywhere."""
 
 from __future__ import annotations
 
@@ -51,12 +52,15 @@ def test_guess_tolerances_reach_the_core():
         GuessSearch(rtol=1.5)
     assert e.value.parameter == "guess_rtol"
     with pytest.raises(ParameterError) as e:
-        ballbal.periodic(B, guess_rtol=0.0)
+        GuessSearch(rtol=0.0, atol=0.0)
     assert e.value.parameter == "guess_rtol"
 
 
-def test_options_and_flat_keywords_give_the_same_solution():
-    flat = ballbal.periodic(B, "R-R", N=5, rtol=1e-7, atol=1e-9, hill=False, settle=800.0)
+def test_the_harmonics_keyword_and_the_options_give_the_same_solution():
+    flat = ballbal.periodic(B, "R-R", N=5,
+                            options=ballbal.PeriodicOptions(
+                                floquet=ballbal.Floquet(rtol=1e-7, atol=1e-9, hill=False),
+                                guess=ballbal.GuessSearch(settle=800.0)))
     opts = PeriodicOptions(harmonic_balance=HarmonicBalance(N=5),
                            floquet=Floquet(rtol=1e-7, atol=1e-9, hill=False),
                            guess=GuessSearch(settle=800.0))
@@ -65,17 +69,60 @@ def test_options_and_flat_keywords_give_the_same_solution():
     assert new.omega == flat.omega
     assert np.array_equal(new.coeffs, flat.coeffs)
     assert np.array_equal(new.multipliers, flat.multipliers)
-    # Keywords given with options change those options.
+    # N given with options changes their harmonics.
     both = ballbal.periodic(B, "R-R", options=opts, N=3)
     assert both.N == 3
 
 
-def test_flat_keyword_errors_name_the_keyword_typed():
-    with pytest.raises(ParameterTypeError) as e:
-        ballbal.periodic(B, floquet=None)
-    assert e.value.parameter == "floquet"
-    with pytest.raises(TypeError, match="unexpected keyword argument 'seeds'"):
-        ballbal.periodic(B, seeds=3)  # a scan's option
+#: Every flat option keyword of before and the field that replaces it, written out here
+#: (not read from ballbal) so that a keyword or a field lost on either side fails.
+REMOVED = {
+    "target": "harmonic_balance.target", "N_max": "harmonic_balance.N_max",
+    "samples": "harmonic_balance.samples", "tol": "harmonic_balance.tol",
+    "step_tol": "harmonic_balance.step_tol", "max_iter": "harmonic_balance.max_iter",
+    "floquet": "floquet.monodromy", "hill": "floquet.hill", "rtol": "floquet.rtol",
+    "atol": "floquet.atol", "margin": "floquet.margin", "max_steps": "floquet.max_steps",
+    "max_trivial": "floquet.max_trivial", "floquet_method": "floquet.method",
+    "hill_target": "floquet.hill_target", "hill_band": "floquet.hill_band",
+    "refine": "floquet.refine", "settle": "guess.settle", "window": "guess.window",
+    "guess_rtol": "guess.rtol", "guess_atol": "guess.atol", "seeds": "guess.seeds",
+    "starts": "guess.starts", "max_closure": "max_closure", "max_tail": "max_tail",
+    "block": "block",
+}
+
+
+@pytest.mark.parametrize("keyword", sorted(REMOVED))
+def test_a_removed_flat_keyword_is_refused_naming_its_field(keyword):
+    calls = [("periodic", "PeriodicOptions", lambda kw: ballbal.periodic(B, **kw)),
+             ("scan", "ScanOptions", lambda kw: ballbal.scan(B, Omega=[1.2], **kw)),
+             ("switch", "PeriodicOptions",
+              lambda kw: ballbal.continuation.switch(B, parameter="Omega", **kw))]
+    for where, cls, call in calls:
+        if keyword == "block" and cls == "PeriodicOptions":
+            # A scan's option, which periodic() never took: Python's own error.
+            with pytest.raises(TypeError, match="unexpected keyword argument 'block'"):
+                call({keyword: 1})
+            continue
+        with pytest.raises(ParameterTypeError) as e:
+            call({keyword: 1})
+        assert isinstance(e.value, TypeError)
+        assert e.value.parameter == keyword
+        msg = str(e.value)
+        assert f"{where}() takes no {keyword}=" in msg and f"{cls}.{REMOVED[keyword]}" in msg
+        # The field named exists on that class.
+        obj = {"PeriodicOptions": PeriodicOptions(), "ScanOptions": ScanOptions()}[cls]
+        for part in REMOVED[keyword].split("."):
+            obj = getattr(obj, part)
+
+
+def test_an_unknown_keyword_is_pythons_type_error():
+    with pytest.raises(TypeError, match="unexpected keyword argument 'nonsense'") as e:
+        ballbal.periodic(B, nonsense=1)
+    assert not isinstance(e.value, ParameterTypeError)
+    # A value refused by an option names the option's field.
+    with pytest.raises(ParameterTypeError) as e2:
+        Floquet(monodromy=None)  # type: ignore[arg-type]
+    assert e2.value.parameter == "monodromy"
 
 
 def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
@@ -107,9 +154,15 @@ def test_scan_fingerprint_of_the_flat_keywords_is_unchanged():
         "guess_atol"] == 1e-7
 
 
-def test_scan_with_options_equals_scan_with_keywords(tmp_path):
+def test_scan_options_in_full_equal_the_defaults_replaced(tmp_path):
+    """Options written out in full and the scan's defaults with three fields replaced
+    are the same table and the same fingerprint (that of the flat keywords of before,
+    ``seeds=2, starts=2, max_steps=10_000``)."""
     grid = {"Omega": [1.2, 1.25], "eta": [1.0]}
-    flat = ballbal.scan(B, threads=1, seeds=2, starts=2, max_steps=10_000, **grid)
+    d = ballbal.options.SCAN_DEFAULTS
+    flat = ballbal.scan(B, threads=1, **grid, options=dataclasses.replace(
+        d, floquet=dataclasses.replace(d.floquet, max_steps=10_000),
+        guess=dataclasses.replace(d.guess, seeds=2, starts=2)))
     opts = ScanOptions(floquet=Floquet(rtol=1e-6, atol=1e-9, max_steps=10_000, hill=True,
                                        method="magnus", hill_target="verdict",
                                        hill_band=ballbal.options.SCAN_HILL_BAND),
@@ -124,11 +177,12 @@ def test_scan_with_options_equals_scan_with_keywords(tmp_path):
 
 def test_periodic_and_scan_share_the_solution_schema():
     grid = {"Omega": [1.2], "eta": [1.0]}
-    df = ballbal.scan(B, threads=1, hill=True, **grid)
-    row = df.row(0, named=True)
-    # The scan's options as periodic() options: the same orbit, the same numbers.
+    # Hill beside every monodromy (no band), as periodic() runs it.
     o = ScanOptions(floquet=dataclasses.replace(ScanOptions().floquet, hill=True,
                                                 hill_band=None))
+    df = ballbal.scan(B, threads=1, options=o, **grid)
+    row = df.row(0, named=True)
+    # The scan's options as periodic() options: the same orbit, the same numbers.
     s = ballbal.periodic(B, "R-R", options=PeriodicOptions(
         harmonic_balance=o.harmonic_balance, floquet=o.floquet, guess=o.guess))
     names = {"status", "omega", "stability", "max_modulus", "trivial_error", "residual",
@@ -149,14 +203,16 @@ def test_periodic_and_scan_share_the_solution_schema():
 
 def test_the_pivot_ratio_has_one_name():
     # 0.1's deprecated alias `condition` is gone (there are no 0.1 users to keep).
-    s = ballbal.periodic(B, "R-R", hill=False)
+    s = ballbal.periodic(B, "R-R",
+                         options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
     assert not hasattr(s, "condition") and s.pivot_ratio >= 1
 
 
 CALLS = {
     "equilibria": (ballbal.equilibria, "balancer", {}),
     "simulate": (ballbal.simulate, "balancer", {"t_eval": [0.0, 1.0]}),
-    "periodic": (ballbal.periodic, "balancer", {"floquet": False, "hill": False}),
+    "periodic": (ballbal.periodic, "balancer",
+                 {"options": PeriodicOptions(floquet=Floquet(monodromy=False, hill=False))}),
     "run_up": (ballbal.run_up, "scene", {"to": 1.3, "duration": 1.0, "settle": 1.0}),
 }
 

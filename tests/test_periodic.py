@@ -35,7 +35,9 @@ def test_table_3_1_converges_to_shooting_values(standard):
     b, sol3 = standard
     prev = sol3
     for N in (6, 10):
-        sol = ballbal.periodic(b, "R-R", N=N, guess=prev, rtol=1e-10, atol=1e-12)
+        sol = ballbal.periodic(b, "R-R", N=N, guess=prev,
+                               options=ballbal.PeriodicOptions(
+                                   floquet=ballbal.Floquet(rtol=1e-10, atol=1e-12)))
         prev = sol
     assert abs(sol.omega - 0.25141) < 1e-5
     assert np.allclose(_moduli(sol), SHOOTING, atol=1e-4)
@@ -56,12 +58,14 @@ def test_standard_case_against_shooting_in_this_test(standard):
 def test_hard_case_needs_more_harmonics():
     b = ballbal.Balancer(**THESIS, Omega=1.0, eta=(0.7, 0.7))
     # The N = 3 series itself (refine=False: the verdict's bound would raise N here).
-    s3 = ballbal.periodic(b, "R-R", N=3, refine=False)
+    s3 = ballbal.periodic(b, "R-R", N=3,
+                          options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
     assert s3.converged and s3.N == 3 and s3.stability == "undetermined"
     # thesis table 3-1: trivial multiplier 1.1808 at N = 3, 1.0379 at N = 4
     assert s3.trivial_error > 0.1
     assert abs((1 + s3.trivial_error) - 1.1808) < 0.01
-    s4 = ballbal.periodic(b, "R-R", N=4, guess=s3, refine=False)
+    s4 = ballbal.periodic(b, "R-R", N=4, guess=s3,
+                          options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
     assert 0.02 < s4.trivial_error < 0.05
     s = s4
     for N in (8, 16):  # N = 16 is what the test relies on
@@ -100,14 +104,18 @@ def test_round_trip_solution_stays_on_orbit(standard):
 def test_failure_is_data_not_exception():
     b = ballbal.Balancer(**THESIS, Omega=1.2, eta=(1.0, 1.0))
     junk = np.full((4, 7), 50.0)
-    sol = ballbal.periodic(b, "R-R", N=3, guess=(5.0, junk), max_iter=20)
+    sol = ballbal.periodic(b, "R-R", N=3, guess=(5.0, junk),
+                           options=ballbal.PeriodicOptions(
+                               harmonic_balance=ballbal.HarmonicBalance(max_iter=20)))
     assert not sol.converged
     assert sol.status in ("diverged", "singular", "max_iterations")
     assert sol.omega is None and sol.multipliers is None
     assert sol.stability == "undetermined"
     # no periodic motion of this type: perfect balance attracts everything here
     stable_pb = ballbal.Balancer(mu=0.2, zeta=0.1, zeta_b=0.1, delta=50, Omega=3.0, eta=(1.0, 1.0))
-    s = ballbal.periodic(stable_pb, "O-O", N=3, settle=300, window=500)
+    s = ballbal.periodic(stable_pb, "O-O", N=3,
+                         options=ballbal.PeriodicOptions(
+                             guess=ballbal.GuessSearch(settle=300, window=500)))
     assert s.status == "no_guess" and s.omega is None
 
 
@@ -123,10 +131,14 @@ def test_bad_periodic_input():
         ballbal.periodic(b, N=0)
     assert err.value.parameter == "N"
     with pytest.raises(ParameterError) as err:
-        ballbal.periodic(b, N=5, samples=4)
+        ballbal.periodic(b, N=5,
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(samples=4)))
     assert err.value.parameter == "samples"
     with pytest.raises(ParameterError) as err:
-        ballbal.periodic(b, tol=float("nan"))
+        ballbal.periodic(b,
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(tol=float("nan"))))
     assert err.value.parameter == "tol"
     # The binding's guess-shape check (not yet a ParameterError) names the guess.
     with pytest.raises(ValueError, match="guess"):
@@ -172,7 +184,9 @@ def test_hb_stage_counters_count_what_a_warm_solve_does(standard):
     def profiled(n: int) -> tuple[Any, list[float]]:
         _native.hb_stage_profile(True)
         try:
-            sol = ballbal.periodic(standard, "R-R", N=n, guess=seed, floquet=False, hill=False)
+            sol = ballbal.periodic(standard, "R-R", N=n, guess=seed,
+                                   options=ballbal.PeriodicOptions(
+                                       floquet=ballbal.Floquet(monodromy=False, hill=False)))
             return sol, _native.hb_stage_seconds()
         finally:
             _native.hb_stage_profile(False)
@@ -185,5 +199,7 @@ def test_hb_stage_counters_count_what_a_warm_solve_does(standard):
     assert all(v > 0 for v in st[:4])
     sol3, st3 = profiled(3)
     assert sol3.status == "converged" and st3[5] == sol3.iterations
-    ballbal.periodic(standard, "R-R", N=8, guess=seed, floquet=False, hill=False)
+    ballbal.periodic(standard, "R-R", N=8, guess=seed,
+                     options=ballbal.PeriodicOptions(
+                         floquet=ballbal.Floquet(monodromy=False, hill=False)))
     assert _native.hb_stage_seconds() == [0.0] * 7

@@ -1,3 +1,4 @@
+import dataclasses
 import os
 import signal
 import subprocess
@@ -38,7 +39,9 @@ def thesis_maps():
 def test_standard_point_equals_single_point_solver(small):
     row = small.filter((pl.col("Omega") == 1.2) & (pl.col("eta") == 1.0)).row(0, named=True)
     # the scan's Floquet settings (Magnus at rtol 1e-6)
-    single = ballbal.periodic(BASE, "R-R", N=3, rtol=1e-6, atol=1e-9, floquet_method="magnus")
+    single = ballbal.periodic(BASE, "R-R", N=3,
+                              options=ballbal.PeriodicOptions(
+                                  floquet=ballbal.Floquet(rtol=1e-6, atol=1e-9, method="magnus")))
     assert row["status"] == "converged" and row["type"] == "R-R"
     assert abs(row["omega"] - single.omega) < 1e-9
     assert abs(row["max_modulus"] - single.max_modulus) < 1e-6
@@ -158,19 +161,23 @@ def test_dask_local_cluster_gives_the_same_table():
 
 
 SCRIPT = """
-import sys, warnings, ballbal
+import dataclasses, sys, warnings, ballbal
 b = ballbal.Balancer()
+opts = ballbal.ScanOptions(block=1, guess=dataclasses.replace(
+    ballbal.options.SCAN_DEFAULTS.guess, starts=8))
 with warnings.catch_warnings(record=True) as w:
     warnings.simplefilter("always")
-    df = ballbal.scan(b, Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), block=1, threads=1,
-                      starts=8, out=sys.argv[1])
+    df = ballbal.scan(b, Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), threads=1,
+                      options=opts, out=sys.argv[1])
 print("ROWS", df.height, "WARNED", sum(issubclass(x.category, ballbal.ScanInterrupted) for x in w))
 """
 
 
 def test_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
     out = tmp_path / "scan.parquet"
-    kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), block=1, threads=1, starts=8)
+    kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), threads=1,
+              options=ballbal.ScanOptions(block=1, guess=dataclasses.replace(
+                  ballbal.options.SCAN_DEFAULTS.guess, starts=8)))
     p = subprocess.Popen([sys.executable, "-c", SCRIPT, str(out)], stdout=subprocess.PIPE,
                          text=True)
     deadline = time.time() + 120
@@ -207,7 +214,10 @@ def test_resume_refuses_another_floquet_method(tmp_path):
     # not end up holding rows of both.
     ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s")
     with pytest.raises(ScanStoreError, match="differs in options.floquet_method"):
-        ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s", floquet_method="rk45")
+        ballbal.scan(BASE, Omega=[1.2], eta=[1.0], out=tmp_path / "s",
+                     options=ballbal.ScanOptions(
+                         floquet=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.floquet,
+                                                     method="rk45")))
 
 
 @pytest.mark.parametrize(
@@ -233,12 +243,29 @@ def test_bad_grids_raise_before_work(grid, name):
 @pytest.mark.parametrize(
     ("kw", "name"),
     [({"patterns": []}, "patterns"), ({"patterns": ["R-X"]}, "pattern"),
-     ({"threads": 0}, "threads"), ({"chunk": 0}, "chunk"), ({"starts": 0}, "starts"),
-     ({"N": 0}, "N"), ({"rtol": -1.0}, "rtol"), ({"max_tail": 0.0}, "max_tail")],
+     ({"threads": 0}, "threads"), ({"chunk": 0}, "chunk"), ({"N": 0}, "N")],
 )
 def test_bad_options_raise_before_work(kw, name):
     with pytest.raises(ParameterError) as err:
         ballbal.scan(BASE, Omega=[1.2], eta=[1.0], **kw)
+    assert err.value.parameter == name
+
+
+def test_a_scans_own_bounds_are_checked_before_work():
+    # No start at all: a bound of scans (periodic() ignores starts), so refused by scan.
+    none = ballbal.ScanOptions(guess=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.guess,
+                                                         starts=0))
+    with pytest.raises(ParameterError) as err:
+        ballbal.scan(BASE, Omega=[1.2], eta=[1.0], options=none)
+    assert err.value.parameter == "starts"
+
+
+@pytest.mark.parametrize(("make", "name"), [
+    (lambda: ballbal.Floquet(rtol=-1.0), "rtol"),
+    (lambda: ballbal.ScanOptions(max_tail=0.0), "max_tail")])
+def test_bad_scan_options_raise_when_made(make, name):
+    with pytest.raises(ParameterError) as err:
+        make()
     assert err.value.parameter == name
 
 

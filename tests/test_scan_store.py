@@ -2,6 +2,7 @@
 ``chunk``: damaged files, resuming with another axis order, two processes on one
 directory, interrupted command-line scans, SIGKILL and SIGINT at any time."""
 
+import dataclasses
 import json
 import os
 import random
@@ -20,7 +21,9 @@ import ballbal
 from ballbal.exceptions import ScanStoreError, ScanStoreWarning
 
 # 7 x 21 points in 21 chunks of one block each (block=1: a few seconds on one thread).
-KW = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), block=1, threads=1, starts=8)
+KW = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), threads=1,
+          options=ballbal.ScanOptions(block=1, guess=dataclasses.replace(
+              ballbal.options.SCAN_DEFAULTS.guess, starts=8)))
 
 
 @pytest.fixture(scope="module")
@@ -70,11 +73,12 @@ def test_table_is_the_same_for_any_chunk_length():
     # blocks) and the default cut the grid differently; the table must not change.
     b = ballbal.Balancer(zeta_b=0.1)
     grid = dict(Omega=[1.2, 1.3], eta=[0.9, 1.1], mu=(0.1, 0.26, 0.02), patterns=["R-R", "O-O"])
-    ref = ballbal.scan(b, block=1, threads=1, **grid)
+    ref = ballbal.scan(b, options=ballbal.ScanOptions(block=1), threads=1, **grid)
     ok = ref.filter(pl.col("status") == "converged")
     assert ok.height >= 20
     for chunk, threads in [(1, 2), (3, 1), (4, 2), (None, 2)]:
-        df = ballbal.scan(b, block=1, chunk=chunk, threads=threads, **grid)
+        df = ballbal.scan(b, options=ballbal.ScanOptions(block=1), chunk=chunk, threads=threads,
+                          **grid)
         keys = ["Omega", "eta", "mu", "type", "solution", "status", "stability"]
         assert df.select(keys).equals(ref.select(keys)), chunk
         assert (df["omega"] - ref["omega"]).abs().max() <= 1e-10
@@ -89,17 +93,20 @@ def test_default_chunk_does_not_cut_continuation():
     default = ballbal.scan(b, threads=2, **grid)
     for chunk in (1, 3):
         assert same(ballbal.scan(b, chunk=chunk, threads=1, **grid), default.drop("seconds"))
-    lines = ballbal.scan(b, block=1, threads=2, **grid)  # the old chunk=1
+    lines = ballbal.scan(b, options=ballbal.ScanOptions(block=1), threads=2,
+                         **grid)  # the old chunk=1
     found = default.filter(pl.col("status") == "converged").height
     assert lines.filter(pl.col("status") == "converged").height < found
 
 
 def test_block_and_chunk_are_validated():
-    for kw, name in [({"block": 0}, "block"), ({"chunk": 0}, "chunk"),
-                     ({"lazy": True}, "lazy"), ({"out": ""}, "out")]:
+    for kw, name in [({"chunk": 0}, "chunk"), ({"lazy": True}, "lazy"), ({"out": ""}, "out")]:
         with pytest.raises(ballbal.exceptions.ParameterError) as e:
             ballbal.scan(ballbal.Balancer(), Omega=[1.2], **kw)
         assert e.value.parameter == name
+    with pytest.raises(ballbal.exceptions.ParameterError) as e:
+        ballbal.ScanOptions(block=0)
+    assert e.value.parameter == "block"
 
 
 # --- damaged directories ----------------------------------------------------------------
@@ -190,7 +197,7 @@ def test_meta_json_of_before_0_2_is_set_aside(tmp_path, reference, written):
 
 def test_resume_with_axes_in_another_order_is_refused(tmp_path):
     out = tmp_path / "s"
-    kw = dict(block=1, threads=1)
+    kw = dict(options=ballbal.ScanOptions(block=1), threads=1)
     ballbal.scan(ballbal.Balancer(), out=out, Omega=[1.2, 1.3], eta=[0.9, 1.0, 1.1], **kw)
     before = {f.name: f.read_bytes() for f in chunk_files(out)}
     with pytest.raises(ScanStoreError, match="order Omega, eta"):
@@ -201,7 +208,8 @@ def test_resume_with_axes_in_another_order_is_refused(tmp_path):
 
 def test_chunk_layout_of_the_directory_is_kept_on_resume(tmp_path):
     out = tmp_path / "s"
-    grid = dict(Omega=[1.2, 1.3], eta=[0.9, 1.0, 1.1], block=1, threads=1)
+    grid = dict(Omega=[1.2, 1.3], eta=[0.9, 1.0, 1.1], options=ballbal.ScanOptions(block=1),
+                threads=1)
     ballbal.scan(ballbal.Balancer(), out=out, chunk=2, **grid)
     assert len(chunk_files(out)) == 2
     again = ballbal.scan(ballbal.Balancer(), out=out, **grid)  # no chunk: the directory's
@@ -213,8 +221,10 @@ def test_chunk_layout_of_the_directory_is_kept_on_resume(tmp_path):
 # --- processes and signals -----------------------------------------------------------
 
 RUN = """
-import sys, warnings, ballbal
-kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), block=1, threads=1, starts=8)
+import dataclasses, sys, warnings, ballbal
+kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), threads=1,
+          options=ballbal.ScanOptions(block=1, guess=dataclasses.replace(
+              ballbal.options.SCAN_DEFAULTS.guess, starts=8)))
 print("READY", flush=True)
 with warnings.catch_warnings(record=True) as w:
     warnings.simplefilter("always")
@@ -252,7 +262,7 @@ def test_two_processes_cannot_share_a_directory(tmp_path, reference):
 
 
 KILL_IN_WRITE = """
-import io, os, signal, sys, polars as pl, ballbal
+import dataclasses, io, os, signal, sys, polars as pl, ballbal
 orig = pl.DataFrame.write_parquet
 calls = []
 def torn(self, file, **kw):
@@ -266,7 +276,9 @@ def torn(self, file, **kw):
     file.flush()
     os.kill(os.getpid(), signal.SIGKILL)
 pl.DataFrame.write_parquet = torn
-kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), block=1, threads=1, starts=8)
+kw = dict(Omega=(1.0, 1.6, 0.1), eta=(0.5, 1.5, 0.05), threads=1,
+          options=ballbal.ScanOptions(block=1, guess=dataclasses.replace(
+              ballbal.options.SCAN_DEFAULTS.guess, starts=8)))
 ballbal.scan(ballbal.Balancer(), out=sys.argv[1], **kw)
 """
 

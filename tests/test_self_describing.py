@@ -4,6 +4,7 @@ model it was computed for (columns in memory and in every chunk; the whole descr
 in the directory's ``_scan.parquet``); nested columns have a flat export that
 ``write_csv`` takes."""
 
+import dataclasses
 import json
 import math
 import os
@@ -20,7 +21,8 @@ from ballbal.exceptions import ScanInterrupted, ScanStoreError, ScanStoreWarning
 
 # 2 x 3 points in three chunks of one block (block=1): about a second on one thread.
 GRID = dict(Omega=[1.2, 1.3], eta=[0.9, 1.0, 1.1])
-KW = dict(block=1, threads=1, starts=4)
+KW = dict(threads=1, options=ballbal.ScanOptions(
+    block=1, guess=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.guess, starts=4)))
 
 
 def names_in(d: Path) -> list[str]:
@@ -137,7 +139,9 @@ MODEL = dict(mu=0.15, zeta=0.07, zeta_b=(0.1, 0.2), delta=40.0, Omega=1.25, eta=
 
 def test_in_memory_table_carries_every_fixed_parameter(tmp_path):
     b = ballbal.Balancer(**MODEL)
-    df = ballbal.scan(b, Omega=[1.2, 1.3], threads=1, starts=4)
+    df = ballbal.scan(b, Omega=[1.2, 1.3], threads=1,
+                      options=ballbal.ScanOptions(
+                          guess=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.guess, starts=4)))
     expect = {"mu": 0.15, "zeta": 0.07, "zeta_b[0]": 0.1, "zeta_b[1]": 0.2, "delta": 40.0,
               "eta[0]": 0.9, "eta[1]": 1.1}
     for c, v in expect.items():
@@ -152,10 +156,15 @@ def test_in_memory_table_carries_every_fixed_parameter(tmp_path):
 
 def test_a_ball_under_an_axis_of_every_ball_takes_the_axis_value():
     b = ballbal.Balancer(**MODEL)
-    df = ballbal.scan(b, eta=[0.8, 1.2], threads=1, starts=4)
+    df = ballbal.scan(b, eta=[0.8, 1.2], threads=1,
+                      options=ballbal.ScanOptions(
+                          guess=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.guess, starts=4)))
     assert df["eta[0]"].to_list() == df["eta"].to_list() == df["eta[1]"].to_list()
     assert sorted(set(df["eta"].to_list())) == [0.8, 1.2]
-    one = ballbal.scan(b, grid={"eta[1]": [0.8, 1.2]}, threads=1, starts=4)
+    one = ballbal.scan(b, grid={"eta[1]": [0.8, 1.2]}, threads=1,
+                       options=ballbal.ScanOptions(
+                           guess=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.guess,
+                                                     starts=4)))
     assert one["eta[0]"].to_list() == [0.9] * one.height
     assert sorted(set(one["eta[1]"].to_list())) == [0.8, 1.2]
     assert one.columns.count("eta[1]") == 1
@@ -164,7 +173,10 @@ def test_a_ball_under_an_axis_of_every_ball_takes_the_axis_value():
 def test_stored_scan_says_model_options_and_scene(tmp_path):
     b = ballbal.Balancer(**MODEL)
     out = tmp_path / "s"
-    ballbal.scan(b, out=out, Omega=[1.2, 1.3], threads=1, starts=4, seeds=3)
+    ballbal.scan(b, out=out, Omega=[1.2, 1.3], threads=1,
+                 options=ballbal.ScanOptions(
+                     guess=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.guess, starts=4,
+                                               seeds=3)))
     meta = ballbal.scan_meta(out)
     bal = meta["balancer"]
     assert (bal["mu"], bal["zeta"], bal["delta"], bal["Omega"]) == (0.15, 0.07, 40.0, 1.25)
@@ -182,7 +194,10 @@ def test_stored_scan_says_model_options_and_scene(tmp_path):
     # A scene: its effects too (here springs in a chain; the axis is stored beside).
     s = ballbal.Scene(balancer=b, springs=0.05, spring_layout="chain")
     out2 = tmp_path / "scene"
-    got = ballbal.scan(s, out=out2, springs=[0.05, 0.06], threads=1, starts=4)
+    got = ballbal.scan(s, out=out2, springs=[0.05, 0.06], threads=1,
+                       options=ballbal.ScanOptions(
+                           guess=dataclasses.replace(ballbal.options.SCAN_DEFAULTS.guess,
+                                                     starts=4)))
     m2 = ballbal.scan_meta(out2)
     assert m2["scene"]["springs"] == {"stiffness": 0.05, "layout": "chain"}
     assert m2["scene"]["balancer"]["mu"] == 0.15 and m2["grid"] == {"springs": [0.05, 0.06]}
@@ -205,7 +220,9 @@ def test_a_description_without_a_description_is_damaged(tmp_path, written):
 
 def test_flat_table_writes_csv_and_keeps_the_multipliers(tmp_path):
     df = ballbal.scan(ballbal.Balancer(zeta_b=0.1), Omega=[1.1, 1.2, 1.3, 1.5], eta=[0.6, 1.0, 1.2],
-                      patterns=["R-R", "O-O"], threads=1, starts=4)
+                      patterns=["R-R", "O-O"], threads=1,
+                      options=ballbal.ScanOptions(guess=dataclasses.replace(
+                          ballbal.options.SCAN_DEFAULTS.guess, starts=4)))
     with pytest.raises(Exception, match="(?i)nested|list|struct"):  # why flat() exists
         df.write_csv(tmp_path / "nested.csv")
     flat = ballbal.flat(df)

@@ -422,7 +422,9 @@ def test_ground_signal_during_a_ramp_matches_the_ground_frame_equations():
 
 def test_an_unconverged_solution_is_a_parameter_error_naming_it() -> None:
     """A solve that did not converge has no lines: that was a plain ValueError."""
-    s = ballbal.periodic(ballbal.Balancer(), "R-R", N=3, max_iter=1)
+    s = ballbal.periodic(ballbal.Balancer(), "R-R", N=3,
+                         options=ballbal.PeriodicOptions(
+                             harmonic_balance=ballbal.HarmonicBalance(max_iter=1)))
     assert s.omega is None
     for f, name in ((sp.line_spectrum, "solution"), (sp.vibration, "source")):
         with pytest.raises(ParameterError) as e:

@@ -5,6 +5,7 @@ every changed file set aside and named in a ``ScanStoreWarning``.
 
 The grids are tiny (4 chunks each) so that every flipped copy can be resumed on its own."""
 
+import dataclasses
 import random
 import shutil
 import warnings
@@ -19,7 +20,9 @@ from ballbal.exceptions import ScanStoreError, ScanStoreWarning
 
 # 3 x 4 points, 4 chunks of one block each; both kinds of row (solutions with
 # multipliers, not_found) are in it.
-KW = dict(Omega=[1.0, 1.3, 1.6], eta=[0.5, 0.9, 1.3, 1.5], block=1, threads=1, starts=8)
+KW = dict(Omega=[1.0, 1.3, 1.6], eta=[0.5, 0.9, 1.3, 1.5], threads=1,
+          options=ballbal.ScanOptions(block=1, guess=dataclasses.replace(
+              ballbal.options.SCAN_DEFAULTS.guess, starts=8)))
 # Flipped copies per chunk file, half of the flips in the footer: 24 copies of the scan
 # (each resume recomputes a chunk of a few solves), 48 of the basins (a few starts).
 SCAN_FLIPS, BASIN_FLIPS = 6, 12

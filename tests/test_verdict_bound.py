@@ -168,7 +168,8 @@ def test_the_issues_example_is_unstable_or_undetermined_at_n_3() -> None:
     leaves it undetermined; refined, it is unstable at more harmonics."""
     b = ballbal.Balancer(mu=0.25, zeta=0.08, zeta_b=0.02, delta=20, Omega=1.3584277344,
                          eta=(1.0, 1.0))
-    kept = ballbal.periodic(b, "R-R", refine=False)
+    kept = ballbal.periodic(b, "R-R",
+                            options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
     assert kept.converged and kept.N == 3 and kept.stability == "undetermined"
     assert kept.modulus_error is not None and kept.modulus_error > abs(kept.max_modulus - 1)
     refined = ballbal.periodic(b, "R-R")

@@ -18,7 +18,9 @@ from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer
 from ballbal.scene import Scene
 
-_INDEXED = re.compile(r"^(eta|zeta_b)\[(\d+)\]$")
+#: A ball's parameter by its index (``eta[1]``): the core's per-ball parameters.
+_INDEXED = re.compile("^({})\\[(\\d+)\\]$".format(
+    "|".join(p["key"] for p in _native.parameters() if p["per_ball"])))
 
 
 def parameter_range(v: Any) -> tuple[float, float]:

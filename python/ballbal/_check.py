@@ -165,18 +165,6 @@ def option(name: str, v: Any, kind: type[_T], default: _T, shown: str) -> _T:
     return v
 
 
-def model(name: str, v: Any) -> Any:
-    """A :class:`Balancer` or :class:`Scene` (what every analysis takes first)."""
-    from .model import Balancer
-    from .scene import Scene
-
-    if not isinstance(v, (Balancer, Scene)):
-        raise ParameterTypeError(
-            name, f"must be a ballbal.Balancer or ballbal.Scene, got {type(v).__name__}",
-            value=v)
-    return v
-
-
 def array(name: str, v: Any) -> np.ndarray:
     """A flat float64 array of finite or non-finite numbers (the core checks values)."""
     if isinstance(v, (str, bytes)) or v is None:

@@ -24,7 +24,7 @@ from ballbal._branch import (
 from ballbal.analysis import Equilibrium, _equilibrium, capacities, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer, Seed003
-from ballbal.scene import Scene
+from ballbal.scene import Scene, model_argument
 
 __all__ = ["equilibrium_branch", "equilibrium_curve", "switch_equilibrium"]
 
@@ -160,7 +160,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     fold, Hopf (with its frequency ``omega``) and branch points, located to ~1e-11 in
     arclength."""
     native, seed = _native_model(model)
-    _check.model("model", native)
+    model_argument("model", native)
     parameter = _check.string("parameter", parameter)
     rng = parameter_range(range)
     options = _options(options)

@@ -4,7 +4,7 @@ core's ``analysis/switch.rs``."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -13,8 +13,8 @@ from ._branch import Branch, _listing, event_name, event_row, model_at
 from .analysis import Equilibrium, PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer, Seed003
-from .options import PERIODIC_DEFAULTS, PERIODIC_KEYWORDS, PeriodicOptions, with_keywords
-from .scene import Scene
+from .options import PERIODIC_DEFAULTS, PeriodicOptions, refuses_keywords, with_harmonics
+from .scene import Scene, model_argument
 
 
 def _from_branch(branch: Branch, event: Any, kind: str | None, parameter: str | None,
@@ -44,6 +44,7 @@ def _from_branch(branch: Branch, event: Any, kind: str | None, parameter: str | 
     return solution, etype, branch.parameter, model
 
 
+@refuses_keywords(PeriodicOptions)
 def switch(
     solution: PeriodicSolution | Equilibrium | Branch,
     *,
@@ -52,8 +53,8 @@ def switch(
     event: int | str | None = None,
     model: Balancer | Scene | None = None,
     amplitude: float = 0.05,
+    N: int | Literal["auto"] | None = None,  # noqa: N803
     options: PeriodicOptions | None = None,
-    **keywords: Any,
 ) -> PeriodicSolution:
     """The first periodic solution on the branch that leaves ``solution`` at a
     bifurcation in ``parameter``, ``kind`` naming it (the names of
@@ -87,9 +88,8 @@ def switch(
     raised); ``info`` holds
     ``switched_from`` (the event's canonical name), ``parameter``, ``value`` and
     ``critical`` (the multiplier, or at a Hopf point the eigenvalue, switched along).
-    ``options`` and the
-    keywords as in :func:`~ballbal.periodic` (``N`` sets the harmonics of a Hopf orbit;
-    a doubled orbit has twice the solution's). When no solution of the new branch is
+    ``options`` and ``N`` as in :func:`~ballbal.periodic` (``N`` sets the harmonics of a
+    Hopf orbit; a doubled orbit has twice the solution's). When no solution of the new branch is
     found within ``amplitude`` (halved up to four times), raises
     :class:`~ballbal.exceptions.ParameterError` naming ``amplitude``.
     """
@@ -104,7 +104,7 @@ def switch(
     amp = _check.real("amplitude", amplitude, 0.0, 10.0, lo_open=True)
     options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
                             "ballbal.PeriodicOptions")
-    options = with_keywords(options, "switch", keywords, PERIODIC_KEYWORDS)
+    options = with_harmonics(options, N)
     if isinstance(solution, PeriodicSolution):
         if kind is None:
             raise ParameterError("kind", "name the event a periodic solution is switched "
@@ -125,7 +125,7 @@ def switch(
         kind = "hopf"
         if model is None:
             raise ParameterError("model", "give the model the equilibrium belongs to")
-        base = _check.model("model", model)
+        base = model_argument("model", model)
         d, p, crit = _native.switch_hopf(base, parameter, [float(v) for v in solution.q],
                                          amp, options)
     else:

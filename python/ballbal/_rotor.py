@@ -33,7 +33,7 @@ import numpy as np
 import polars as pl
 
 from . import _check
-from .bearing import Bearing
+from ._geometry import Bearing
 from .exceptions import ParameterError, ParameterTypeError
 
 if TYPE_CHECKING:

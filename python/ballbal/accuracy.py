@@ -16,7 +16,8 @@ from . import _check
 from .analysis import PeriodicSolution, periodic
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
-from .scene import Scene
+from .options import Floquet, HarmonicBalance, PeriodicOptions
+from .scene import Scene, model_argument
 
 
 def _match_error(a: np.ndarray, ref: np.ndarray) -> float:
@@ -28,6 +29,17 @@ def _match_error(a: np.ndarray, ref: np.ndarray) -> float:
         k = int(np.argmin([abs(z - r) for z in left]))
         worst = max(worst, abs(left.pop(k) - r))
     return worst
+
+
+def _study_options(kw: dict[str, Any]) -> PeriodicOptions:
+    """One setting of the study (its ``N``, ``samples``, ``tol``, ``rtol``, ``atol`` and
+    where given ``step_tol`` and the Floquet method) without Hill, at the truncation
+    under study (``refine=False``: not one the verdict's bound refined)."""
+    hb = HarmonicBalance(N=kw["N"], samples=kw["samples"], tol=kw["tol"],
+                         step_tol=kw.get("step_tol", HarmonicBalance.step_tol))
+    fl = Floquet(rtol=kw["rtol"], atol=kw["atol"], method=kw.get("floquet_method", "rk45"),
+                 hill=False, refine=False)
+    return PeriodicOptions(harmonic_balance=hb, floquet=fl)
 
 
 def _coeff_error(c: np.ndarray, ref: np.ndarray) -> float:
@@ -91,7 +103,7 @@ def accuracy_cost(
     giving at most 65536 samples, ``tol > 0``, ``rtol`` and ``magnus_rtol`` in (0, 1),
     ``neighbour <= Omega``.
     """
-    _check.model("model", model)
+    model_argument("model", model)
     _check.string("pattern", pattern)
     N = [_check.integer("N", n, 1, 256) for n in _knob("N", N)]
     base_N = _check.integer("base_N", base_N, 1, 255)
@@ -116,20 +128,22 @@ def accuracy_cost(
     if guess is not None and not isinstance(guess, PeriodicSolution):
         raise ParameterTypeError("guess", "must be a PeriodicSolution or None, got "
                                  f"{type(guess).__name__}", value=guess)
-    tight: dict[str, Any] = dict(tol=1e-12, step_tol=1e-10, rtol=1e-11, atol=1e-13, hill=False)
+    no_hill = PeriodicOptions(floquet=Floquet(hill=False))
+    tight = PeriodicOptions(harmonic_balance=HarmonicBalance(tol=1e-12, step_tol=1e-10),
+                            floquet=Floquet(rtol=1e-11, atol=1e-13, hill=False))
     if guess is None:
-        start = periodic(model, pattern, N=8, hill=False)
+        start = periodic(model, pattern, N=8, options=no_hill)
         if not start.converged:
             raise ParameterError("pattern", f"no {pattern} solution found at this point by "
                              f"simulation (status {start.status}); pass guess=")
         guess = start
-    ref = periodic(model, pattern, N=reference_N, guess=guess, **tight)
+    ref = periodic(model, pattern, N=reference_N, guess=guess, options=tight)
     if not ref.converged or ref.multipliers is None:
         raise ParameterError("reference_N", f"the N = {reference_N} solve did not converge "
                          f"(status {ref.status})")
     closure = ref.verify(rtol=1e-11, atol=1e-13)
     near_b = model.replace(Omega=model.Omega - neighbour)
-    near = periodic(near_b, pattern, N=reference_N, guess=ref, hill=False)
+    near = periodic(near_b, pattern, N=reference_N, guess=ref, options=no_hill)
     warm = near if near.converged else ref
 
     settings: list[tuple[str, float, dict[str, Any]]] = []
@@ -153,7 +167,7 @@ def accuracy_cost(
         for _ in range(repeats):
             t0 = time.perf_counter()
             # The truncation under study, not one the verdict's bound refined.
-            s = periodic(model, pattern, guess=warm, hill=False, refine=False, **kw)
+            s = periodic(model, pattern, guess=warm, options=_study_options(kw))
             times.append(time.perf_counter() - t0)
         ok = s.converged and s.multipliers is not None
         errors: dict[str, float | None] = dict.fromkeys(

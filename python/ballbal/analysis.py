@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal, overload
+from typing import Any, Literal, overload
 
 import numpy as np
 import polars as pl
@@ -12,11 +12,9 @@ import polars as pl
 from . import _check, _native
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
-from .options import PERIODIC_DEFAULTS, PERIODIC_KEYWORDS, PeriodicOptions, with_keywords
-from .scene import Scene
-
-if TYPE_CHECKING:
-    from .spectrum import Vibration
+from .options import PERIODIC_DEFAULTS, PeriodicOptions, refuses_keywords, with_harmonics
+from .scene import Scene, model_argument
+from .spectrum import LineSource, Vibration, line_spectrum, vibration
 
 Stability = Literal["stable", "unstable", "undetermined"]
 
@@ -95,7 +93,7 @@ def simulate(
     if not isinstance(stats, (bool, np.bool_)):
         raise ParameterTypeError("stats", f"must be True or False, got {stats!r:.60}",
                                  value=stats)
-    _check.model("model", model)
+    model_argument("model", model)
     n = model.n_balls
     d = len(model.coordinates)
     if y0 is None:
@@ -151,7 +149,7 @@ def _span(t_span: Any) -> tuple[float, float]:
 
 
 @dataclass(frozen=True)
-class Equilibrium:
+class Equilibrium(LineSource):
     """One equilibrium: balls at rest relative to the disk."""
 
     kind: str
@@ -171,6 +169,16 @@ class Equilibrium:
     #: for one ball straight opposite the imbalance). ``ballbal.data.residual_imbalance``
     #: gives it in mass x length. NaN only where the balls' capacities were not known.
     residual_imbalance: float = float("nan")
+
+    def _displacement_lines(self, Omega: float | None,  # noqa: N803
+                            name: str) -> tuple[np.ndarray, np.ndarray, float, float]:
+        # One line at the spin: the disk centre's offset, constant in the rotating frame.
+        if Omega is None:
+            raise ParameterError("Omega", "an Equilibrium does not carry its model: give "
+                                 "Omega (the spin speed ratio it was computed at)")
+        spin = _check.real("Omega", Omega, finite=True)
+        return (np.zeros(1, dtype=int), np.array([self.q[0] + 1j * self.q[1]]),
+                spin, float("nan"))
 
 
 def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
@@ -201,7 +209,7 @@ def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
     reported once by one of its points. Up to four balls every start of a lattice is
     tried; from five on the search tries ``max(600, 25 n)`` starts (balls together, then
     a low-discrepancy sequence) and says so with ``exhaustive=False``."""
-    _check.model("model", model)
+    model_argument("model", model)
     eta = capacities(model)
     return [_equilibrium(d, eta) for d in _native.equilibria(model)]
 
@@ -238,7 +246,7 @@ def _equilibrium(d: dict[str, Any], eta: np.ndarray | None = None) -> Equilibriu
 
 
 @dataclass(frozen=True)
-class PeriodicSolution:
+class PeriodicSolution(LineSource):
     """A periodic solution from harmonic balance (or a failed attempt: see ``status``).
 
     ``coeffs[j] = [a_0, a_1, b_1, ..., a_N, b_N]`` for coordinate ``j`` of
@@ -289,6 +297,26 @@ class PeriodicSolution:
     #: about the frequency's.
     omega_error: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
+
+    def _displacement_lines(self, Omega: float | None,  # noqa: N803
+                            name: str) -> tuple[np.ndarray, np.ndarray, float, float]:
+        if self.omega is None:
+            raise ParameterError(name, f"has no spectrum: the solve did not converge (status "
+                                 f"{self.status})", allowed="a converged PeriodicSolution")
+        spin = self.balancer.Omega
+        if Omega is not None and _check.real("Omega", Omega) != spin:
+            raise ParameterError("Omega", f"a periodic solution spins at its model's Omega "
+                                 f"({spin}), got {Omega}", value=Omega)
+        n = self.N
+        ax, ay = self.coeffs[0], self.coeffs[1]
+        a_x, b_x = ax[1::2], ax[2::2]
+        a_y, b_y = ay[1::2], ay[2::2]
+        k = np.arange(-n, n + 1)
+        c = np.empty(2 * n + 1, dtype=complex)
+        c[n] = ax[0] + 1j * ay[0]
+        c[n + 1:] = 0.5 * ((a_x + b_y) + 1j * (a_y - b_x))
+        c[:n] = (0.5 * ((a_x - b_y) + 1j * (a_y + b_x)))[::-1]
+        return k, c, float(spin), float(self.omega)
 
     @property
     def converged(self) -> bool:
@@ -344,16 +372,12 @@ class PeriodicSolution:
         """The exact ground-frame spectrum: lines at ``Omega + k omega`` from the
         coefficients (:func:`ballbal.spectrum.line_spectrum`, which takes the keywords:
         ``natural_frequency_hz`` / ``_rpm``, ``eccentricity``, ``min_relative``)."""
-        from .spectrum import line_spectrum
-
         return line_spectrum(self, quantity, **keywords)
 
     def vibration(self, quantity: Literal["displacement", "velocity", "acceleration"]
                   = "acceleration") -> Vibration:
         """Mean, min, max and rms of ``|Z''|`` (or ``|Z|``, ``|Z'|``) over the orbit,
         exact from the coefficients (:func:`ballbal.spectrum.vibration`)."""
-        from .spectrum import vibration
-
         return vibration(self, quantity)
 
     def state(self, t: float = 0.0) -> np.ndarray:
@@ -421,27 +445,28 @@ def _homotopy(model: Balancer | Scene, homotopy: Any) -> list[tuple[str, float]]
     return out
 
 
+@refuses_keywords(PeriodicOptions)
 def periodic(
     model: Balancer | Scene,
     pattern: str = "R-R",
     *,
+    N: int | Literal["auto"] | None = None,  # noqa: N803
     options: PeriodicOptions | None = None,
     guess: PeriodicSolution | tuple[float, np.ndarray] | None = None,
     windings: Sequence[int] | None = None,
     homotopy: bool | dict[str, float] | Sequence[tuple[str, float]] | None = None,
-    **keywords: Any,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
     per ball) by Newton–IHB with ``N`` harmonics, and its Floquet multipliers.
 
     ``options``: a :class:`~ballbal.PeriodicOptions` (harmonic balance, Floquet, guess
-    search, certificates; default :data:`ballbal.options.PERIODIC_DEFAULTS`). The flat
-    keywords below are still accepted and change those options: ``N, target, N_max,
-    samples, tol, step_tol, max_iter`` (:class:`~ballbal.HarmonicBalance`), ``floquet``
-    (its ``monodromy``), ``hill, hill_band, rtol, atol, margin, max_steps, max_trivial,
-    refine`` (:class:`~ballbal.Floquet`; ``hill_band`` limits Hill to verdicts in doubt, as in
-    scans, and ``hill_stability`` is then None elsewhere), ``settle, window, guess_rtol,
-    guess_atol`` (:class:`~ballbal.GuessSearch`), ``max_closure, max_tail``.
+    search, certificates; default :data:`ballbal.options.PERIODIC_DEFAULTS`); the option
+    names below are its fields' (``hill`` is ``options.floquet.hill``, ``settle``
+    ``options.guess.settle``, ``max_closure`` ``options.max_closure``; ``hill_band``
+    limits Hill to verdicts in doubt, as in scans, and ``hill_stability`` is then None
+    elsewhere). ``N``: the harmonics (``options.harmonic_balance.N`` when given). The
+    flat option keywords of before (``hill=``, ``rtol=``, ...) are refused with a
+    :class:`~ballbal.exceptions.ParameterTypeError` naming the field that replaces each.
 
     Without ``guess`` the start comes from a time simulation (``settle`` time units for
     transients, then up to ``window`` to measure the period). One ball, when no start at
@@ -538,11 +563,11 @@ def periodic(
     :data:`~ballbal._check.MAX_SEARCH_DAMPING` (30): beyond, the simulated search for a
     start takes minutes; a ``guess`` (a solution continued there) lifts the bound.
     """
-    _check.model("model", model)
+    model_argument("model", model)
     _check.string("pattern", pattern)
     options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
                             "ballbal.PeriodicOptions")
-    options = with_keywords(options, "periodic", keywords, PERIODIC_KEYWORDS)
+    options = with_harmonics(options, N)
     wind = None if windings is None else _windings(windings)
     go: float | None = None
     gc: np.ndarray | None = None

@@ -14,7 +14,7 @@ from . import _check, _native
 from .analysis import Equilibrium, _equilibrium, capacities
 from .exceptions import ParameterError
 from .model import Balancer
-from .scene import Scene
+from .scene import Scene, model_argument
 
 
 def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
@@ -25,7 +25,7 @@ def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
     rest spacing is not the balancing spacing leave a nearly balanced state whose
     residual whirl is ``hypot(x, y)`` (in units of ``e``); it is followed from zero
     spring stiffness. Needs an autonomous scene."""
-    _check.model("model", model)
+    model_argument("model", model)
     d = _native.balanced_states([model])[0]
     return None if d is None else _equilibrium(d, capacities(model))
 
@@ -35,9 +35,11 @@ def balance_map(
     **axes: Sequence[float] | np.ndarray | tuple[float, float, float] | str,
 ) -> pl.DataFrame:
     """The balanced state's stability over a grid: one row per point of the product of
-    ``axes`` (parameter name = values; balancer fields such as ``Omega``, ``eta``,
+    ``axes`` (parameter name = values; the names the scene takes, as the core lists them
+    in ``_native.parameter_keys``: balancer fields such as ``Omega``, ``eta``,
     ``zeta_b``, ``zeta``, the scene's ``springs`` and tilt fields ``j_t``, ``j_z``,
-    ``zeta_r``, ``a``, ``b``; on a bearing ``rho``, ``depth_ratio``, ``groove_angle``).
+    ``zeta_r``, ``a``, ``b``; on a bearing ``rho``, ``depth_ratio``, ``groove_angle``;
+    ``gravity`` only at 0, where the scene stays autonomous).
     Points are solved in parallel in the core, each on its own, so the table does not
     depend on the thread count.
 
@@ -55,13 +57,12 @@ def balance_map(
     a list or array explicit values; finite, inside the parameter's range (a value
     outside it raises :class:`~ballbal.exceptions.ParameterError` naming the axis); the
     grid has at most :data:`~ballbal._check.MAX_MAP_POINTS` points."""
-    _check.model("model", model)
+    model_argument("model", model)
     if not axes:
         raise ParameterError("axes", "give at least one parameter to vary, e.g. Omega=[...]")
     scene = model if isinstance(model, Scene) else Scene(balancer=model)
     names = list(axes)
-    allowed = (_MAP_AXES | (_TILT_AXES if scene.tilt is not None else set())
-               | (_BEARING_AXES if scene.support is not None else set()))
+    allowed = set(_native.parameter_keys(scene))
     values: list[list[float]] = []
     for name in names:
         if name not in allowed:
@@ -104,10 +105,9 @@ def balance_map(
     return pl.DataFrame(cols, schema=schema)
 
 
-_MAP_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta", "springs"}
 #: The planar balancer's axes: the core sets them on each point's scene without checking
 #: them (issue 30: ``Omega=[-1.0]`` gave rows with verdicts), so they are checked here.
-_PLANAR_AXES = {"mu", "zeta", "zeta_b", "delta", "Omega", "eta"}
+_PLANAR_AXES = {p["key"] for p in _native.parameters() if p["key"] and p["planar"]}
 
 
 def _planar_range(balancer: Balancer, name: str, values: np.ndarray) -> None:
@@ -123,9 +123,6 @@ def _planar_range(balancer: Balancer, name: str, values: np.ndarray) -> None:
         except ParameterError as e:
             raise ParameterError(name, f"{x:g} is outside its range: {e.message}",
                                  allowed=e.allowed, value=x) from None
-_TILT_AXES = {"a", "b", "j_t", "j_z", "zeta_r"}
-#: On a bearing support: ``rho = e / c``, and the grooves' depth ratio and angle (degrees).
-_BEARING_AXES = {"rho", "depth_ratio", "groove_angle"}
 
 
 def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: str = "",

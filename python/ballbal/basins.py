@@ -47,7 +47,7 @@ from . import _check, _native
 from .exceptions import ParameterError, ParameterTypeError, ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .options import Execution
-from .scene import Scene
+from .scene import Scene, model_argument
 
 LABELS = ("perfect_balance", "other_equilibrium", "merged_R-R", "separated_R-R", "R-O",
           "O-O", "other", "not_settled", "failed")
@@ -411,7 +411,7 @@ def basins(
     ``samples`` only. Bad arguments raise a
     :class:`~ballbal.exceptions.ParameterError` naming them before any start is made.
     """
-    _check.model("model", model)
+    model_argument("model", model)
     if model.n_balls != 2:
         raise ParameterError("model", f"basins are drawn for two balls, got {model.n_balls}")
     options = _check.option("options", options, BasinOptions, BasinOptions(),

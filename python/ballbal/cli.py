@@ -14,8 +14,9 @@ import re
 import sys
 import time
 import warnings
+from dataclasses import replace
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import NoReturn
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from ._native import __version__
 from .analysis import equilibria, periodic
 from .exceptions import BallbalError, ParameterError, ScanInterrupted, ScanStoreError
 from .model import Balancer
-from .options import SCAN_HILL_BAND
+from .options import SCAN_DEFAULTS, SCAN_HILL_BAND
 from .scan import SCANNABLE, read_scan, scan, scan_meta
 from .scene import MAX_BALLS, Scene, load_scene
 
@@ -191,10 +192,13 @@ def _scan(a: argparse.Namespace) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ScanInterrupted)
-            hill: dict[str, Any] = {"doubt": {}, "all": {"hill": True},
-                                    "off": {"hill": False}}[a.hill]
-            df = scan(b, grid=grid, patterns=a.types, N=a.N, threads=a.threads,
-                      chunk=a.chunk, out=a.out, progress=not a.no_progress, **hill)
+            # --hill doubt: the default band; all: Hill beside every monodromy; off: none.
+            fl = SCAN_DEFAULTS.floquet
+            floquet = {"doubt": fl, "all": replace(fl, hill=True, hill_band=None),
+                       "off": replace(fl, hill=False)}[a.hill]
+            df = scan(b, grid=grid, patterns=a.types, N=a.N,
+                      options=replace(SCAN_DEFAULTS, floquet=floquet), threads=a.threads,
+                      chunk=a.chunk, out=a.out, progress=not a.no_progress)
     except ScanStoreError as e:  # another scan's directory, or one in use
         print(f"ballbal: error: {e}", file=sys.stderr)
         return 2

@@ -33,15 +33,17 @@ option                                ``periodic()``     ``scan()``
 
 from __future__ import annotations
 
+import functools
+import inspect
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, fields, replace
-from typing import Any, ClassVar, Literal
-
-import numpy as np
+from typing import Any, ClassVar, Literal, TypeVar, cast
 
 from . import _check, _native
 from .exceptions import ParameterError, ParameterTypeError
+
+_F = TypeVar("_F", bound=Callable[..., Any])
 
 #: Harmonics ``N = "auto"`` starts from.
 AUTO_START = 3
@@ -312,95 +314,93 @@ class Execution:
 PERIODIC_DEFAULTS = PeriodicOptions()
 SCAN_DEFAULTS = ScanOptions()
 
-#: The keyword arguments ``periodic()`` and ``scan()`` took before the option classes,
-#: still accepted: where each goes.
-_LEGACY: dict[str, tuple[str, str]] = {
-    "N": ("harmonic_balance", "N"), "target": ("harmonic_balance", "target"),
-    "N_max": ("harmonic_balance", "N_max"), "samples": ("harmonic_balance", "samples"),
-    "tol": ("harmonic_balance", "tol"), "step_tol": ("harmonic_balance", "step_tol"),
-    "max_iter": ("harmonic_balance", "max_iter"),
-    "floquet": ("floquet", "monodromy"), "hill": ("floquet", "hill"),
-    "rtol": ("floquet", "rtol"), "atol": ("floquet", "atol"),
-    "margin": ("floquet", "margin"), "max_steps": ("floquet", "max_steps"),
-    "max_trivial": ("floquet", "max_trivial"), "floquet_method": ("floquet", "method"),
-    "hill_target": ("floquet", "hill_target"), "hill_band": ("floquet", "hill_band"),
-    "refine": ("floquet", "refine"),
-    "settle": ("guess", "settle"), "window": ("guess", "window"),
-    "guess_rtol": ("guess", "rtol"), "guess_atol": ("guess", "atol"),
-    "seeds": ("guess", "seeds"), "starts": ("guess", "starts"),
-    "max_closure": ("", "max_closure"), "max_tail": ("", "max_tail"), "block": ("", "block"),
+#: The flat keywords ``periodic()``, ``scan()`` and ``switch()`` took beside the option
+#: classes, removed: the field of the options that replaces each (``floquet.hill``:
+#: ``options=PeriodicOptions(floquet=Floquet(hill=...))``), for the error that a caller
+#: of the old keyword gets. ``N=`` stays a keyword: the harmonics are the usual call.
+REMOVED_KEYWORDS: dict[str, str] = {
+    "target": "harmonic_balance.target", "N_max": "harmonic_balance.N_max",
+    "samples": "harmonic_balance.samples", "tol": "harmonic_balance.tol",
+    "step_tol": "harmonic_balance.step_tol", "max_iter": "harmonic_balance.max_iter",
+    "floquet": "floquet.monodromy", "hill": "floquet.hill", "rtol": "floquet.rtol",
+    "atol": "floquet.atol", "margin": "floquet.margin", "max_steps": "floquet.max_steps",
+    "max_trivial": "floquet.max_trivial", "floquet_method": "floquet.method",
+    "hill_target": "floquet.hill_target", "hill_band": "floquet.hill_band",
+    "refine": "floquet.refine",
+    "settle": "guess.settle", "window": "guess.window", "guess_rtol": "guess.rtol",
+    "guess_atol": "guess.atol", "seeds": "guess.seeds", "starts": "guess.starts",
+    "max_closure": "max_closure", "max_tail": "max_tail", "block": "block",
 }
+#: What a flat keyword set besides its field, said in its error.
+_ALSO = {"hill": "; hill=True also set floquet.hill_band=None (Hill on every solution)",
+         "guess_rtol": "; it also set guess.atol to rtol / 100 (periodic) or rtol / 1000 "
+                       "(scan)"}
+#: The option classes the parts of a field's path name.
+_PARTS = {"harmonic_balance": "HarmonicBalance", "floquet": "Floquet",
+          "guess": "GuessSearch"}
 
 
-# Options built from keywords, by (options, keywords): a loop of small solves with the
-# same keywords pays for the dataclasses' checks once, not on every call.
-_BUILT: dict[Any, Any] = {}
-
-
-def with_keywords(options: Any, where: str, kwargs: dict[str, Any],
-                  allowed: frozenset[str]) -> Any:
-    """``options`` with the keyword arguments of the flat, older interface applied.
-    ``guess_rtol`` alone also sets the guess's ``atol`` as that interface did (``rtol /
-    100`` for ``periodic()``, ``rtol / 1000`` for ``scan()``)."""
-    for k in kwargs:
-        if k not in allowed:
+def refuse_keywords(where: str, options_class: type, keywords: Iterable[str]) -> None:
+    """Raises for the first of ``keywords`` (ones ``where()`` does not take): a removed
+    flat option keyword that ``options_class`` has a field for as
+    :class:`~ballbal.exceptions.ParameterTypeError` naming that field, any other as
+    Python's ``TypeError``."""
+    cls = options_class.__name__
+    for k in keywords:
+        path = REMOVED_KEYWORDS.get(k)
+        part, _, name = (path or "").rpartition(".")
+        if path is None or (part or name) not in option_names(options_class):
             raise TypeError(f"{where}() got an unexpected keyword argument {k!r}")
-    if not kwargs:
+        if not part:
+            how = f"options={cls}({name}=...)"
+        elif options_class is ScanOptions:
+            # A scan's parts have defaults of their own: changed from them, not rebuilt.
+            how = f"options={cls}({part}=replace(SCAN_DEFAULTS.{part}, {name}=...))"
+        else:
+            how = f"options={cls}({part}={_PARTS[part]}({name}=...))"
+        raise ParameterTypeError(
+            k, f"{where}() takes no {k}= keyword: options are dataclasses, set "
+            f"{cls}.{path} instead ({how}){_ALSO.get(k, '')}", allowed=f"{cls}.{path}")
+
+
+def refuses_keywords(options_class: type) -> Callable[[_F], _F]:
+    """Makes a function without ``**keywords`` refuse a removed flat option keyword with
+    :func:`refuse_keywords`' error (naming its replacement) instead of Python's."""
+    def wrap(f: _F) -> _F:
+        takes = frozenset(inspect.signature(f).parameters)
+
+        @functools.wraps(f)
+        def checked(*args: Any, **kwargs: Any) -> Any:
+            if not takes.issuperset(kwargs):
+                refuse_keywords(f.__name__, options_class, sorted(kwargs.keys() - takes))
+            return f(*args, **kwargs)
+        return cast(_F, checked)
+    return wrap
+
+
+#: Options with ``N`` set, by (options, type of N, N): building them (their checks call
+#: the core) costs about 80 us, an eighth of a warm N = 3 solve, so a loop of small
+#: solves at ``N=8`` pays for it once. The type is part of the key: 3, 3.0 and True are
+#: equal and hash alike, and only 3 is a valid N.
+_WITH_N: dict[tuple[Any, type, Any], Any] = {}
+
+
+def with_harmonics(options: Any, N: int | Literal["auto"] | None) -> Any:  # noqa: N803
+    """``options`` with ``harmonic_balance.N`` set to ``N`` (unchanged for None)."""
+    if N is None:
         return options
+    key: tuple[Any, type, Any] | None = (options, type(N), N)
     try:
-        # types are part of the key: 1 and 1.0 and True are equal and hash alike
-        key: Any = (options, tuple((k, type(v), v) for k, v in sorted(kwargs.items())))
-        hit = _BUILT.get(key)
-    except TypeError:  # an unhashable value (a list): build it every time
-        key, hit = None, None
-    if hit is not None:
-        return hit
-    built = _with_keywords(options, kwargs)
-    if key is not None:
-        if len(_BUILT) >= 256:
-            _BUILT.clear()
-        _BUILT[key] = built
+        built = _WITH_N.get(key)  # type: ignore[arg-type]
+    except TypeError:  # an unhashable N (a list): built, and refused, every time
+        key, built = None, None
+    if built is None:
+        built = replace(options, harmonic_balance=replace(options.harmonic_balance, N=N))
+        if key is not None:
+            if len(_WITH_N) >= 64:
+                _WITH_N.clear()
+            _WITH_N[key] = built
     return built
-
-
-def _true(v: Any) -> bool:
-    # A bool or numpy bool that is true (anything else is left to the option's check).
-    return isinstance(v, (bool, np.bool_)) and bool(v)
-
-
-def _with_keywords(options: Any, kwargs: dict[str, Any]) -> Any:
-    kw = dict(kwargs)
-    if "hill_band" not in kw and _true(kw.get("hill")):
-        # ``hill=True`` always meant Hill beside every monodromy, also where the
-        # defaults (a scan's) cross-check only the doubtful verdicts.
-        kw["hill_band"] = None
-    if "guess_rtol" in kw and "guess_atol" not in kw:
-        r = _check.real("guess_rtol", kw["guess_rtol"])
-        kw["guess_atol"] = r * (1e-3 if isinstance(options, ScanOptions) else 1e-2)
-    parts: dict[str, dict[str, Any]] = {}
-    for k, v in kw.items():
-        part, name = _LEGACY[k]
-        parts.setdefault(part, {})[name] = v
-    top = parts.pop("", {})
-    part = ""
-    try:
-        for part, changes in parts.items():
-            top[part] = replace(getattr(options, part), **changes)
-        part = ""
-        return replace(options, **top)
-    except ParameterError as e:
-        # Name the keyword as the caller typed it (``floquet``, not ``monodromy``).
-        typed = [k for k in kw if _LEGACY[k][1] == e.parameter
-                 and _LEGACY[k][0] == part]
-        if typed and typed[0] != e.parameter:
-            raise type(e)(typed[0], e.message.removeprefix(f"{e.parameter}:").strip(),
-                          allowed=e.allowed, value=e.value) from e
-        raise
-
-
-PERIODIC_KEYWORDS = frozenset(k for k in _LEGACY
-                              if k not in ("seeds", "starts", "block"))
-SCAN_KEYWORDS = frozenset(_LEGACY)
 
 
 def option_names(cls: type) -> list[str]:

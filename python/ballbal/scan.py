@@ -37,47 +37,50 @@ from .exceptions import (
     ScanStoreWarning,
 )
 from .model import Balancer
-from .options import SCAN_DEFAULTS, SCAN_KEYWORDS, Execution, ScanOptions, with_keywords
-from .scene import Scene
+from .options import (
+    REMOVED_KEYWORDS,
+    SCAN_DEFAULTS,
+    Execution,
+    ScanOptions,
+    refuse_keywords,
+    with_harmonics,
+)
+from .scene import Scene, model_argument
 
 try:
     import fcntl
 except ImportError:  # pragma: no cover - not on POSIX: scan directories are not locked
     fcntl = None  # type: ignore[assignment]
 
-SCANNABLE = ("mu", "zeta", "zeta_b", "delta", "Omega", "eta")
-#: Scene parameters a scan can vary besides the balancer's (tilt fields need a tilt; the
-#: bearing's ``rho`` and groove ``depth_ratio``, ``groove_angle`` need a bearing support).
-SCENE_SCANNABLE = ("springs", "a", "b", "j_t", "j_z", "zeta_r", "rho", "depth_ratio",
-                   "groove_angle")
-_INDEXED = ("eta[", "zeta_b[")
+#: The parameter registry as the core serves it (``_native.parameters()``): the names,
+#: owners and ranges every model's parameters are checked with.
+PARAMETERS: tuple[dict[str, Any], ...] = tuple(_native.parameters())
+#: The planar balancer's parameters a scan can vary (per-ball ones also one ball at a
+#: time, ``eta[1]``).
+SCANNABLE: tuple[str, ...] = tuple(p["key"] for p in PARAMETERS if p["key"] and p["planar"])
+#: Scene parameters a scan can vary besides the balancer's: the core takes each only from
+#: a scene that has its component (the tilt's with a tilting disk, ``rho``,
+#: ``depth_ratio`` and ``groove_angle`` on a bearing support) and refuses a value that
+#: makes the scene time-dependent (gravity above 0).
+SCENE_SCANNABLE: tuple[str, ...] = tuple(p["key"] for p in PARAMETERS
+                                         if p["key"] and not p["planar"])
 
 GridSpec = Sequence[float] | np.ndarray | tuple[float, float, float] | str
 
 MULTIPLIER = pl.List(pl.Struct({"re": pl.Float64, "im": pl.Float64}))
-_SCHEMA: dict[str, Any] = {
-    "type": pl.Utf8, "solution": pl.Int64, "status": pl.Utf8, "omega": pl.Float64,
-    "omega_error": pl.Float64, "stability": pl.Utf8, "max_modulus": pl.Float64,
-    "modulus_error": pl.Float64, "modulus_error_source": pl.Utf8, "trivial_error": pl.Float64,
-    "multipliers": MULTIPLIER, "residual": pl.Float64, "tail": pl.Float64,
-    "closure": pl.Float64, "separation_error": pl.Float64,
-    "pivot_ratio": pl.Float64, "iterations": pl.Int64, "floquet_steps": pl.Int64,
-    "floquet_error": pl.Utf8, "N": pl.Int64, "attempts": pl.Int64, "seconds": pl.Float64,
-    "origin": pl.Utf8, "pb_exists": pl.Boolean, "pb_stable": pl.Boolean,
-    "target_met": pl.Boolean, "hill_stability": pl.Utf8, "verdicts_disagree": pl.Boolean,
-}
+#: polars' dtype for each column type of the core's schema.
+_DTYPES: dict[str, Any] = {"float": pl.Float64, "count": pl.Int64, "flag": pl.Boolean,
+                           "label": pl.Utf8, "multipliers": MULTIPLIER}
+#: A scan table's columns after the axes and their index columns, as the core serves
+#: them (``_native.scan_schema()``), with their polars dtypes.
+SCHEMA: dict[str, Any] = {name: _DTYPES[kind] for name, kind in _native.scan_schema()}
 
 
 def grid_values(name: str, spec: GridSpec) -> np.ndarray:
     """The values of one grid axis (:func:`ballbal._check.axis`, shared by every gridded
     function): ``(start, stop, step)`` or ``"start:stop:step"`` (both ends included),
-    or a sequence or array of explicit values."""
-    if not (name in SCANNABLE or name in SCENE_SCANNABLE
-            or (name.startswith(_INDEXED) and name.endswith("]"))):
-        raise ParameterError(
-            name, f"not a scannable parameter (choose from {', '.join(SCANNABLE)}, "
-            f"eta[i], zeta_b[i]; for scenes also {', '.join(SCENE_SCANNABLE)})"
-        )
+    or a sequence or array of explicit values. Whether a model has the parameter
+    ``name`` is the core's to say (:func:`scan` asks it before any work)."""
     if spec is None or isinstance(spec, (bool, np.bool_)):
         raise ParameterTypeError(name, f"grid values must be numbers, got {spec!r}")
     return _check.axis(name, spec)
@@ -126,7 +129,7 @@ class _Job:
             "block": self.block, "chunk": self.chunk,
             # A store written with other columns is not resumed into this table.
             # (the axes' index columns named generically: the axes are compared apart)
-            "columns": [_index_name("<axis>"), *_SCHEMA],
+            "columns": [_index_name("<axis>"), *SCHEMA],
             "model_columns": list(self.model_values()),
         }
 
@@ -233,7 +236,7 @@ def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
         order = np.argsort(grid, kind="stable")
         at = order[np.searchsorted(grid[order], np.asarray(d[n], dtype=np.float64))]
         cols[_index_name(n)] = pl.Series(_index_name(n), at, dtype=pl.Int64)
-    for c, dtype in _SCHEMA.items():
+    for c, dtype in SCHEMA.items():
         cols[c] = mult if c == "multipliers" else pl.Series(c, d[c], dtype=dtype)
     rows = len(d["type"])
     for k, v in job.model_values().items():
@@ -246,7 +249,7 @@ def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
 
 def _empty(names: Sequence[str], model_columns: Sequence[str]) -> pl.DataFrame:
     return pl.DataFrame(schema={**{n: pl.Float64 for n in names},
-                                **{_index_name(n): pl.Int64 for n in names}, **_SCHEMA,
+                                **{_index_name(n): pl.Int64 for n in names}, **SCHEMA,
                                 **{k: pl.Float64 for k in model_columns}})
 
 
@@ -628,7 +631,7 @@ class _Store:
                 hint = ""
                 if old.get("options", {}).get("hill") is False and "options.hill" in diff:
                     hint = (" (scans written before 2026-11-24 ran without Hill's "
-                            "cross-check by default: hill=False resumes them)")
+                            "cross-check by default: Floquet(hill=False) resumes them)")
                 raise ScanStoreError(
                     f"out: {self.dir} holds a different scan (it differs in "
                     f"{', '.join(diff)}){hint}; choose another directory or delete it")
@@ -729,6 +732,7 @@ def scan(  # noqa: E302 - overloads above
     model: Balancer | Scene,
     *,
     patterns: Sequence[str] = ("R-R",),
+    N: int | Literal["auto"] | None = None,  # noqa: N803
     options: ScanOptions | None = None,
     execution: Execution | None = None,
     chunk: int | None = None,
@@ -738,7 +742,7 @@ def scan(  # noqa: E302 - overloads above
     lazy: bool = False,
     executor: Any = None,
     grid: Mapping[str, GridSpec] | None = None,
-    **axes_and_options: Any,
+    **axes: GridSpec,
 ) -> pl.DataFrame | pl.LazyFrame:
     """Scan parameters of ``model`` over a grid and return one row per solution found.
 
@@ -764,11 +768,11 @@ def scan(  # noqa: E302 - overloads above
 
     ``options``: a :class:`~ballbal.ScanOptions` (what is computed; default
     :data:`ballbal.options.SCAN_DEFAULTS`, whose tolerances and guess search differ from
-    :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`). The flat keywords
-    of :func:`~ballbal.periodic` (``N, target, N_max, hill, hill_band, samples, tol, step_tol,
-    max_iter, floquet, rtol, atol, margin, max_steps, settle, window, guess_rtol,
-    guess_atol, max_tail, max_closure, max_trivial, refine``) and ``seeds, starts, block`` are
-    still accepted beside the axes and change those options. ``execution``: an
+    :func:`~ballbal.periodic`'s on purpose: see :mod:`ballbal.options`); ``N``: the
+    harmonics (``options.harmonic_balance.N`` when given). The flat option keywords of
+    before (``hill=``, ``seeds=``, ``block=``, ...) are refused with a
+    :class:`~ballbal.exceptions.ParameterTypeError` naming the field that replaces each
+    (they are no parameters, so never axes). ``execution``: an
     :class:`~ballbal.Execution` (where it runs: ``threads, chunk, executor, progress,
     out, lazy``); the keywords of the same names override it. Execution never changes
     the table.
@@ -830,10 +834,11 @@ def scan(  # noqa: E302 - overloads above
     ``N_max``): easy points stay cheap; ``N`` and ``target_met`` say what each row got.
     Hill's method cross-checks the verdicts where they are in doubt: a row whose
     monodromy gives no verdict, or whose leading non-trivial multiplier lies within
-    ``hill_band`` (default 0.2) of the unit circle or within ten times the monodromy's
-    own error estimate, gets Hill's verdict (``hill_stability``) and a flag where the
-    two contradict each other (``verdicts_disagree``); elsewhere both are null.
-    ``hill=True`` cross-checks every solution (``hill_band=None``), ``hill=False`` none.
+    ``floquet.hill_band`` (default 0.2) of the unit circle or within ten times the
+    monodromy's own error estimate, gets Hill's verdict (``hill_stability``) and a flag
+    where the two contradict each other (``verdicts_disagree``); elsewhere both are null.
+    ``hill_band=None`` cross-checks every solution, ``hill=False`` none (both fields of
+    ``options.floquet``).
 
     ``out``: a directory; each finished chunk is written there as Parquet at once
     (atomically), and a later call with the same arguments and ``out`` skips the chunks
@@ -860,7 +865,7 @@ def scan(  # noqa: E302 - overloads above
     Limits (checked before any work): at most 1e6 values per axis, 5e6 grid points for a
     table held in memory and 1e9 for one streamed to ``out=``.
     """
-    _check.model("model", model)
+    model_argument("model", model)
     options = _check.option("options", options, ScanOptions, SCAN_DEFAULTS,
                             "ballbal.ScanOptions")
     execution = _check.option("execution", execution, Execution, Execution(),
@@ -874,13 +879,13 @@ def scan(  # noqa: E302 - overloads above
         given["lazy"] = lazy
     if given:
         execution = replace(execution, **given)
-    opts = {k: axes_and_options.pop(k) for k in list(axes_and_options) if k in SCAN_KEYWORDS}
-    options = with_keywords(options, "scan", opts, SCAN_KEYWORDS)
+    refuse_keywords("scan", ScanOptions, [k for k in axes if k in REMOVED_KEYWORDS])
+    options = with_harmonics(options, N)
     p = _check.patterns("patterns", patterns)
     if not p:
         raise ParameterError("patterns", "give at least one solution type, e.g. ['R-R']")
     axes_all: dict[str, GridSpec] = dict(grid or {})
-    for k, v in axes_and_options.items():
+    for k, v in axes.items():
         if k in axes_all:
             raise ParameterError(k, "given twice (keyword and grid)")
         axes_all[k] = v
@@ -891,6 +896,8 @@ def scan(  # noqa: E302 - overloads above
     if (isinstance(model, Scene) and not model._effects_on()
             and not set(names) & set(SCENE_SCANNABLE)):
         model = model.balancer  # the same table, and a scan directory it can resume
+    # The core's own refusal of a name, before any value is read or file written.
+    _native.check_axes(model, list(names))
     values = tuple(tuple(grid_values(n, s).tolist()) for n, s in axes_all.items())
     ex = execution
     _check.grid_points([len(v) for v in values], names, streamed=ex.out is not None)

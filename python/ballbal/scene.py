@@ -557,3 +557,12 @@ def load_scene(path: str | os.PathLike[str]) -> Scene:
         raise ParameterError("path", f"{path} holds no keys; give at least the balancer's "
                              "(e.g. Omega = 1.2, balls = 2)", value=path)
     return scene_from_dict(d, where=str(path))
+
+
+def model_argument(name: str, v: Any) -> Balancer | Scene:
+    """A :class:`Balancer` or :class:`Scene` (what every analysis takes first)."""
+    if not isinstance(v, (Balancer, Scene)):
+        raise ParameterTypeError(
+            name, f"must be a ballbal.Balancer or ballbal.Scene, got {type(v).__name__}",
+            value=v)
+    return v

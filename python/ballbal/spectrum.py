@@ -84,37 +84,24 @@ def _natural_hz(hz: Any, rpm: Any) -> float | None:
 # Exact lines of a periodic solution or an equilibrium
 
 
+class LineSource:
+    """A result with displacement lines: :class:`~ballbal.PeriodicSolution` and
+    :class:`~ballbal.Equilibrium` derive from it, each saying how its lines follow from
+    its values, so that this module reads them without knowing the classes."""
+
+    def _displacement_lines(self, Omega: float | None,  # noqa: N803
+                            name: str) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """``(k, c_k, Omega, omega)``: the lines ``Z = sum c_k e^{i (Omega + k omega) t}``
+        (``omega`` NaN for a single line); ``name`` is the caller's for the result."""
+        raise NotImplementedError
+
+
 def _lines(source: PeriodicSolution | Equilibrium, Omega: float | None,  # noqa: N803
            name: str = "solution") -> tuple[np.ndarray, np.ndarray, float, float]:
     """``(k, c_k, Omega, omega)``: the displacement lines ``Z = sum c_k e^{i f_k t}``
     (``name``: the caller's name for ``source``)."""
-    from .analysis import Equilibrium, PeriodicSolution
-
-    if isinstance(source, PeriodicSolution):
-        if source.omega is None:
-            raise ParameterError(name, f"has no spectrum: the solve did not converge (status "
-                                 f"{source.status})", allowed="a converged PeriodicSolution")
-        spin = source.balancer.Omega
-        if Omega is not None and _check.real("Omega", Omega) != spin:
-            raise ParameterError("Omega", f"a periodic solution spins at its model's Omega "
-                                 f"({spin}), got {Omega}", value=Omega)
-        n = source.N
-        ax, ay = source.coeffs[0], source.coeffs[1]
-        a_x, b_x = ax[1::2], ax[2::2]
-        a_y, b_y = ay[1::2], ay[2::2]
-        k = np.arange(-n, n + 1)
-        c = np.empty(2 * n + 1, dtype=complex)
-        c[n] = ax[0] + 1j * ay[0]
-        c[n + 1:] = 0.5 * ((a_x + b_y) + 1j * (a_y - b_x))
-        c[:n] = (0.5 * ((a_x - b_y) + 1j * (a_y + b_x)))[::-1]
-        return k, c, float(spin), float(source.omega)
-    if isinstance(source, Equilibrium):
-        if Omega is None:
-            raise ParameterError("Omega", "an Equilibrium does not carry its model: give "
-                                 "Omega (the spin speed ratio it was computed at)")
-        spin = _check.real("Omega", Omega, finite=True)
-        return (np.zeros(1, dtype=int), np.array([source.q[0] + 1j * source.q[1]]),
-                spin, float("nan"))
+    if isinstance(source, LineSource):
+        return source._displacement_lines(Omega, name)
     raise ParameterTypeError(name, f"must be a ballbal.PeriodicSolution or "
                              f"ballbal.Equilibrium, got {type(source).__name__}",
                              value=source)
@@ -384,10 +371,8 @@ def vibration(
       ``t_min`` (leave out transients; over a whole number of periods or a long record
       the mean is that of the motion).
     """
-    from .analysis import Equilibrium, PeriodicSolution
-
     _quantity(quantity)
-    if isinstance(source, (PeriodicSolution, Equilibrium)):
+    if isinstance(source, LineSource):
         k, _, C, _, _ = _scaled_lines(source, quantity, Omega, "source")
         return _exact_vibration(C, k, quantity)
     if isinstance(source, pl.DataFrame):

@@ -39,6 +39,7 @@ from . import _check, _native
 from .basins import REST, ROTATING, BasinOptions
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
+from .scene import model_argument
 
 #: Longest ``dwell`` (and ``record``): the basins' classifier's longest ``t_end``
 #: (``BasinOptions``, checked in the core), which a step's dwell is.
@@ -137,7 +138,7 @@ def speed_sweep(
     from .analysis import simulate
     from .spectrum import ground_signal, signal_spectrum, vibration
 
-    _check.model("model", model)
+    model_argument("model", model)
     if not isinstance(model, Balancer):
         raise ParameterTypeError("model", "speed sweeps take a Balancer", value=model)
     if not isinstance(direction, str) or direction not in ("up-down", "up", "down"):

@@ -15,7 +15,7 @@ from .analysis import simulate
 from .balance import balanced_state
 from .exceptions import NotAutonomousError, ParameterError
 from .model import Balancer
-from .scene import Ramp, Scene
+from .scene import Ramp, Scene, model_argument
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ def disturbance_response(
 
     ``dt`` (the output step) must be at most ``t_end - start``, so that some samples
     follow the change; ``rtol`` (the integrator's) must be in (0, 1)."""
-    _check.model("model", model)
+    model_argument("model", model)
     to = _check.real("to", to, 0.0, lo_open=True)
     start = _check.real("start", start, 0.0)
     duration = _check.real("duration", duration, 0.0, lo_open=True)
@@ -112,7 +112,7 @@ def track_damping_study(
     minimum. At most :data:`~ballbal._check.MAX_STUDY_VALUES` dampings (each a
     simulation of ``t_end``)."""
     rows = []
-    _check.model("model", model)
+    model_argument("model", model)
     values = [zeta_b] if _check.is_real(zeta_b) else zeta_b
     for zb in _check.vector("zeta_b", values, _check.MAX_STUDY_VALUES):
         res = disturbance_response(model.replace(zeta_b=zb), to, **kw)
@@ -159,7 +159,7 @@ def run_up(
     balls at rest relative to the disk at angles ``balls``, in track order (default:
     spread over +-1 rad about the unbalance, where a classic balancer's balls make the
     resonance worst). A plain :class:`Balancer` runs up as a scene without effects."""
-    _check.model("model", model)
+    model_argument("model", model)
     scene = Scene(balancer=model) if isinstance(model, Balancer) else model
     to = _check.real("to", to, 0.0, lo_open=True)
     duration = _check.real("duration", duration, 0.0, lo_open=True)

@@ -493,3 +493,58 @@ pub fn default_chunk(lens: Vec<usize>) -> PyResult<usize> {
     }
     Ok(ballbal_core::scan::default_chunk(&lens))
 }
+
+/// The parameter registry (`ballbal_core::model::params::REGISTRY`), one dict per
+/// parameter in the registry's order: `name` (as errors name it), `key` (as scans and
+/// `with_param` take it, None when it cannot be varied by name), `owner` (the
+/// component), `planar` (owned by the planar balancer), `per_ball`, and the range
+/// `lo`, `lo_open`, `hi`, `hi_open`.
+#[pyfunction]
+pub fn parameters(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    use ballbal_core::model::params::{PLANAR_OWNERS, REGISTRY};
+    REGISTRY
+        .iter()
+        .map(|s| {
+            let d = PyDict::new(py);
+            d.set_item("name", s.name)?;
+            d.set_item("key", s.key)?;
+            d.set_item("owner", s.owner)?;
+            d.set_item("planar", PLANAR_OWNERS.contains(&s.owner))?;
+            d.set_item("per_ball", s.per_ball)?;
+            d.set_item("lo", s.range.lo)?;
+            d.set_item("lo_open", s.range.lo_open)?;
+            d.set_item("hi", s.range.hi)?;
+            d.set_item("hi_open", s.range.hi_open)?;
+            Ok(d)
+        })
+        .collect()
+}
+
+/// The model built as a scan builds it (a scene stays a scene).
+fn scanned_model(model: &ModelArgs) -> PyResult<Model> {
+    model.build(matches!(model, ModelArgs::Scene(_))).py()
+}
+
+/// Refuses the first of `names` the model cannot vary, with the core's error (the one
+/// a scan of it would stop with), before any work or file is started.
+#[pyfunction]
+pub fn check_axes(model: ModelArgs, names: Vec<String>) -> PyResult<()> {
+    let m = scanned_model(&model)?;
+    for n in &names {
+        dispatch!(&m, d => d.check_param(n)).py()?;
+    }
+    Ok(())
+}
+
+/// The registry's keys the model takes by name (its per-ball parameters as one key for
+/// every ball; `eta[i]` also takes one ball), in the registry's order.
+#[pyfunction]
+pub fn parameter_keys(model: ModelArgs) -> PyResult<Vec<&'static str>> {
+    use ballbal_core::model::params::REGISTRY;
+    let m = scanned_model(&model)?;
+    Ok(REGISTRY
+        .iter()
+        .filter_map(|s| s.key)
+        .filter(|k| dispatch!(&m, d => d.check_param(k)).is_ok())
+        .collect())
+}

@@ -152,3 +152,14 @@ pub fn scan_columns<'py>(
     )?;
     Ok(d)
 }
+
+/// A scan table's columns after its axes, with their types
+/// (`ballbal_core::scan::rows::SCAN_COLUMNS`): `(name, type)` with the type one of
+/// `"float"`, `"count"`, `"flag"`, `"label"`, `"multipliers"`.
+#[pyfunction]
+pub fn scan_schema() -> Vec<(&'static str, &'static str)> {
+    ballbal_core::scan::rows::SCAN_COLUMNS
+        .iter()
+        .map(|(n, t)| (*n, t.as_str()))
+        .collect()
+}

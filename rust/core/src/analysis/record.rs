@@ -18,6 +18,72 @@ pub enum Cell {
     V(Option<Vec<f64>>),
 }
 
+/// What a column of a result table holds: a real, a count, a yes/no, a label, or the
+/// multipliers (the `mult_re` and `mult_im` cells as one list of complex numbers).
+/// Every value may be missing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnType {
+    Float,
+    Count,
+    Flag,
+    Label,
+    Multipliers,
+}
+
+impl ColumnType {
+    /// The name the binding serves (`_native.scan_schema()`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ColumnType::Float => "float",
+            ColumnType::Count => "count",
+            ColumnType::Flag => "flag",
+            ColumnType::Label => "label",
+            ColumnType::Multipliers => "multipliers",
+        }
+    }
+
+    /// The type of a cell's values (a part of the multipliers for `V`).
+    pub fn of(cell: &Cell) -> ColumnType {
+        match cell {
+            Cell::F(_) => ColumnType::Float,
+            Cell::U(_) => ColumnType::Count,
+            Cell::B(_) => ColumnType::Flag,
+            Cell::S(_) | Cell::Text(_) => ColumnType::Label,
+            Cell::V(_) => ColumnType::Multipliers,
+        }
+    }
+}
+
+/// The types of [`SOLUTION_FIELDS`], in their order: what [`solution_cells`] makes
+/// of a solution (its `None`s are missing values of these types).
+pub const SOLUTION_TYPES: [ColumnType; 22] = {
+    use ColumnType::*;
+    [
+        Label,
+        Float,
+        Float,
+        Label,
+        Float,
+        Float,
+        Label,
+        Float,
+        Multipliers,
+        Multipliers,
+        Float,
+        Float,
+        Float,
+        Float,
+        Float,
+        Count,
+        Count,
+        Label,
+        Count,
+        Flag,
+        Label,
+        Flag,
+    ]
+};
+
 /// The schema's names, in the order of [`solution_cells`]. `pivot_ratio` is the last
 /// Newton matrix's largest over smallest LU pivot, a lower bound of its condition
 /// number (`PeriodicSolution.condition` before; stored scan tables use this name).
@@ -99,3 +165,42 @@ pub fn missing_cells(n_harm: usize) -> [Cell; 22] {
 /// The position of `N` in [`SOLUTION_FIELDS`].
 const N_FIELD: usize = 18;
 const _: () = assert!(matches!(SOLUTION_FIELDS[N_FIELD].as_bytes(), b"N"));
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::floquet::FloquetOptions;
+    use crate::periodic::{periodic, PeriodicOptions};
+    use crate::Planar;
+
+    /// Every cell a solution gives (with Floquet and Hill, so that every cell is made)
+    /// is of its declared type.
+    #[test]
+    fn cells_are_of_the_declared_types() {
+        let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
+        let opts = PeriodicOptions {
+            floquet: Some(FloquetOptions::default()),
+            hill: true,
+            ..Default::default()
+        };
+        let r = periodic(&p, &[true, true], None, &opts);
+        assert!(r.floquet.is_some() && r.hill.is_some());
+        // A missing solution's cells are missing values (F(None) stands for any type)
+        // but for its status and harmonics.
+        for ((name, cell), t) in SOLUTION_FIELDS
+            .iter()
+            .zip(&missing_cells(3))
+            .zip(SOLUTION_TYPES)
+        {
+            let missing = matches!(cell, Cell::F(None));
+            assert!(ColumnType::of(cell) == t || missing, "{name}: {cell:?}");
+        }
+        for ((name, cell), t) in SOLUTION_FIELDS
+            .iter()
+            .zip(solution_cells(&r))
+            .zip(SOLUTION_TYPES)
+        {
+            assert_eq!(ColumnType::of(&cell), t, "{name}");
+        }
+    }
+}

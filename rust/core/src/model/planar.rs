@@ -142,10 +142,19 @@ impl Planar {
     /// Returns a copy with one named parameter changed (used by scans and continuation):
     /// a registry name (`"mu"`, `"eta"` for every ball, `"eta[1]"`, the second ball: balls count from 0), revalidated.
     pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
-        let p = ParamRef::parse(name)
+        self.with(Self::param_ref(name)?, value)
+    }
+
+    /// Whether [`Self::with_param`] takes `name`: `Ok`, or its error for that name, which
+    /// comes before any value is looked at (a scan's axes are checked so before work).
+    pub fn check_param(&self, name: &str) -> Result<()> {
+        self.clone().set(Self::param_ref(name)?, 0.0)
+    }
+
+    fn param_ref(name: &str) -> Result<ParamRef> {
+        ParamRef::parse(name)
             .filter(|p| PLANAR_OWNERS.contains(&p.id.spec().owner))
-            .ok_or_else(|| unknown(name, "planar balancer", &key_list(PLANAR_OWNERS)))?;
-        self.with(p, value)
+            .ok_or_else(|| unknown(name, "planar balancer", &key_list(PLANAR_OWNERS)))
     }
 
     /// [`Self::with_param`] by typed id.

@@ -388,6 +388,14 @@ impl Scene {
         self.with(p, value)
     }
 
+    /// Whether [`Self::with_param`] takes `name`: `Ok`, or its error for that name (a
+    /// tilt parameter of a scene without a tilting disk, ...), which comes before any
+    /// value is looked at.
+    pub fn check_param(&self, name: &str) -> Result<()> {
+        let p = ParamRef::parse(name).ok_or_else(|| unknown(name, "scene", &Self::keys()))?;
+        self.clone().set_field(p, 0.0)
+    }
+
     /// [`Self::with_param`] by typed id.
     pub fn with(&self, p: ParamRef, value: f64) -> Result<Self> {
         let mut s = self.clone();

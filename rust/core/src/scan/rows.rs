@@ -3,8 +3,48 @@
 
 use super::grid::Local;
 use super::Found;
+use crate::analysis::record::ColumnType;
 use crate::continuation::{Lattice, Tally};
 use crate::periodic::Periodic;
+
+/// A scan table's columns after the grid's axes (and their index columns), in the
+/// order the tables and their stored files have always had: the solution type, the
+/// solution's number, the solution's schema ([`crate::analysis::record::SOLUTION_FIELDS`],
+/// the multipliers as one column) with how the row was reached (a [`ScanRow`]'s own
+/// fields) after `N`. The binding serves it, so the Python tables restate nothing.
+pub const SCAN_COLUMNS: [(&str, ColumnType); 28] = {
+    use ColumnType::*;
+    [
+        ("type", Label),
+        ("solution", Count),
+        ("status", Label),
+        ("omega", Float),
+        ("omega_error", Float),
+        ("stability", Label),
+        ("max_modulus", Float),
+        ("modulus_error", Float),
+        ("modulus_error_source", Label),
+        ("trivial_error", Float),
+        ("multipliers", Multipliers),
+        ("residual", Float),
+        ("tail", Float),
+        ("closure", Float),
+        ("separation_error", Float),
+        ("pivot_ratio", Float),
+        ("iterations", Count),
+        ("floquet_steps", Count),
+        ("floquet_error", Label),
+        ("N", Count),
+        ("attempts", Count),
+        ("seconds", Float),
+        ("origin", Label),
+        ("pb_exists", Flag),
+        ("pb_stable", Flag),
+        ("target_met", Flag),
+        ("hill_stability", Label),
+        ("verdicts_disagree", Flag),
+    ]
+};
 
 /// How a scan reached a solution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,4 +148,36 @@ pub(super) fn rows(
         }
     }
     rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::record::{SOLUTION_FIELDS, SOLUTION_TYPES};
+
+    /// The scan's columns are the solution's schema (the multipliers' two parts as one
+    /// column), each with its type, plus the row's own columns, each once.
+    #[test]
+    fn scan_columns_hold_the_solution_schema() {
+        let own = [
+            ("type", ColumnType::Label),
+            ("solution", ColumnType::Count),
+            ("attempts", ColumnType::Count),
+            ("seconds", ColumnType::Float),
+            ("origin", ColumnType::Label),
+            ("pb_exists", ColumnType::Flag),
+            ("pb_stable", ColumnType::Flag),
+        ];
+        let mut expected: Vec<(&str, ColumnType)> = SOLUTION_FIELDS
+            .iter()
+            .zip(SOLUTION_TYPES)
+            .filter(|(n, _)| **n != "mult_im")
+            .map(|(n, t)| (if *n == "mult_re" { "multipliers" } else { *n }, t))
+            .chain(own)
+            .collect();
+        let mut got = SCAN_COLUMNS.to_vec();
+        expected.sort_by_key(|c| c.0);
+        got.sort_by_key(|c| c.0);
+        assert_eq!(got, expected);
+    }
 }
