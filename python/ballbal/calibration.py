@@ -126,6 +126,12 @@ class Calibration:
         return fig
 
 
+def _balancer(model: Any) -> None:
+    if not isinstance(model, Balancer):
+        raise ParameterTypeError("model", "calibration works on a ballbal.Balancer, got "
+                                 f"{type(model).__name__}", value=model)
+
+
 def _features(source: Any) -> pl.DataFrame:
     if isinstance(source, Record):
         return source.features()
@@ -171,9 +177,7 @@ def calibrate(
     from .analysis import periodic
     from .spectrum import line_spectrum
 
-    _check.model("model", model)
-    if not isinstance(model, Balancer):
-        raise ParameterTypeError("model", "calibration fits a ballbal.Balancer")
+    _balancer(model)
     ft = _features(features)
     names = [_check.string("free", f) for f in _check.sequence("free", free)]
     for f in names:
@@ -288,7 +292,7 @@ def stable_band_end(model: Balancer, pattern: str = "R-R", *,
     from .analysis import periodic
     from .scan import scan
 
-    _check.model("model", model)
+    _balancer(model)
     n_refine = _check.integer("refine", refine, 0, 60)
     df = scan(model, Omega=Omega, patterns=[pattern])
     st = df.filter(pl.col("stability") == "stable")
@@ -359,7 +363,7 @@ def calibrate_transition(
     bracket for the answer to be unique: the function checks the ends' order."""
     from scipy import optimize
 
-    _check.model("model", model)
+    _balancer(model)
     _check.string("parameter", parameter)
     if parameter not in CALIBRATABLE or parameter == "natural_frequency_rpm":
         allowed = ", ".join(k for k in CALIBRATABLE if k != "natural_frequency_rpm")
