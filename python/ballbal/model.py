@@ -44,7 +44,7 @@ def _unknown_fields(cls: type, changes: dict[str, Any]) -> None:
 
 @dataclass(frozen=True)
 class Balancer:
-    """A planar automatic ball balancer in the thesis' nondimensional parameters.
+    """A planar automatic ball balancer in the nondimensional parameters of [Tien2011].
 
     ``eta`` has one entry per ball (its length is the number of balls ``n``); ``zeta_b``
     is one value shared by all balls or one per ball. The core checks the parameters
