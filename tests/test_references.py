@@ -49,7 +49,7 @@ def entries() -> set[str]:
 def test_references_page_lists_the_five_sources() -> None:
     assert REFERENCES.exists(), f"{REFERENCES}: set BALLBAL_REPO to the repository checkout"
     keys = entries()
-    # The thesis the planar model follows and the ball-spring/tilt paper at least.
+    # Tien (2011) the planar model follows and the ball-spring/tilt paper at least.
     assert {"Tien2011", "Rezaee2017"} <= keys, keys
     assert len(keys) == 5, keys
 

@@ -1,11 +1,11 @@
-"""Hydrodynamic journal bearings, plain and herringbone-grooved (seed 002, ``bearing.md``).
+"""Hydrodynamic journal bearings, plain and herringbone-grooved ([Yen2005], ``bearing.md``).
 
 Nondimensional description of the film (``bearing.md`` section 1): ``length_ratio`` is
 ``L / D``; positions are over the radial clearance ``c``, pressures over
 ``mu w R^2 / c^2`` and forces over ``F_S = mu w L R^3 / c^2``.
 
 :class:`Grooves` are symmetric herringbone grooves over the bearing's length, on the
-stationary ``"sleeve"`` (the seed's configuration) or on the rotating ``"journal"``; the
+stationary ``"sleeve"`` (Yen's (2005) configuration) or on the rotating ``"journal"``; the
 angle is in degrees **from the circumferential direction** (90 would be axial grooves).
 The apex at the mid-plane points in the direction in which the smooth surface moves
 relative to the grooved one, so the grooves pump towards the mid-plane.
@@ -97,7 +97,7 @@ def default_grid(grooves: Grooves | None, model: str = "finite") -> tuple[int, i
 @dataclass(frozen=True)
 class Bearing:
     """A journal bearing: ``length_ratio`` = L/D, optional :class:`Grooves`, the
-    ``cavitation`` condition (``"half_sommerfeld"``, the seed's and the default;
+    ``cavitation`` condition (``"half_sommerfeld"``, Yen's (2005) and the default;
     ``"reynolds"``; ``"none"``), the film ``model`` (``"short"``, ``"long"``,
     ``"finite"``, ``"narrow_groove"``) and the grid ``(n_theta, n_zeta)`` of the finite
     and narrow-groove models (``None``: :func:`default_grid`); at most
@@ -475,7 +475,7 @@ def plot_pressure(force_or_bearing: FilmForce | Bearing, position: Any = None,
 
 
 # Imported last (they need :class:`Bearing`, defined above): a rigid rotor on the bearing
-# (fixed frame, no balls; seed 002's scenarios) and the groove study (a parallel scan over
+# (fixed frame, no balls; Yen's (2005) scenarios) and the groove study (a parallel scan over
 # groove parameters).
 from ._groove_study import groove_study, plot_groove_study  # noqa: E402
 from ._rotor import (  # noqa: E402
