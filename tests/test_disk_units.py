@@ -1,10 +1,10 @@
 """Equilibrium continuation in units of the disk alone (omega0, m0, e, C0, D0) and
-[EccentricRotorABB]'s figure 4: the saddle-node curve SN_2+ against the closed form of its condition (14) taken
-as an equality, the pitchfork at m0 = e/2, the perfect balance's Hopf curve H_1 against a
-Routh–Hurwitz computation (the characteristic polynomial built in
-test_eq_continuation.py from model.md's equations, with the conversion to the model's units
-written out here), and the point where they meet, (omega0, m0) = (1/sqrt(1 + 2 m0), e/2)
-= (0.5773, 1)."""
+[EccentricRotorABB]'s figure 4: the saddle-node curve SN_2+ against the closed form of its
+condition (14) taken as an equality, the pitchfork at m0 = e/2, the perfect balance's Hopf
+curve H_1 against a Routh–Hurwitz computation (the characteristic polynomial built in
+test_eq_continuation.py from model.md's equations, with the conversion to the model's
+units written out here), and the point where they meet, (omega0, m0) =
+(1/sqrt(1 + 2 m0), e/2) = (0.5773, 1)."""
 
 from __future__ import annotations
 

@@ -6,7 +6,8 @@ the eccentricity ``e``, time over ``1/w_n``, forces over ``M e w_n^2``):
 * ``springs``: circumferential springs between neighbouring balls, stiffness ``k_d / k``,
   rest spacing ``2 pi / n`` (the ball-spring balancer of [Rezaee2017]); ``spring_layout``
   ``"ring"`` (n springs, ball n to ball 1 closing the ring) or ``"chain"`` (the
-  [Rezaee2017] form: n - 1 springs, ball 1 to ball n; for two balls a ring of stiffness k is a chain of 2 k);
+  [Rezaee2017] form: n - 1 springs, ball 1 to ball n; for two balls a ring of stiffness k
+  is a chain of 2 k);
 * ``ramp``: the spin changes linearly from ``Omega`` to ``ramp.to`` over
   ``ramp.duration`` from ``ramp.start`` (a run-up, or the speed disturbance of [TwoBallStrength]);
 * ``gravity``: ``g / (e w_n^2)`` for a horizontal spin axis (gravity along -Y of the
