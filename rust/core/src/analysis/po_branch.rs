@@ -752,7 +752,7 @@ mod tests {
         assert!(ns(0.9).1 > 0.0 && ns(1.1).1 > 0.0);
     }
 
-    /// Tien's (2011) standard R-R orbit continued up in Omega: every point's residual is
+    /// The thesis' standard R-R orbit continued up in Omega: every point's residual is
     /// Newton's, and a point re-solved by `periodic()` at its Omega gives the same omega.
     #[test]
     fn branch_points_are_solutions_of_periodic() {
