@@ -1,4 +1,4 @@
-"""Basin grids: starts per second on 1 and 2 threads at the thesis' 1000 time units
+"""Basin grids: starts per second on 1 and 2 threads at Tien's (2011) 1000 time units
 (figures 4-15 / 4-16: mu 0.2, zeta 0.05, zeta_b 0.05, delta 50, eta 0.7), and the time a
 200 x 200 map would take, extrapolated from a smaller grid (targets: at most 10 ms per
 start on one core, a 200 x 200 map in under 3 minutes on 2 cores). The starts are

@@ -5,7 +5,8 @@
 1. ballbal's per-evaluation costs (short closed form, plain finite 128 x 32 by the sine
    transform, herringbone 256 x 32 by sparse Cholesky cold and along a trajectory with the
    old factor as CG preconditioner) come from the core's timing test
-   (``cargo test --release -p ballbal-core bearing_bench -- --ignored``), run here if
+   (``cargo test --release -p ballbal-core --features studies bearing_bench --
+   --ignored``), run here if
    ``cargo`` is on the path; they are wall clock on a shared machine (callgrind counts are
    in ``rust/core/src/model/bearing/finite.rs``).
 2. ROSS (``ross-rotordynamics``, optional, skipped with a message when missing): its
@@ -40,7 +41,8 @@ def core_timings() -> dict[str, float]:
         print("cargo not found: skipping the core's per-evaluation timings")
         return {}
     out = subprocess.run(
-        ["cargo", "test", "--release", "-q", "-p", "ballbal-core", "bearing_bench", "--",
+        ["cargo", "test", "--release", "-q", "-p", "ballbal-core", "--features", "studies",
+         "bearing_bench", "--",
          "--ignored", "--nocapture"],
         cwd=ROOT, capture_output=True, text=True, check=False).stdout
     found = {}

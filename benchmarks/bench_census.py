@@ -485,7 +485,7 @@ def issue_points() -> list[Point]:
     """Points near stability changes, from issue 31."""
     th = dict(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0)
     return [
-        # the thesis' stable R-O of its table 4-7 (omega 0.3047), in the first bullet's map
+        # Tien's (2011) stable R-O of its table 4-7 (omega 0.3047), in the first bullet's map
         Point("issue-map-1.3-0.7", th["mu"], th["zeta"], th["zeta_b"], th["delta"], 1.3,
               (0.7, 0.7)),
         # where that map's perfect balance is unstable and its scan lists no stable orbit

@@ -3,7 +3,7 @@
 The core adds up the time it spends in the certificate checks (the integrated ODE defect
 of every accepted series, and the merged balls' separation product after each Floquet
 analysis) in a process-wide counter, `_native.certificate_seconds()`. This runs the
-thesis grid (zeta 0.05, zeta_b 0.1; Omega 1.0-2.0 step 0.1, eta 0.4-1.5 step 0.1; R-R,
+Tien (2011) grid (zeta 0.05, zeta_b 0.1; Omega 1.0-2.0 step 0.1, eta 0.4-1.5 step 0.1; R-R,
 O-O, R-O; N = 3) and prints that time against the scan's CPU time (wall time x
 threads), per point and as a fraction: the same build, the same run, the checks timed
 where they run.

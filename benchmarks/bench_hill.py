@@ -1,6 +1,6 @@
 """Cost of Hill's-method cross-check (``periodic(..., hill=True)``, and at the scan's
 ``hill_target="verdict"``) against the monodromy
-it cross-checks (RK45 at the scan's rtol 1e-6, and Magnus), at the thesis' standard case
+it cross-checks (RK45 at the scan's rtol 1e-6, and Magnus), at Tien's (2011) standard case
 (Omega 1.2, eta 1.0, balls merged, R-R) and its hard case (Omega 1.0, eta 0.7, period
 ~106), N = 3 and 8, with the Hill multipliers' error against RK45 at rtol 1e-12.
 
@@ -18,9 +18,9 @@ clamp(N + 4, 8, 24)) is reachable only in the core (``hill_multipliers_dense``);
 is printed beside today's from the callgrind counts below, and ``--rust`` runs the
 core's ``hill_profile`` test, which times both on the same series:
 
-    cargo test --release -p ballbal-core --lib --no-run
+    cargo test --release -p ballbal-core --features studies --lib --no-run
     valgrind --tool=callgrind target/release/deps/ballbal_core-* --ignored --exact \\
-        numerics::floquet::tests::hill_profile
+        numerics::floquet::studies::hill_profile
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ CALLGRIND = {(3, 2): (146.9e6, 14.1e6), (8, 2): (347.7e6, 14.2e6),
 
 # The scan's verdict target (hill_target="verdict"), callgrind on 2026-11-23: the
 # standard case N = 3 at H = 3 (42 + 14 rows) 4.3 M per call (the multipliers target
-# 14.1 M at H = 6); over the thesis grid (zeta = zeta_b = 0.05, N = 3, all three types,
+# 14.1 M at H = 6); over Tien (2011) grid (zeta = zeta_b = 0.05, N = 3, all three types,
 # one thread, 190 solutions) Hill 1.19 G = 6.3 M per solution against the Magnus
 # monodromy's 0.57 G = 3.0 M, 15 % of the scan's 7.85 G. 146 of the 190 solutions
 # settle at H = 3, all at the first truncation tried. The fine grid (101 x 111, R-R,
@@ -60,8 +60,8 @@ CALLGRIND = {(3, 2): (146.9e6, 14.1e6), (8, 2): (347.7e6, 14.2e6),
 # H = 3): on a 26 x 28 R-R grid (840 solutions, callgrind) hill_verdict 5.49 M -> 4.80 M
 # per solution; the fine grid's Hill extra 90-91 % -> 80 % of CPU time (one thread,
 # alternating runs). faer's Schur iteration is 84 % of what remains.
-SCAN_CALLGRIND = {"standard N=3, per call": 4.3e6, "thesis grid, per solution": 6.3e6,
-                  "Magnus, thesis grid, per solution": 3.0e6}
+SCAN_CALLGRIND = {"standard N=3, per call": 4.3e6, "Tien (2011) grid, per solution": 6.3e6,
+                  "Magnus, Tien (2011) grid, per solution": 3.0e6}
 
 
 def case(name: str, b: ballbal.Balancer, seed: ballbal.PeriodicSolution, N: int) -> None:
@@ -142,8 +142,8 @@ def main() -> None:
     if "--rust" in sys.argv:
         root = Path(__file__).resolve().parent.parent
         out = subprocess.run(
-            ["cargo", "test", "--release", "-q", "-p", "ballbal-core", "--lib",
-             "hill_profile", "--", "--ignored", "--nocapture"],
+            ["cargo", "test", "--release", "-q", "-p", "ballbal-core", "--features",
+             "studies", "--lib", "hill_profile", "--", "--ignored", "--nocapture"],
             cwd=root, capture_output=True, text=True, check=True).stdout
         print("\ncore, same series, one call each (today's hill vs hill_multipliers_dense):")
         print("\n".join("  " + ln for ln in out.splitlines() if ln.startswith("N=")))

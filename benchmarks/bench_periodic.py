@@ -1,4 +1,4 @@
-"""Per-point cost of a periodic solution at the thesis' standard case (Omega 1.2, eta 1.0,
+"""Per-point cost of a periodic solution at Tien's (2011) standard case (Omega 1.2, eta 1.0,
 balls merged, R-R) and its hard case (Omega 1.0, eta 0.7, period ~106): Newton-IHB from
 a neighbour's warm start against N, and the Floquet multipliers by both monodromy
 methods side by side (``Floquet(method="rk45")``, today's, and ``"magnus"``) with their
@@ -9,12 +9,12 @@ errors against a tight reference; Hill's-method cross-check; scipy shooting for 
 Wall clock on a shared machine is noisy (medians of many repeats); the Rust core's
 instruction counts under callgrind are steadier:
 
-    cargo test --release -p ballbal-core --lib --no-run
+    cargo test --release -p ballbal-core --features studies --lib --no-run
     valgrind --tool=callgrind target/release/deps/ballbal_core-* --ignored --exact \\
-        numerics::floquet::tests::magnus_profile        # RK45, Magnus, Hill
+        numerics::floquet::studies::magnus_profile        # RK45, Magnus, Hill
     BALLBAL_HB_N=8 valgrind --tool=callgrind --toggle-collect='*warm_solve*' \\
         target/release/deps/ballbal_core-* --ignored --exact \\
-        numerics::hb::tests::hb_profile  # 20 warm HB solves at N (total / 20 per solve)
+        numerics::hb::studies::hb_profile  # 20 warm HB solves at N (total / 20 per solve)
 
 Instructions per warm solve (certificates included), 2026-11-23, before -> after the
 product-to-sum Jacobian (N > 3) and the reuse of the accepted trial's residual:
@@ -24,8 +24,8 @@ Then (same harness, 2026-11-23 night): the basis and DFT tables kept per thread,
 vectorised along the samples and faer factoring the row-major view (every result the
 same to the bit): N = 3: 1.87 M -> 1.82 M, N = 6: 3.00 M -> 2.76 M, N = 8: 4.45 M ->
 4.06 M, N = 12: 8.32 M -> 7.45 M; N = 8 / N = 3: 2.38 -> 2.23. Chord steps ending the
-N > 3 solves (reusing the last LU) measured N = 8 / N = 3 = 2.01 but made one thesis
-N = 8 scan gain a solution, unexplained, and were taken out again (commit e6f873a has
+N > 3 solves (reusing the last LU) measured N = 8 / N = 3 = 2.01 but made one Omega-eta
+map N = 8 scan gain a solution, unexplained, and were taken out again (commit e6f873a has
 them).
 Then (2026-11-24) the sample count above N = 3 grows as 4 (N + 5) instead of 8 (N + 1)
 (N = 8: 52 samples, not 72; aliasing measured at round-off, see ``hb::default_samples``;
@@ -147,7 +147,7 @@ def main() -> None:
     b = ballbal.Balancer(**base, Omega=1.2)
     neighbour = ballbal.Balancer(**base, Omega=1.19)  # fine-grid neighbour, step 0.01
     seed = ballbal.periodic(neighbour, "R-R", N=12)
-    print("thesis standard case, warm start from the fine-grid neighbour Omega = 1.19")
+    print("Tien (2011) standard case, warm start from the fine-grid neighbour Omega = 1.19")
     harmonic_balance(b, seed)
     for N in (3, 8):
         floquet_methods("standard case", b, seed, N)

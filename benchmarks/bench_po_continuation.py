@@ -1,6 +1,6 @@
 """Periodic continuation speed (issue 15), printed side by side:
 
-* a 200-point branch of the thesis' standard merged R-R orbit (mu 0.2, zeta 0.05,
+* a 200-point branch of Tien's (2011) standard merged R-R orbit (mu 0.2, zeta 0.05,
   zeta_b 0.05, delta 50, eta 1, N = 8) continued in Omega by pseudo-arclength, every
   point with its certificates, Floquet multipliers and located events, against
   ``ballbal.scan`` (natural-parameter continuation on the scan's lattice, one thread)

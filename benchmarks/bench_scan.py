@@ -1,11 +1,11 @@
 """Scan throughput, including Floquet, on 1 and 2 threads, side by side:
 
-* the thesis grid (Omega 1.0-2.0, eta 0.4-1.5, step 0.1; mu 0.2, delta 50), all three
+* Tien (2011) grid (Omega 1.0-2.0, eta 0.4-1.5, step 0.1; mu 0.2, delta 50), all three
   two-ball types, at the standard point (zeta = zeta_b = 0.05) and at zeta_b = 0.1;
 * the fine grid (101 x 111, step 0.01) for R-R.
 
 Each at N = 3 and N = 8 (the fine grid at N = 3 with ``--quick``). Targets (issue 17):
-thesis grid, all three types, at most 0.35 s on 1 thread and 0.2 s on 2; 1-to-2-thread
+Tien (2011) grid, all three types, at most 0.35 s on 1 thread and 0.2 s on 2; 1-to-2-thread
 speed-up at least 1.85.
 
 Per-stage costs (one thread, from ``_native.scan_stage_seconds``): perfect-balance
@@ -20,7 +20,7 @@ would add instead.
 ``ballbal`` package, put first on ``PYTHONPATH`` in a subprocess), printed beside.
 
     python benchmarks/bench_scan.py                       # everything (minutes)
-    python benchmarks/bench_scan.py --quick               # thesis grids, N = 3
+    python benchmarks/bench_scan.py --quick               # Omega-eta map grids, N = 3
     python benchmarks/bench_scan.py --fine                # fine grid, profiled runs only
     python benchmarks/bench_scan.py --quick --old /work/ref/before_pkg
 
@@ -49,7 +49,7 @@ import subprocess
 import sys
 import time
 
-THESIS = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
+MAP_GRID = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
 FINE = {"Omega": (1.0, 2.0, 0.01), "eta": (0.4, 1.5, 0.01)}
 ALL = ("R-R", "O-O", "R-O")
 
@@ -211,13 +211,13 @@ def main() -> None:
     quick = "--quick" in sys.argv
     old = sys.argv[sys.argv.index("--old") + 1] if "--old" in sys.argv else None
     rows: list[tuple[str, dict, tuple[str, ...], int, float, int]] = [
-        ("thesis, zeta_b 0.05", THESIS, ALL, 3, 0.05, 3),
-        ("thesis, zeta_b 0.1", THESIS, ALL, 3, 0.1, 3)]
+        ("thesis, zeta_b 0.05", MAP_GRID, ALL, 3, 0.05, 3),
+        ("thesis, zeta_b 0.1", MAP_GRID, ALL, 3, 0.1, 3)]
     if "--fine" in sys.argv:
         rows = [("fine 101x111, zb 0.05", FINE, ("R-R",), 3, 0.05, 0)]
     elif not quick:
-        rows += [("thesis, zeta_b 0.05", THESIS, ALL, 8, 0.05, 3),
-                 ("thesis, zeta_b 0.1", THESIS, ALL, 8, 0.1, 3),
+        rows += [("thesis, zeta_b 0.05", MAP_GRID, ALL, 8, 0.05, 3),
+                 ("thesis, zeta_b 0.1", MAP_GRID, ALL, 8, 0.1, 3),
                  ("fine 101x111, zb 0.05", FINE, ("R-R",), 3, 0.05, 1)]
     print(f"{'grid':<24} {'types':<12} {'N':>2} {'points':>6} {'sols':>5} {'stable':>6} "
           f"{'1 thr s':>8} {'2 thr s':>8} {'speed-up':>8} {'ceiling':>7}"

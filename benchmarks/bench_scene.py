@@ -77,7 +77,7 @@ def main() -> None:
                                                                              hill=False))), 40)
         grid = np.linspace(0.5, 3.0, 200)
         tmap = best_time(lambda: ballbal.balance_map(ts, Omega=grid), 5)
-        print("tilting disk on a flexible shaft (seed 004):")
+        print("tilting disk on a flexible shaft (Rezaee et al. 2017):")
         print(f"  simulate 1000 time units (rtol 1e-8):  {tsim * 1e3:8.3f} ms "
               f"({tsim / sim:.2f} x planar)")
         print(f"  harmonic balance, N =  8, warm start: {thb * 1e6:8.1f} us "

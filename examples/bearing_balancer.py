@@ -16,7 +16,7 @@ beside the plain bearing, on which the centred rotor is unstable at every speed:
 film at the centre has only cross-coupled stiffness, so nothing holds the centred journal
 (the largest real part of the eigenvalues is drawn against speed, plain and grooved).
 
-Parameters and why: the thesis balancer (``mu = 0.2``, ``delta = 50``, two balls of ``eta =
+Parameters and why: Tien (2011) balancer (``mu = 0.2``, ``delta = 50``, two balls of ``eta =
 1``, ``zeta_b = 0.05``) with ``zeta = 0`` (the film's damping only); a short bearing, ``L/D
 = 0.5``; 8 grooves on the journal (so the scene stays autonomous: grooves on the sleeve
 with the resolved finite model make it time-periodic, simulation only), width ratio 0.5

@@ -1,6 +1,6 @@
 """R-R motions of ball-spring balancers (scans of scenes): where balls that chase round
 the track exist and are stable, over spin speed and spring stiffness, for a planar disk
-and for an off-centre disk that tilts on its shaft (seed 004's rotor).
+and for an off-centre disk that tilts on its shaft (Rezaee et al.'s (2017) rotor).
 
     python examples/scene_maps.py [output-directory]      # about 10 s on 2 cores
 

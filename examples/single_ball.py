@@ -1,4 +1,4 @@
-"""The thesis' single-ball experiment (seed 000, section 4-3) in the model: the support
+"""Tien's (2011) single-ball experiment (section 4-3) in the model: the support
 vibration (mean |Z''|) of one ball of eta 0.54, 0.99 and 1.85 (from the masses and
 radii in ``ballbal.data``) against speed, at the stable equilibrium (figure 4-7) and in
 the rotating motion (figure 4-8), beside the disk without balls; and the residual
@@ -79,7 +79,7 @@ def main(out: Path) -> None:
     for eta, r in zip(etas, rows[last]["eq"], strict=True):
         print(f"residual imbalance at {last:.0f} rpm, eta {eta:.2f}: {r[1]:.2f} g mm "
               f"(m_d e |1 - eta| = {IMBALANCE * abs(1 - eta):.2f})")
-    # The thesis' orders: 4-7 (balanced) 1.85 > 0.54 > 0.99; 4-8 (rotating) 1.85 > 0.99 > 0.54.
+    # Tien's (2011) orders: 4-7 (balanced) 1.85 > 0.54 > 0.99; 4-8 (rotating) 1.85 > 0.99 > 0.54.
     i47 = [etas.index(e) for e in sb.sort("rank_balanced")["eta"]]
     i48 = [etas.index(e) for e in sb.sort("rank_rotating")["eta"]]
     for label, key, idx in (("fig. 4-7 balanced", "eq", i47),
@@ -89,7 +89,7 @@ def main(out: Path) -> None:
         holds = [rpm for rpm in have if ordered([level(rows[rpm][key][i]) for i in idx])]
         some = {f"{etas[i]:.2f}": sum(rows[rpm][key][i] is not None for rpm in SPEEDS)
                 for i in range(3)}
-        print(f"{label}: all three at {len(have)} of {len(SPEEDS)} speeds, the thesis' "
+        print(f"{label}: all three at {len(have)} of {len(SPEEDS)} speeds, the published "
               f"order holds at {len(holds)} of them; speeds with a stable state per eta "
               f"{some}")
     # At zeta_b 0.05 the 0.54 ball never rotates: the two heavier ones compared alone.
@@ -117,7 +117,7 @@ def main(out: Path) -> None:
         ax.legend(fontsize=8)
     axes[0].set_ylabel("mean |Z''| (e w_n^2)")
     axes[0].set_yscale("log")
-    fig.suptitle("One ball: mu 0.2, zeta 0.05, zeta_b 0.05, delta 50 (the thesis' model)")
+    fig.suptitle("One ball: mu 0.2, zeta 0.05, zeta_b 0.05, delta 50 (Tien's (2011) model)")
     fig.tight_layout()
     fig.savefig(out / "single_ball.png", dpi=80 if SMALL else 110)
 

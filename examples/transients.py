@@ -1,10 +1,10 @@
 """Transient studies with scenes (time simulation of non-autonomous scenes).
 
-1. Seed 001: a spin-speed disturbance (Omega 2.0 -> 2.5 in 5 time units) from the
+1. [TwoBallStrength]: a spin-speed disturbance (Omega 2.0 -> 2.5 in 5 time units) from the
    perfect balance; peak radial amplitude and settling time into a +-0.01 e band against
    the track damping, and the damping that minimises their combined index.
 2. A run-up through the resonance (Omega 0.3 -> 2.0) of the classic balancer and of a
-   ball-spring balancer (the planar part of seed 004's comparison).
+   ball-spring balancer (the planar part of Rezaee et al.'s (2017) comparison).
 
     python examples/transients.py [output-directory]      # about 10 s
 """

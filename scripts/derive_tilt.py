@@ -12,7 +12,7 @@ Coordinates (nondimensional as in ``model.md``: lengths over ``e``, time over
 
 * ``x, y``: the disk centre C (shaft station under the disk);
 * ``A, B``: tilts, scaled ``A = delta alpha``, ``B = delta beta`` (the rim's axial
-  displacement over ``e``), Euler angles of seed 004: turn ``alpha`` about the
+  displacement over ``e``), Euler angles of Rezaee et al. (2017): turn ``alpha`` about the
   rotating x axis, then ``beta`` about the new y axis;
 * ``phi``: a ball's angle in the disk plane from the mass-centre direction.
 
@@ -274,7 +274,7 @@ pub struct RotorConsts {
         print("tilt_terms.rs is", "up to date" if same else "STALE")
         return 0 if same else 1
     OUT.write_text(text)
-    # seed 004 eq. (7) as a check on the kinematics (unscaled angles, frame rate om)
+    # Rezaee et al. (2017) eq. (7) as a check on the kinematics (unscaled angles, frame rate om)
     a_, b_ = sp.symbols("alpha beta")
     sub = {A: a_ * dl, B: b_ * dl, vA: sp.Symbol("da") * dl, vB: sp.Symbol("db") * dl}
     print([sp.simplify(c.subs(sub)) for c in w_body])

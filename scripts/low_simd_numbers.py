@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
+STANDARD_PARAMS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 
 
 def emit(name: str, values: Any) -> None:
@@ -90,7 +90,7 @@ def numbers(large: bool) -> None:
     import ballbal
 
     libm_checksums()
-    b = ballbal.Balancer(**THESIS, Omega=1.2, eta=(1.0, 1.0))
+    b = ballbal.Balancer(**STANDARD_PARAMS, Omega=1.2, eta=(1.0, 1.0))
     s3 = periodic_numbers(b, "N3", 3, None)
     periodic_numbers(b, "N10", 10, s3)
     if large:

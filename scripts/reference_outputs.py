@@ -5,7 +5,7 @@ change must leave as it was.
     python scripts/reference_outputs.py compare DIR   # with the build after it
     python scripts/reference_outputs.py compare DIR --ignore hill_stability,verdicts_disagree
 
-Saved: thesis-grid scans (zeta_b 0.05 and 0.1; R-R, O-O, R-O; N = 3 and 8), scene scans
+Saved: Omega-eta map scans (zeta_b 0.05 and 0.1; R-R, O-O, R-O; N = 3 and 8), scene scans
 (ball springs, a tilting disk), single periodic solutions with multipliers, equilibria,
 balanced states, a simulation and a balance map, as Parquet. ``compare`` requires every
 table to be identical (timings and the two renamed columns aside) and prints what it
@@ -24,7 +24,7 @@ import polars as pl
 import ballbal
 
 BASE = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
-THESIS = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
+MAP_GRID = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
 PATTERNS = ["R-R", "O-O", "R-O"]
 # timings differ run to run; names the redesign may unify
 DROP = {"seconds"}
@@ -73,7 +73,7 @@ def _scans() -> dict[str, Callable[[], pl.DataFrame]]:
         for N in (3, 8):
             b = BASE.replace(zeta_b=zb)
             out[f"scan_thesis_zb{zb}_N{N}"] = (
-                lambda b=b, N=N: ballbal.scan(b, patterns=PATTERNS, N=N, **THESIS))
+                lambda b=b, N=N: ballbal.scan(b, patterns=PATTERNS, N=N, **MAP_GRID))
     sc = ballbal.Scene(balancer=BASE, springs=1e-5)
     out["scan_springs"] = lambda: ballbal.scan(sc, Omega=(1.0, 1.6, 0.1), eta=(0.6, 1.2, 0.2))
     tl = ballbal.Tilt(a=1.8, b=2.2, j_t=0.35, j_z=0.55, zeta_r=0.04)

@@ -3,8 +3,8 @@
     python scripts/scan_reference.py save DIR      # with the build before the change
     python scripts/scan_reference.py compare DIR   # with the build after it
 
-Saved as Parquet: the thesis grid (Omega 1.0-2.0, eta 0.4-1.5, step 0.1; mu 0.2,
-delta 50, N 3, R-R / O-O / R-O) for all nine zeta x zeta_b maps of the thesis (zeta in
+Saved as Parquet: Tien (2011) grid (Omega 1.0-2.0, eta 0.4-1.5, step 0.1; mu 0.2,
+delta 50, N 3, R-R / O-O / R-O) for all nine zeta x zeta_b maps of Tien (2011) (zeta in
 {0.02, 0.05, 0.1}, zeta_b in {0.05, 0.1, 0.2}), and the fine grid (101 x 111, step 0.01,
 R-R, N 3, zeta = zeta_b = 0.05).
 
@@ -46,13 +46,13 @@ import polars as pl
 
 import ballbal
 
-THESIS = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
+MAP_GRID = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
 FINE = {"Omega": (1.0, 2.0, 0.01), "eta": (0.4, 1.5, 0.01)}
 ZETAS, ZETA_BS = (0.02, 0.05, 0.1), (0.05, 0.1, 0.2)
 PATTERNS = ("R-R", "O-O", "R-O")
 OMEGA_TOL, MULT_TOL = 1e-8, 1e-5
 # Same orbit in both tables: omega within this (relative; a row the bound refined to
-# more harmonics moves by its truncation error, below 1e-4 on the thesis grids).
+# more harmonics moves by its truncation error, below 1e-4 on the Tien (2011) grids).
 MATCH_TOL = 1e-4
 KEY = ["Omega", "eta", "type", "solution"]
 STILL_TAIL = 1e-12
@@ -63,7 +63,7 @@ def tables() -> dict[str, tuple[ballbal.Balancer, dict, tuple[str, ...]]]:
     for z in ZETAS:
         for zb in ZETA_BS:
             b = ballbal.Balancer(mu=0.2, zeta=z, zeta_b=zb, delta=50.0)
-            out[f"thesis_z{z}_zb{zb}"] = (b, THESIS, PATTERNS)
+            out[f"thesis_z{z}_zb{zb}"] = (b, MAP_GRID, PATTERNS)
     out["fine_rr"] = (ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0), FINE,
                       ("R-R",))
     return out

@@ -54,7 +54,7 @@ def ground_rhs(scene, t, s, support=None):
     rhs[1] = (fy + sy - g - mu * (math.cos(th) * dw - math.sin(th) * w0**2)
               + np.sum(fb * dl * S * dphi**2))
     # ball springs: V = k dl^2 / 2 sum (phi_{j+1} - phi_j - 2 pi / n)^2, a ring closed
-    # by ball n to ball 1, or seed 004's chain without that last spring
+    # by ball n to ball 1, or Rezaee et al.'s (2017) chain without that last spring
     dv = np.zeros(n)
     if scene.springs:
         kd = scene.springs * dl**2

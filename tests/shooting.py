@@ -20,7 +20,7 @@ from scipy.integrate import solve_ivp
 
 from reference import rhs
 
-#: The flow's tolerances: DOP853 at rtol 1e-11 closes a thesis orbit (period ~25, states
+#: The flow's tolerances: DOP853 at rtol 1e-11 closes a standard-map orbit (period ~25, states
 #: of order 1 and angles of order 2 pi) to about 1e-10 after one period.
 FLOW_RTOL, FLOW_ATOL = 1e-11, 1e-13
 #: The shooting residual a converged orbit must reach: ten times the flow's error above,

@@ -1,7 +1,7 @@
-"""Basins of attraction (the thesis' figures 4-15 and 4-16: mu 0.2, zeta 0.05, zeta_b
+"""Basins of attraction (Tien's (2011) figures 4-15 and 4-16: mu 0.2, zeta 0.05, zeta_b
 0.05, delta 50, eta 0.7, Omega 1.2 and 1.35, starts at rest in the ground frame).
 
-Grids are small (a few dozen starts) and the physics lets t_end stay at the thesis'
+Grids are small (a few dozen starts) and the physics lets t_end stay at Tien's (2011)
 1000: the perfect balance's slowest decay rate there is 0.004 (Omega 1.2) to 0.04, and
 the R-R orbit's largest nontrivial multiplier 0.58 (Omega 1.35) per period of 17, so
 both are settled well within 1000; every start costs a few milliseconds."""
@@ -15,14 +15,14 @@ from ballbal.basins import BasinOptions, basins
 from ballbal.exceptions import ParameterError
 
 
-def thesis(omega: float) -> ballbal.Balancer:
+def standard(omega: float) -> ballbal.Balancer:
     return ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50, Omega=omega,
                             eta=(0.7, 0.7))
 
 
 @pytest.fixture(scope="module")
 def maps() -> dict[float, ballbal.basins.Basins]:
-    return {om: basins(thesis(om), n=8) for om in (1.2, 1.35)}
+    return {om: basins(standard(om), n=8) for om in (1.2, 1.35)}
 
 
 def test_rotating_fraction_falls_with_speed(maps):
@@ -46,7 +46,7 @@ def test_labels_agree_with_an_independent_long_simulation(maps):
     for om, res in maps.items():
         rows = res.table.unique(subset=["label"], keep="first", maintain_order=True)
         for r in rows.iter_rows(named=True):
-            m = thesis(om)
+            m = standard(om)
             y0 = [0, 0, r["b1"], r["b2"], 0, 0, -om, -om]
             df = ballbal.simulate(m, y0, t_eval=np.linspace(2700, 3000, 601), t0=0.0,
                                   rtol=1e-10, atol=1e-12)
@@ -67,7 +67,7 @@ def test_labels_agree_with_an_independent_long_simulation(maps):
 
 def test_no_label_changes_between_1000_and_3000():
     for om in (1.2, 1.35):
-        r = basins(thesis(om), n=5, settle_check=True)
+        r = basins(standard(om), n=5, settle_check=True)
         assert r.table["settled"].all(), r.table.filter(~pl.col("settled"))
         assert set(r.table["label"]) <= {"perfect_balance", "merged_R-R", "separated_R-R"}
 
@@ -75,7 +75,7 @@ def test_no_label_changes_between_1000_and_3000():
 def test_exchange_symmetry():
     # Identical balls: swapping them swaps the motion, so the label must not change.
     ax = np.array([0.4, 1.3, 2.5, 3.6, 4.9])
-    t = basins(thesis(1.35), b1=ax, b2=ax).table
+    t = basins(standard(1.35), b1=ax, b2=ax).table
     lab = {(round(a, 9), round(b, 9)): lab for a, b, lab in
            zip(t["b1"], t["b2"], t["label"], strict=True)}
     for (a, b), v in lab.items():
@@ -95,7 +95,7 @@ def test_classes_link_to_the_solutions_they_converge_to(maps):
 
 
 def test_same_table_on_one_and_two_threads():
-    m = thesis(1.2)
+    m = standard(1.2)
     a = basins(m, samples=12, seed=3, execution=ballbal.Execution(threads=1, chunk=5))
     b = basins(m, samples=12, seed=3, execution=ballbal.Execution(threads=2, chunk=4))
     assert a.table.equals(b.table)
@@ -103,14 +103,14 @@ def test_same_table_on_one_and_two_threads():
 
 
 def test_default_grid_avoids_the_diagonal():
-    t = basins(thesis(1.35), n=4, t_end=60, options=BasinOptions(window=30)).table
+    t = basins(standard(1.35), n=4, t_end=60, options=BasinOptions(window=30)).table
     assert t.height == 16
     gap = np.abs(np.angle(np.exp(1j * (t["b1"] - t["b2"]).to_numpy())))
     assert gap.min() > 0.5
 
 
 def test_errors_name_the_parameter():
-    m = thesis(1.2)
+    m = standard(1.2)
     with pytest.raises(ParameterError) as e:
         basins(m, n=2, t_end=-1.0)
     assert e.value.parameter == "t_end"
@@ -194,7 +194,7 @@ def test_ctrl_c_keeps_chunks_on_disk_and_a_rerun_resumes(tmp_path):
     assert int(words[3]) == 1 and words[5] == "True", out
     assert 3 <= kept < 16, kept
     assert int(words[1]) == 16 * kept  # the table returned is what is on disk
-    m = thesis(1.2)
+    m = standard(1.2)
     before = {f: f.stat().st_mtime_ns for f in d.glob("chunk-*.parquet")}
     resumed = basins(m, n=16, execution=ballbal.Execution(threads=2, chunk=16, out=d))
     assert not resumed.interrupted
@@ -210,7 +210,7 @@ def test_resume_from_a_directory_redoes_only_a_damaged_chunk(tmp_path):
 
     from ballbal.exceptions import ScanStoreError, ScanStoreWarning
 
-    m = thesis(1.35)
+    m = standard(1.35)
     ex = ballbal.Execution(threads=2, chunk=4, out=tmp_path / "b")
     full = basins(m, n=4, execution=ex)
     files = sorted((tmp_path / "b").glob("chunk-*.parquet"))
@@ -230,7 +230,7 @@ def test_resume_from_a_directory_redoes_only_a_damaged_chunk(tmp_path):
 def test_an_executor_gives_the_same_table():
     from concurrent.futures import ThreadPoolExecutor
 
-    m = thesis(1.2)
+    m = standard(1.2)
     here = basins(m, samples=6, seed=5, execution=ballbal.Execution(threads=1))
     with ThreadPoolExecutor(2) as ex:
         there = basins(m, samples=6, seed=5,
@@ -265,7 +265,7 @@ def test_early_stop_keeps_the_labels_of_full_runs(omega):
     # a torus, a clean decay to rest) and must give the label the full 1000 time units
     # give: against the classifier without early stopping on a 12 x 12 grid, and
     # against fixed-horizon simulations read in this test on random starts.
-    m = thesis(omega)
+    m = standard(omega)
     early = basins(m, n=12).table
     full = basins(m, n=12, options=BasinOptions(early_stop=False)).table
     assert early["label"].to_list() == full["label"].to_list()
@@ -319,7 +319,7 @@ def test_periodic_starts_link_to_the_orbit_they_settle_on(omega, maps):
     assert per["orbit"].null_count() == 0
     assert t.filter(pl.col("motion") != "periodic")["orbit"].null_count() == \
         t.filter(pl.col("motion") != "periodic").height
-    m = thesis(omega)
+    m = standard(omega)
     for o in res.orbits.iter_rows(named=True):
         assert o["status"] == "converged" and o["stability"] == "stable", o
         assert o["max_modulus"] < 1
@@ -343,7 +343,7 @@ def test_a_start_unsettled_at_t_end_is_extended_and_linked():
     # with no extension it has no regular period and is not linked; with extensions it
     # is simulated on, 400 at a time, until its two-turn period repeats, and is linked
     # to the (-2, -2) orbit, whose period the independent simulation gives.
-    m = thesis(1.2)
+    m = standard(1.2)
     b1, b2 = [0.1309], [0.392699]
     short = basins(m, b1=b1, b2=b2, t_end=400,
                    options=BasinOptions(extend_factor=1)).table.row(0, named=True)
@@ -366,7 +366,7 @@ def test_a_start_unsettled_at_t_end_is_extended_and_linked():
 
 def test_link_and_extension_options_are_checked():
     # (c)
-    m = thesis(1.2)
+    m = standard(1.2)
     for bad in (0.5, 65.0, float("nan")):
         with pytest.raises(ParameterError) as e:
             basins(m, n=2, options=BasinOptions(extend_factor=bad))
@@ -412,7 +412,7 @@ def test_starts_of_one_class_link_to_distinct_orbits_by_period_and_rates(monkeyp
     t = pl.DataFrame(
         [dict(zip(("label", "motion", "period", "rate1", "rate2", "winding1", "winding2"),
                   r, strict=True)) | {"b1": float(i), "b2": 0.0} for i, r in enumerate(rows)])
-    col, orbits = bmod._link_orbits(thesis(1.2), t, [[0.0] * 8] * len(rows),
+    col, orbits = bmod._link_orbits(standard(1.2), t, [[0.0] * 8] * len(rows),
                                     BasinOptions(), 8)
     assert col == [0, 0, 1, 2, None, None, 1]
     assert orbits["count"].to_list() == [2, 2, 1]

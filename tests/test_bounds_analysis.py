@@ -14,7 +14,7 @@ import pytest
 import ballbal
 from ballbal import Balancer, _check
 from ballbal.basins import BasinOptions, basins, default_grid
-from ballbal.continuation import Continuation, Seed003, from_seed003
+from ballbal.continuation import Continuation, DiskUnits, from_disk_units
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.sweep import speed_sweep
 
@@ -38,8 +38,8 @@ def test_one_bound_on_balls_everywhere():
     refused(lambda: Balancer(eta=np.full(65, 0.1)), "eta")
     refused(lambda: Balancer(eta=(0.5, 0.5), zeta_b=(0.1,) * 65), "zeta_b")
     refused(lambda: Balancer().replace(eta=(0.1,) * 65), "eta")
-    refused(lambda: from_seed003(0.5, 0.1, 2.0, n=65), "n")
-    refused(lambda: Seed003(0.5, 0.1, 2.0, n=65), "n")
+    refused(lambda: from_disk_units(0.5, 0.1, 2.0, n=65), "n")
+    refused(lambda: DiskUnits(0.5, 0.1, 2.0, n=65), "n")
     refused(lambda: Balancer.from_lab(
         disk_mass=1.0, eccentricity=1e-3, ball_masses=[1e-3] * 65, track_radius=0.05,
         stiffness=1e4, damping=1.0, track_damping=1e-3, spin=100.0), "ball_masses")

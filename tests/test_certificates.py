@@ -241,7 +241,7 @@ def test_random_continuation_paths_are_certified(p):
 
 
 def test_accuracy_study_gives_no_verdict_without_an_accurate_trivial_multiplier():
-    # The thesis' hard case: at N = 3 the trivial multiplier is off by 0.18 (the
+    # Tien's (2011) hard case: at N = 3 the trivial multiplier is off by 0.18 (the
     # published 1.1808), which used to pass as a "stable" verdict matching the reference.
     b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, Omega=1.0,
                          eta=(0.7, 0.7))
@@ -284,7 +284,7 @@ def test_auto_harmonics_from_a_non_orbit_certifies_after_refinement():
 
 def test_o_o_scan_reports_no_equilibrium_as_an_orbit():
     """An equilibrium solves the harmonic-balance equations at any omega; O-O scans of
-    the thesis map at zeta 0.02, zeta_b 0.1 used to report eight such series (harmonics
+    Tien (2011) map at zeta 0.02, zeta_b 0.1 used to report eight such series (harmonics
     at round-off, pivot ratios 1e8 to 3e10) as converged O-O solutions. Every converged
     O-O row must now move: its highest harmonic is not at round-off and its omega is
     determined (a well-conditioned Newton matrix)."""
@@ -295,7 +295,7 @@ def test_o_o_scan_reports_no_equilibrium_as_an_orbit():
     assert (conv["tail"] > 1e-12).all()
     assert (conv["pivot_ratio"] < 1e8).all()
     # The perfect balance those series sat at, in closed form, is an equilibrium of the
-    # model: the solver's own equilibria find it where the thesis puts it.
+    # model: the solver's own equilibria find it where Tien (2011) puts it.
     one = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50.0, eta=(0.7, 0.7),
                            Omega=1.3)
     pb = [e for e in ballbal.equilibria(one) if e.kind == "perfect_balance"][0]

@@ -17,7 +17,7 @@ import polars as pl
 from scipy.integrate import solve_ivp
 from test_codim2 import fold_curve
 from test_ns_curves import _flow, _monodromy
-from test_po_curves import MONODROMY, NO_FLOQUET, thesis
+from test_po_curves import MONODROMY, NO_FLOQUET, standard
 
 import ballbal
 from ballbal.continuation import Continuation, Curve, periodic_branch, periodic_curve
@@ -54,8 +54,8 @@ def shoot(b: ballbal.Balancer, y: np.ndarray, T: float, winding: np.ndarray,
 def fold_flip_curve() -> Curve:
     """The merged R-R at zeta_b 0.05 continued down in eta at Omega 1.16: a multiplier
     passes -1 near eta 0.279; its PD curve in (eta, Omega) meets the fold curve where the
-    thesis' period-doubling tongue ends, near (0.2805, 1.1574)."""
-    s = ballbal.periodic(thesis(1.16, 0.30), "R-R", options=MONODROMY)
+    Tien's (2011) period-doubling tongue ends, near (0.2805, 1.1574)."""
+    s = ballbal.periodic(standard(1.16, 0.30), "R-R", options=MONODROMY)
     br = periodic_branch(s, "eta", range=(0.25, 0.30), periodic_options=MONODROMY,
                          options=Continuation(ds=0.01, ds_max=0.02, forward=False,
                                               max_points=40))

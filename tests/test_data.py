@@ -1,4 +1,4 @@
-"""ballbal.data: the thesis' chapter-4 numbers, checked against each other and against
+"""ballbal.data: Tien's (2011) chapter-4 numbers, checked against each other and against
 formulas written here, and the lab helpers against synthetic records."""
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ def test_every_row_has_a_source_and_unit_column() -> None:
 ])
 def test_printed_eta_follows_from_masses_and_radii(case: str, m_b: float, r_t: float,
                                                     m_d: float, e: float) -> None:
-    # eta = m_b r_t / (m_d e) (model.md), rounded as the thesis prints it.
+    # eta = m_b r_t / (m_d e) (model.md), rounded as Tien (2011) prints it.
     got = data.eta(m_b, r_t, data.imbalance(m_d, e))
     assert round(got, 2) == pytest.approx(_value("eta", case), abs=1e-12)
 
@@ -57,7 +57,7 @@ def test_design_natural_frequency_of_section_4_1_2() -> None:
 
 
 def test_peak_labels_are_omega_plus_k_omega() -> None:
-    # The thesis' labels: each peak within 2 rpm of speed + k * whirl; the unlabelled
+    # Tien's (2011) labels: each peak within 2 rpm of speed + k * whirl; the unlabelled
     # 996 rpm peak of the 800 rpm record is no such line (it is twice the ball rate).
     whirl = {"R-R 800 rpm": 302.0, "O-O 555 rpm": 24.0, "R-O 560 rpm": 39.0}
     for row in data.peaks().iter_rows(named=True):
@@ -90,7 +90,7 @@ def test_log_decrement_recovers_damping_from_a_noisy_decay(zeta: float) -> None:
     wd = wn * math.sqrt(1 - zeta**2)
     t = np.linspace(0, 1.0, 20001)
     x = np.exp(-zeta * wn * t) * np.cos(wd * t) + 2e-3 * rng.standard_normal(t.size)
-    # The thesis low-passes first: a short moving average stands in for the filter.
+    # Tien (2011) low-passes first: a short moving average stands in for the filter.
     x = np.convolve(x, np.ones(21) / 21, mode="same")
     fit = data.log_decrement(x, n_peaks=5)
     assert fit.zeta == pytest.approx(zeta, rel=0.03)

@@ -17,7 +17,7 @@ from ballbal._branch import Branch, Continuation
 from ballbal.continuation import (
     equilibrium_branch,
     equilibrium_curve,
-    from_seed003,
+    from_disk_units,
     switch_equilibrium,
 )
 from ballbal.exceptions import ParameterError
@@ -165,11 +165,11 @@ def test_bad_input_names_the_parameter() -> None:
     assert e.value.parameter == "start"
 
 
-def test_from_seed003_meets_at_the_thesis_point() -> None:
-    # the seed's curves meet at (omega0, m0) = (1/sqrt(1 + 2 m0), e/2)
-    b = from_seed003(m0=1.0, omega0=1 / np.sqrt(3.0), e=2.0)
+def test_from_disk_units_meets_at_the_double_zero_point() -> None:
+    # the paper's curves meet at (omega0, m0) = (1/sqrt(1 + 2 m0), e/2)
+    b = from_disk_units(m0=1.0, omega0=1 / np.sqrt(3.0), e=2.0)
     assert abs(b.Omega - 1.0) < 1e-15 and abs(b.eta[0] - 0.5) < 1e-15
-    d = from_seed003(1.5, 2.0, 2.0, C0=0.35, D0=0.35)  # the seed's table 2
+    d = from_disk_units(1.5, 2.0, 2.0, C0=0.35, D0=0.35)  # the paper's table 2
     assert abs(d.mu - 0.2) < 1e-15 and abs(d.delta - 0.5) < 1e-15
 
 

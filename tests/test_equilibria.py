@@ -23,10 +23,10 @@ def test_perfect_balance_closed_form_and_existence():
 
 
 @pytest.mark.parametrize(("omega0", "m0", "e"), [(1.5, 2.0, 2.0), (0.4, 0.6, 2.0), (2.0, 1.2, 1.5)])
-def test_unbalanced_equilibria_match_seed003_closed_forms(omega0, m0, e):
-    """Seed 003 eqs (11) and (12) in its own units, converted to the thesis' units."""
+def test_unbalanced_equilibria_match_closed_forms_in_disk_units(omega0, m0, e):
+    """[EccentricRotorABB] eqs (11) and (12) in its own units, converted to Tien's (2011) units."""
     C0 = 0.05
-    b = ballbal.from_seed003(omega0, m0, e, C0=C0, D0=0.1)
+    b = ballbal.from_disk_units(omega0, m0, e, C0=C0, D0=0.1)
     eqs = ballbal.equilibria(b)
     k = 1 - omega0**2 * (1 + 2 * m0)
     den = k**2 + (2 * C0 * omega0) ** 2
@@ -58,8 +58,8 @@ def test_unbalanced_equilibria_match_seed003_closed_forms(omega0, m0, e):
     assert abs(_wrap(tog[0][2] - tog[1][2])) > 1e-3
 
 
-def test_seed003_pitchfork_point_conversion():
-    b = ballbal.from_seed003(0.5773, 1.0, 2.0)
+def test_pitchfork_point_in_disk_units_converts():
+    b = ballbal.from_disk_units(0.5773, 1.0, 2.0)
     assert abs(b.Omega - 1.0) < 1e-4 and b.eta == (0.5, 0.5)
 
 
@@ -75,8 +75,8 @@ def test_routh_hurwitz_agrees_with_eigenvalues_on_grid():
     assert checked > 500
 
 
-def test_characteristic_polynomial_matches_thesis_eq_2_17():
-    """Coefficients a1, a2, a7, a8 of the thesis' degree-8 polynomial (eq. 2.17) at the
+def test_characteristic_polynomial_matches_tien2011_eq_2_17():
+    """Coefficients a1, a2, a7, a8 of Tien's (2011) degree-8 polynomial (eq. 2.17) at the
     perfect balance, written out independently here."""
     mu, z, zb, dl = 0.2, 0.05, 0.1, 50.0
     for Om, eta in ((1.2, 1.0), (2.0, 0.8), (0.7, 1.4)):

@@ -155,7 +155,7 @@ def test_t_span_types() -> None:
 # --- simulate's step budget --------------------------------------------------------
 
 def test_simulate_max_steps_is_a_keyword() -> None:
-    # The thesis start's balls rotate with period ~5: 1e4 time units need far more
+    # Tien (2011) start's balls rotate with period ~5: 1e4 time units need far more
     # than 100 steps, so the budget runs out, with a message naming the keyword.
     with pytest.raises(IntegrationError, match="max_steps"):
         bb.simulate(B, t_eval=[0.0, 1e4], max_steps=100)

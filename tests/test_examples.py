@@ -1,6 +1,6 @@
 """Every script in examples/ runs, small (BALLBAL_EXAMPLE_SMALL=1), so that none can rot:
 it exits 0, writes its figures as PNG files, and what it prints or saves agrees with
-values known independently (the thesis' published case, computed by shooting in the
+values known independently (Tien's (2011) published case, computed by shooting in the
 spec; closed forms). The test command points BALLBAL_REPO at the checkout, since the
 tests run from a copy."""
 
@@ -19,7 +19,7 @@ import pytest
 REPO = pathlib.Path(os.environ.get("BALLBAL_REPO") or pathlib.Path(__file__).resolve().parents[1])
 EXAMPLES = REPO / "examples"
 
-# The spec's independent shooting value for the thesis' R-R case (mu 0.2, zeta 0.05,
+# The spec's independent shooting value for Tien's (2011) R-R case (mu 0.2, zeta 0.05,
 # zeta_b 0.05, delta 50, Omega 1.2, eta 1.0): omega and the largest nontrivial modulus.
 RR_OMEGA, RR_MODULUS = 0.25141, 0.8637
 
@@ -33,7 +33,7 @@ def check_png(path: pathlib.Path) -> None:
 
 
 def standard_rr(df: pl.DataFrame, **at: float) -> dict:
-    """The stable R-R row at the thesis' standard point (a map may hold other R-R)."""
+    """The stable R-R row at Tien's (2011) standard point (a map may hold other R-R)."""
     sel = pl.lit(True)
     for k, v in at.items():
         sel = sel & ((pl.col(k) - v).abs() < 1e-9)
@@ -55,7 +55,7 @@ def accuracy_cost(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "accuracy_cost.png"]
 
 
-def thesis_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+def omega_eta_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     df = pl.read_parquet(out / "map_zeta0.05_zetab0.05.parquet")
     row = standard_rr(df, Omega=1.2, eta=1.0)
     assert abs(row["omega"] - RR_OMEGA) < 1e-4
@@ -71,7 +71,7 @@ def thesis_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
 
 
 def scene_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
-    # Without springs the planar scene is the thesis' balancer.
+    # Without springs the planar scene is Tien's (2011) balancer.
     df = pl.read_parquet(out / "scene_map_planar.parquet")
     row = standard_rr(df, Omega=1.2, springs=0.0)
     assert abs(row["omega"] - RR_OMEGA) < 1e-4
@@ -97,18 +97,18 @@ def transients(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "transients.png"]
 
 
-def seed004(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+def ball_spring_tilt(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     counts = re.findall(r"\): (\d+) points", stdout)
     assert counts == ["45"] * 4, counts  # 9 speeds x 5 values, each map
     final = dict(re.findall(r"run-up 0.3 -> 2.0, (classic|ball springs)[^:]*:.*final whirl "
                             r"(\S+) e", stdout))
     assert float(final["classic"]) < 0.01, final
     assert "wrote" in stdout
-    return [out / "seed004.png"]
+    return [out / "ball_spring_tilt.png"]
 
 
-def seed002(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
-    # One equilibrium from every start; the seed's unbalance regimes: contact, then a
+def grooved_bearing_rotor(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # One equilibrium from every start; Yen's (2005) unbalance regimes: contact, then a
     # whirl at the spin frequency (the forcing's: a stable response is synchronous) whose
     # radius scales about linearly with the unbalance.
     assert float(re.search(r"final positions agree to (\S+) c", stdout).group(1)) < 1e-6
@@ -118,18 +118,18 @@ def seed002(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
         abs(float(v) - 1) < 0.01 for v in whirl.values()), whirl
     radius = dict(re.findall(r"unbalance (\S+) W: orbit radius (\S+) c", stdout))
     assert 5 < float(radius["0.255"]) / float(radius["0.0255"]) < 15, radius
-    return [out / "seed002.png"]
+    return [out / "grooved_bearing_rotor.png"]
 
 
-def thesis_ch4(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
-    # The thesis' own numbers: omega 0.32 (fig. 4-12), 0.09 (4-27), 0.30 (4-28), the
+def rig_observables(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Tien's (2011) own numbers: omega 0.32 (fig. 4-12), 0.09 (4-27), 0.30 (4-28), the
     # largest line at Omega - omega (k = -1) in all three.
     figs = re.findall(r"fig\. (4-\d\d) \S+: omega (\S+), largest line k = (-?\d+) at (\S+) "
                       r"\(Omega - omega = (\S+)\)", stdout)
     assert [f[0] for f in figs] == ["4-12", "4-27", "4-28"], stdout
     for (_, om, k, f, main), want in zip(figs, (0.32, 0.09, 0.30), strict=True):
         assert abs(float(om) - want) < 0.01 and k == "-1" and f == main
-    # Figure 4-13: the model's main frequency lies in the thesis' MIHB band 460-510 rpm.
+    # Figure 4-13: the model's main frequency lies in Tien's (2011) MIHB band 460-510 rpm.
     lo, hi = (float(v) for v in re.search(r"main frequency (\S+) to (\S+) rpm", stdout)
               .groups())
     assert 455 <= lo <= hi <= 515
@@ -138,11 +138,11 @@ def thesis_ch4(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     up, down = (float(v) for v in re.search(r"up-transition Omega ([\d.]+), "
                                              r"down-transition Omega ([\d.]+)", stdout).groups())
     assert up > down
-    return [out / "thesis_ch4.png"]
+    return [out / "rig_observables.png"]
 
 
 def single_ball(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
-    # eta = m_b r_t / (m_d e) with the thesis' 33.12 g mm (table 4-2)
+    # eta = m_b r_t / (m_d e) with Tien's (2011) 33.12 g mm (table 4-2)
     etas = [float(v) for v in re.findall(r"-> (\S+?)(?:,|$)", stdout.splitlines()[0])]
     assert np.allclose(etas, [1.05 * 17 / 33.12, 2.05 * 16 / 33.12, 4.09 * 15 / 33.12],
                        atol=6e-4), etas
@@ -150,11 +150,11 @@ def single_ball(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     res = dict(re.findall(r"residual imbalance at \S+ rpm, eta (\S+): (\S+) g mm", stdout))
     assert abs(float(res["0.54"]) - 15.24) < 0.01 * 15.24
     assert abs(float(res["1.85"]) - 28.15) < 0.01 * 28.15
-    # the thesis' orders hold wherever all three states exist (figure 4-7; figure 4-8
+    # Tien's (2011) orders hold wherever all three states exist (figure 4-7; figure 4-8
     # with a dry track's zeta_b 0.01)
     for label in ("fig. 4-7 balanced", "fig. 4-8 rotating, zeta_b 0.01"):
         have, holds = (int(v) for v in re.search(
-            label + r": all three at (\d+) of \d+ speeds, the thesis' order holds at (\d+)",
+            label + r": all three at (\d+) of \d+ speeds, the published order holds at (\d+)",
             stdout).groups())
         assert have >= 3 and holds == have, (label, have, holds)
     pair = re.search(r"eta 1.85 > 0.99 > no balls at (\d+) of the (\d+) speeds", stdout)
@@ -173,25 +173,25 @@ def bearing_balancer(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "bearing_balancer.png"]
 
 
-def seed003(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+def disk_units_bifurcations(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     # both planes get the together saddle-node and the perfect balance's Hopf curve
     assert stdout.count("saddle_node curve") == 2 and stdout.count("hopf curve") == 2, stdout
-    # figure 4 in the seed's own parameters: the three curves and their meeting point
+    # figure 4 in the disk's units: the three curves and their meeting point
     for name in ("SN_2+", "PF", "H_1"):
         assert f"figure 4: {name} of" in stdout, stdout
     assert "figure 4: pitchfork at (omega0, m0) = (0.5774, 1.0000)" in stdout, stdout
-    return [out / "seed003.png"]
+    return [out / "disk_units_bifurcations.png"]
 
 
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
-    "seed003.py": seed003,
-    "seed002.py": seed002,
+    "disk_units_bifurcations.py": disk_units_bifurcations,
+    "grooved_bearing_rotor.py": grooved_bearing_rotor,
     "accuracy_cost.py": accuracy_cost,
-    "thesis_maps.py": thesis_maps,
+    "omega_eta_maps.py": omega_eta_maps,
     "scene_maps.py": scene_maps,
     "transients.py": transients,
-    "seed004.py": seed004,
-    "thesis_ch4.py": thesis_ch4,
+    "ball_spring_tilt.py": ball_spring_tilt,
+    "rig_observables.py": rig_observables,
     "single_ball.py": single_ball,
     "bearing_balancer.py": bearing_balancer,
 }
@@ -208,8 +208,8 @@ def test_example_runs_small(name, tmp_path):
     assert script.exists(), f"{script}: set BALLBAL_REPO to the repository checkout"
     out = tmp_path / "out"
     out.mkdir()
-    args = ([f"--out={out / name.replace('.py', '.png')}"] if name in ("seed002.py", "seed004.py")
-            else [str(out)])
+    args = ([f"--out={out / name.replace('.py', '.png')}"]
+            if name in ("grooved_bearing_rotor.py", "ball_spring_tilt.py") else [str(out)])
     env = {**os.environ, "BALLBAL_EXAMPLE_SMALL": "1", "MPLBACKEND": "Agg"}
     # From tmp_path, so that nothing can land in the checkout.
     res = subprocess.run([sys.executable, str(script), *args], cwd=tmp_path, env=env,

@@ -1,7 +1,7 @@
 """The Magnus monodromy (``Floquet(method="magnus")``) against independent estimates of
 the same multipliers: RK45 at tight tolerances on the same series, and the monodromy of
 tests/shooting.py (central differences of scipy flows) on the orbit, which the series
-closes to 1e-8 by simulation, the thesis' long-period hard case included."""
+closes to 1e-8 by simulation, Tien's (2011) long-period hard case included."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from ballbal.exceptions import ParameterError, ParameterTypeError
 from reference import rhs
 from shooting import flow, match_error
 
-THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
+STANDARD_PARAMS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 # (Omega, eta, pattern): the standard R-R case (balls merged), the hard R-R case
 # (period ~106), an unstable O-O and a stable R-O orbit of the zeta_b = 0.05 map.
 POINTS = [(1.2, 1.0, "R-R"), (1.0, 0.7, "R-R"), (1.1, 0.4, "O-O"), (1.3, 0.7, "R-O")]
@@ -25,7 +25,7 @@ POINTS = [(1.2, 1.0, "R-R"), (1.0, 0.7, "R-R"), (1.1, 0.4, "O-O"), (1.3, 0.7, "R
 def solutions():
     out = {}
     for om, eta, pattern in POINTS:
-        b = ballbal.Balancer(**THESIS, Omega=om, eta=(eta, eta))
+        b = ballbal.Balancer(**STANDARD_PARAMS, Omega=om, eta=(eta, eta))
         s = ballbal.periodic(b, pattern, N=3,
                              options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
         assert s.converged, (om, eta, pattern, s.status)

@@ -37,7 +37,7 @@ from ballbal.basins import BasinOptions, basins, default_grid
 from ballbal.continuation import (
     Branch,
     Continuation,
-    Seed003,
+    DiskUnits,
     equilibrium_branch,
     equilibrium_curve,
     periodic_branch,
@@ -162,7 +162,7 @@ def test_residual_imbalance(eta: Any, angles: Any) -> None:
 
 # --- continuation ---------------------------------------------------------------------
 
-SEED003 = st.builds(Seed003, st.floats(0.3, 1.5), st.floats(0.05, 0.5), st.floats(1.0, 3.0))
+DISK_UNITS = st.builds(DiskUnits, st.floats(0.3, 1.5), st.floats(0.05, 0.5), st.floats(1.0, 3.0))
 PARAMETERS = sometimes(
     st.sampled_from(["Omega", "eta", "eta[1]", "zeta", "zeta_b", "mu", "delta"]),
     st.one_of(st.sampled_from(["eta[9]", "springs", "m0", "omega0", "nope", ""]), BAD))
@@ -180,7 +180,7 @@ CONTINUATION = sometimes(kwargs(
 
 
 @FUZZ
-@given(st.one_of(MODEL2, SEED003), PARAMETERS, kwargs(
+@given(st.one_of(MODEL2, DISK_UNITS), PARAMETERS, kwargs(
     start=sometimes(st.sampled_from(["perfect_balance", "together"]),
                     st.one_of(st.sampled_from(["opposite", "x"]), BAD)),
     range=RANGE, options=CONTINUATION,
@@ -304,7 +304,7 @@ def test_ball_counts(name: str, n: int) -> None:
     b = check(bb.Balancer, **kw)
     if isinstance(b, bb.Balancer):
         assert b.n_balls <= 64
-    check(bb.from_seed003, 0.5, 0.1, 2.0, n=n)
+    check(bb.from_disk_units, 0.5, 0.1, 2.0, n=n)
 
 
 @FEW

@@ -20,18 +20,18 @@ def genuine(s, closure=1e-6):
     return s.converged and s.verify() < closure
 
 
-def test_thesis_hard_case_auto_N_meets_its_target():
+def test_hard_rr_case_auto_N_meets_its_target():
     s = ballbal.periodic(HARD, "R-R", N="auto",
                          options=ballbal.PeriodicOptions(
                              harmonic_balance=ballbal.HarmonicBalance(target=1e-7)))
     assert s.target_met and s.N >= 8
     assert s.trivial_error < 1e-7
-    # the thesis' period and an independent closure check by time simulation
+    # Tien's (2011) period and an independent closure check by time simulation
     assert abs(2 * math.pi / s.omega - 106.5) < 0.1
     assert genuine(s, 1e-7)
     low = ballbal.periodic(HARD, "R-R", N=3, guess=s,
                            options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
-    assert abs(abs(low.multipliers[0]) - 1.1808) < 2e-3  # thesis table 3-1, N = 3
+    assert abs(abs(low.multipliers[0]) - 1.1808) < 2e-3  # Tien (2011) table 3-1, N = 3
 
 
 def test_auto_N_stays_low_where_the_point_is_easy():

@@ -1,7 +1,7 @@
 """Hill's cross-check at the scan's target (``Floquet(hill_target="verdict")``: the
 truncation only as large as the verdict needs) against independent estimates: the
-monodromy of tests/shooting.py on the orbit (the thesis' period-106 case included) and
-RK45 at tight tolerances across a thesis map."""
+monodromy of tests/shooting.py on the orbit (Tien's (2011) period-106 case included) and
+RK45 at tight tolerances across a Tien (2011) map."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from ballbal.exceptions import ParameterError
 
 from shooting import flow, match_error
 
-THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
+STANDARD_PARAMS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 
 
 def _lead(ev: np.ndarray) -> float:
@@ -50,7 +50,7 @@ def _check_against_shooting(b: ballbal.Balancer, s: ballbal.PeriodicSolution) ->
 
 
 def test_verdict_target_against_shooting_on_the_standard_case():
-    b = ballbal.Balancer(**THESIS, Omega=1.2, eta=(1.0, 1.0))
+    b = ballbal.Balancer(**STANDARD_PARAMS, Omega=1.2, eta=(1.0, 1.0))
     s = ballbal.periodic(b, "R-R", N=12,
                          options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
     _check_against_shooting(b, s)
@@ -58,7 +58,7 @@ def test_verdict_target_against_shooting_on_the_standard_case():
 
 def test_verdict_target_against_shooting_on_the_hard_case():
     """Period ~106: the multipliers target needs H = 13 to 15 here; the verdict H = 5."""
-    b = ballbal.Balancer(**THESIS, Omega=1.0, eta=(0.7, 0.7))
+    b = ballbal.Balancer(**STANDARD_PARAMS, Omega=1.0, eta=(0.7, 0.7))
     s = ballbal.periodic(b, "R-R", N=3,
                          options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(hill=False)))
     for N in (8, 16, 24):
@@ -72,11 +72,11 @@ KEY = ["Omega", "eta", "type", "solution"]
 
 
 @pytest.fixture(scope="module")
-def thesis_map() -> dict[str, pl.DataFrame]:
-    """The standard thesis map (all three types, N = 3) with Hill beside every
+def standard_map() -> dict[str, pl.DataFrame]:
+    """The standard Tien (2011) map (all three types, N = 3) with Hill beside every
     monodromy, with the scan's defaults (Hill where the verdict is in doubt), and with
     RK45 at rtol 1e-10 and no Hill; converged rows only."""
-    b = ballbal.Balancer(**THESIS)
+    b = ballbal.Balancer(**STANDARD_PARAMS)
     grid = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
     pats = ("R-R", "O-O", "R-O")
     fl = ballbal.options.SCAN_DEFAULTS.floquet
@@ -88,12 +88,12 @@ def thesis_map() -> dict[str, pl.DataFrame]:
             .filter(pl.col("status") == "converged") for k, floquet in runs.items()}
 
 
-def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map(
-        thesis_map: dict[str, pl.DataFrame]) -> None:
+def test_scan_verdicts_agree_with_tight_rk45_across_an_omega_eta_map(
+        standard_map: dict[str, pl.DataFrame]) -> None:
     """Every Hill verdict of a scan at its target is the verdict of RK45 at rtol 1e-10
     on the same series, or undetermined; undetermined only where that leading modulus
     is within 1e-3 of 1 or the tight verdict is undetermined itself."""
-    hill, tight = thesis_map["all"], thesis_map["tight"]
+    hill, tight = standard_map["all"], standard_map["tight"]
     assert hill["hill_stability"].is_not_null().all()
     both = hill.join(tight, on=KEY, suffix="_tight")
     assert both.height == hill.height > 100
@@ -111,7 +111,7 @@ def test_scan_verdicts_agree_with_tight_rk45_across_a_thesis_map(
 
 
 def test_default_scan_cross_checks_the_doubtful_verdicts(
-        thesis_map: dict[str, pl.DataFrame]) -> None:
+        standard_map: dict[str, pl.DataFrame]) -> None:
     """The scan's default runs Hill on every solution whose monodromy verdict is
     undetermined or whose leading modulus is within ``SCAN_HILL_BAND`` of 1, with the
     verdicts Hill gives beside every monodromy, and skips most of the others. What it
@@ -120,9 +120,9 @@ def test_default_scan_cross_checks_the_doubtful_verdicts(
     band = ballbal.options.SCAN_HILL_BAND
     assert ballbal.options.SCAN_DEFAULTS.floquet.hill
     assert ballbal.options.SCAN_DEFAULTS.floquet.hill_band == band
-    dflt = thesis_map["default"].join(thesis_map["all"], on=KEY, suffix="_all")
-    dflt = dflt.join(thesis_map["tight"], on=KEY, suffix="_tight")
-    assert dflt.height == thesis_map["all"].height
+    dflt = standard_map["default"].join(standard_map["all"], on=KEY, suffix="_all")
+    dflt = dflt.join(standard_map["tight"], on=KEY, suffix="_tight")
+    assert dflt.height == standard_map["all"].height
     doubt = ((pl.col("stability") == "undetermined")
              | ((pl.col("max_modulus") - 1.0).abs() <= band))
     checked = dflt.filter(pl.col("hill_stability").is_not_null())
@@ -187,7 +187,7 @@ def test_scans_written_without_hill_resume_with_hill_off(tmp_path: Path) -> None
     the new defaults with a message saying how to resume it, and resumes with
     ``Floquet(hill=False)`` (from Python and with ``ballbal scan --hill off``) to the same
     table."""
-    b = ballbal.Balancer(**THESIS)
+    b = ballbal.Balancer(**STANDARD_PARAMS)
     grid = {"Omega": [1.2, 1.3], "eta": [1.0]}
     off = ballbal.ScanOptions(floquet=dataclasses.replace(
         ballbal.options.SCAN_DEFAULTS.floquet, hill=False))

@@ -120,7 +120,7 @@ def test_hopeless_step_budget_fails_quickly() -> None:
 
 
 def test_normal_cases_are_not_called_stiff() -> None:
-    """Hairer's test must not fire on ordinary runs: a long simulation of the thesis case
+    """Hairer's test must not fire on ordinary runs: a long simulation of the Tien (2011) case
     and a highly damped but not stiff one integrate to the end."""
     df = simulate(Balancer(), t_span=(0, 2000))
     assert df.height == 1001 and np.isfinite(df["x"].to_numpy()).all()

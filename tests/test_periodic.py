@@ -8,14 +8,14 @@ from ballbal.exceptions import ParameterError
 
 from shooting import monodromy_multipliers, shoot
 
-THESIS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
+STANDARD_PARAMS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
 PUBLISHED_N3 = [1.0000, 0.8641, 0.2859, 0.2859, 0.2346, 0.2346, 0.1185, 0.0951]
 SHOOTING = [1.0000, 0.8637, 0.2859, 0.2859, 0.2345, 0.2345, 0.1185, 0.0951]
 
 
 @pytest.fixture(scope="module")
 def standard():
-    b = ballbal.Balancer(**THESIS, Omega=1.2, eta=(1.0, 1.0))
+    b = ballbal.Balancer(**STANDARD_PARAMS, Omega=1.2, eta=(1.0, 1.0))
     return b, ballbal.periodic(b, "R-R", N=3)
 
 
@@ -56,12 +56,12 @@ def test_standard_case_against_shooting_in_this_test(standard):
 
 
 def test_hard_case_needs_more_harmonics():
-    b = ballbal.Balancer(**THESIS, Omega=1.0, eta=(0.7, 0.7))
+    b = ballbal.Balancer(**STANDARD_PARAMS, Omega=1.0, eta=(0.7, 0.7))
     # The N = 3 series itself (refine=False: the verdict's bound would raise N here).
     s3 = ballbal.periodic(b, "R-R", N=3,
                           options=ballbal.PeriodicOptions(floquet=ballbal.Floquet(refine=False)))
     assert s3.converged and s3.N == 3 and s3.stability == "undetermined"
-    # thesis table 3-1: trivial multiplier 1.1808 at N = 3, 1.0379 at N = 4
+    # Tien (2011) table 3-1: trivial multiplier 1.1808 at N = 3, 1.0379 at N = 4
     assert s3.trivial_error > 0.1
     assert abs((1 + s3.trivial_error) - 1.1808) < 0.01
     s4 = ballbal.periodic(b, "R-R", N=4, guess=s3,
@@ -77,7 +77,7 @@ def test_hard_case_needs_more_harmonics():
 
 
 def test_oo_solution_cross_checked_by_simulation_and_shooting():
-    # thesis table 4-7: O-O at zeta = zeta_b = 0.1, Omega = 1.1, eta = 1.3, omega ~ 0.09
+    # Tien (2011) table 4-7: O-O at zeta = zeta_b = 0.1, Omega = 1.1, eta = 1.3, omega ~ 0.09
     b = ballbal.Balancer(mu=0.2, zeta=0.1, zeta_b=0.1, delta=50, Omega=1.1, eta=(1.3, 1.3))
     sol = ballbal.periodic(b, "O-O", N=8)
     assert sol.converged and sol.type == "O-O"
@@ -102,7 +102,7 @@ def test_round_trip_solution_stays_on_orbit(standard):
 
 
 def test_failure_is_data_not_exception():
-    b = ballbal.Balancer(**THESIS, Omega=1.2, eta=(1.0, 1.0))
+    b = ballbal.Balancer(**STANDARD_PARAMS, Omega=1.2, eta=(1.0, 1.0))
     junk = np.full((4, 7), 50.0)
     sol = ballbal.periodic(b, "R-R", N=3, guess=(5.0, junk),
                            options=ballbal.PeriodicOptions(
@@ -146,8 +146,8 @@ def test_bad_periodic_input():
 
 
 def test_ro_solution_by_continuation_cross_checked():
-    """Thesis section 3-2: R-O at zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.8. There the
-    perfect balance attracts every simulated start, so (as in the thesis) the orbit is
+    """Tien (2011) section 3-2: R-O at zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.8. There the
+    perfect balance attracts every simulated start, so (as in Tien (2011)) the orbit is
     reached by continuation from a point where time simulation lands on it."""
     b = ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.05, delta=50, Omega=1.4, eta=(0.8, 0.8))
     sol = ballbal.periodic(b, "R-O", N=8)

@@ -344,7 +344,7 @@ def test_continuation_down_stops_at_the_infinite_period_end() -> None:
     assert abs(om_ip - om_star) < 4e-4, (om_ip, om_star)
 
 
-def _thesis(eta: float) -> ballbal.Balancer:
+def _standard(eta: float) -> ballbal.Balancer:
     return ballbal.Balancer(**STD, Omega=1.2, eta=(eta, eta))
 
 
@@ -360,13 +360,13 @@ def _turns(b: ballbal.Balancer, y0: np.ndarray, t_end: float) -> np.ndarray:
 
 def test_period_doubling_against_shooting_and_simulation() -> None:
     """The merged R-R orbit at zeta_b 0.05, Omega 1.2 continued down in eta: a real
-    multiplier passes -1 (the thesis' tongue of balls rotating separately). Shooting at
+    multiplier passes -1 (Tien's (2011) tongue of balls rotating separately). Shooting at
     eta_PD +- 3e-3 brackets it and its secant zero is the located eta (measured 2e-6:
     the N = 8 series closes to 1e-6 under scipy there; 2e-5 allowed for the secant's
     curvature error over the bracket). Inside the tongue, simulation from the merged
     orbit, nudged, settles on alternating turns whose sum is the period of the doubled
     orbit switched to from the event; above it the turns stay equal, one period each."""
-    s = ballbal.periodic(_thesis(0.9), "R-R", options=OPTS)
+    s = ballbal.periodic(_standard(0.9), "R-R", options=OPTS)
     br = periodic_branch(s, "eta", range=(0.8, 0.9),
                          options=Continuation(ds=0.01, ds_max=0.02, forward=False))
     pd = br.events.filter(br.events["type"] == "period_doubling")
@@ -376,9 +376,9 @@ def test_period_doubling_against_shooting_and_simulation() -> None:
     h = 3e-3
     g = []
     for e in (e_pd + h, e_pd - h):
-        sol = ballbal.periodic(_thesis(e), "R-R", options=OPTS, guess=br.solutions[k])
+        sol = ballbal.periodic(_standard(e), "R-R", options=OPTS, guess=br.solutions[k])
         assert sol.converged
-        T, ev = shoot_newton(_thesis(e), sol.state(0.0), sol.period, np.asarray(sol.winding))
+        T, ev = shoot_newton(_standard(e), sol.state(0.0), sol.period, np.asarray(sol.winding))
         assert abs(T - sol.period) < 1e-6 * T
         real = ev[np.abs(ev.imag) < 1e-8].real
         g.append(real[np.argmin(np.abs(real + 1))] + 1)
@@ -390,13 +390,13 @@ def test_period_doubling_against_shooting_and_simulation() -> None:
     d2 = switch(br, event=i_pd, amplitude=0.2)
     assert d2.converged and list(d2.winding[2:]) == [-2, -2] and d2.info["value"] < e_pd
     for e in (0.84, 0.82):
-        d2 = ballbal.periodic(_thesis(e), "R-R", N=16, guess=d2)
+        d2 = ballbal.periodic(_standard(e), "R-R", N=16, guess=d2)
         assert d2.converged and list(d2.winding[2:]) == [-2, -2]
     kick = 1e-3 * np.array([1, 0, 1, -1, 0, 0, 0, 0])
     for e, inside in ((0.82, True), (0.88, False)):
-        merged = ballbal.periodic(_thesis(e), "R-R", options=OPTS, guess=br.solutions[0])
+        merged = ballbal.periodic(_standard(e), "R-R", options=OPTS, guess=br.solutions[0])
         assert merged.converged
-        d = _turns(_thesis(e), merged.state(0.0) + kick, 6000.0)
+        d = _turns(_standard(e), merged.state(0.0) + kick, 6000.0)
         if inside:
             assert abs(d[-1] - d[-2]) > 0.1 * d[-1]
             assert abs(d[-1] - d[-3]) < 1e-4 * d[-1]

@@ -29,7 +29,7 @@ MONODROMY = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=N
                                     floquet=ballbal.Floquet(hill=False))
 
 
-def thesis(Omega: float, eta: float, zeta_b: float = 0.05) -> ballbal.Balancer:
+def standard(Omega: float, eta: float, zeta_b: float = 0.05) -> ballbal.Balancer:
     return ballbal.Balancer(**STD, zeta_b=zeta_b, Omega=Omega, eta=(eta, eta))
 
 
@@ -92,7 +92,7 @@ def _shoot_row(c: Curve, k: int) -> tuple[ballbal.Balancer, float, np.ndarray]:
 @cache
 def band_end(eta: float = 1.0) -> ballbal.continuation.Branch:
     """The merged R-R band's upper end in Omega (BP, then LP) at zeta_b 0.05."""
-    start = ballbal.periodic(thesis(1.2, eta), "R-R", options=OPTS)
+    start = ballbal.periodic(standard(1.2, eta), "R-R", options=OPTS)
     return periodic_branch(start, "Omega", range=(1.2, 1.9), periodic_options=NO_FLOQUET,
                            options=Continuation(ds=0.05, ds_max=0.2, max_points=80))
 
@@ -114,7 +114,7 @@ def band_curve(kind: str) -> Curve:
 def pd_curve() -> Curve:
     """Merged R-R at zeta_b 0.05, Omega 1.2: a multiplier passes -1 near eta 0.86; the
     PD curve in (eta, Omega)."""
-    start = ballbal.periodic(thesis(1.2, 0.9), "R-R", options=OPTS)
+    start = ballbal.periodic(standard(1.2, 0.9), "R-R", options=OPTS)
     br = periodic_branch(start, "eta", range=(0.8, 0.9), periodic_options=MONODROMY,
                          options=Continuation(ds=0.01, ds_max=0.02, forward=False,
                                               max_points=60))
@@ -171,7 +171,7 @@ def test_scan_verdicts_lie_on_the_right_side_of_the_band_end() -> None:
     # From Omega 1.3: simulation finds no R-R start near the band end, the scan's
     # lattice carries it up from where it does.
     oms = np.arange(1.3, 1.9 + 1e-9, step)
-    df = ballbal.scan(thesis(1.8, 1.0), Omega=oms, eta=etas, patterns=("R-R",), N=N)
+    df = ballbal.scan(standard(1.8, 1.0), Omega=oms, eta=etas, patterns=("R-R",), N=N)
     df = df.filter((df["status"] == "converged") & df["separation_error"].is_not_null())
     checked = {"stable": 0, "converged": 0}
     for r in df.iter_rows(named=True):

@@ -16,7 +16,7 @@ from reference import rhs
 from shooting import flow, shoot
 
 
-def thesis(Omega: float, eta: float, zeta_b: float = 0.05) -> bb.Balancer:
+def standard(Omega: float, eta: float, zeta_b: float = 0.05) -> bb.Balancer:
     return bb.Balancer(mu=0.2, zeta=0.05, zeta_b=zeta_b, delta=50, Omega=Omega,
                        eta=[eta, eta])
 
@@ -36,10 +36,10 @@ def turn_times(b: bb.Balancer, y0: np.ndarray, t0: float, t1: float) -> np.ndarr
 
 
 def test_windings_find_the_period_doubled_rr_orbit_simulation_reaches() -> None:
-    # zeta_b 0.05, Omega 1.2, eta 0.7: the thesis' "balls rotating separately", which
-    # its MIHB could not converge to. The simulation from the thesis' start reaches an
+    # zeta_b 0.05, Omega 1.2, eta 0.7: Tien's (2011) "balls rotating separately", which
+    # its MIHB could not converge to. The simulation from Tien's (2011) start reaches an
     # orbit whose turns alternate between two durations.
-    b = thesis(1.2, 0.7)
+    b = standard(1.2, 0.7)
     s = periodic(b, "R-R", windings=(-2, -2), N=12)
     assert s.converged and s.type == "R-R"
     assert list(s.winding[2:]) == [-2, -2]
@@ -65,7 +65,7 @@ def test_windings_find_the_period_doubled_rr_orbit_simulation_reaches() -> None:
 @pytest.mark.parametrize("windings", [(-2,), (-2, -2, -2), (0, -2), (-2, 0.5), (-2, "a"),
                                       "RR", (-17, -2), 3])
 def test_bad_windings_name_the_parameter(windings: object) -> None:
-    b = thesis(1.2, 0.7)
+    b = standard(1.2, 0.7)
     with pytest.raises(ParameterError) as e:
         periodic(b, "R-R", windings=windings)  # type: ignore[arg-type]
     assert e.value.parameter == "windings"
@@ -75,7 +75,7 @@ def test_bad_windings_name_the_parameter(windings: object) -> None:
 
 
 def test_default_windings_are_unchanged() -> None:
-    b = thesis(1.2, 1.0)
+    b = standard(1.2, 1.0)
     a = periodic(b, "R-R")
     w = periodic(b, "R-R", windings=(-1, -1))
     assert a.converged and w.converged
@@ -84,13 +84,13 @@ def test_default_windings_are_unchanged() -> None:
 
 def test_period_doubling_switch_gives_the_orbit_simulation_reaches() -> None:
     # Merged R-R at zeta_b 0.05, Omega 1.2: a multiplier passes -1 near eta 0.862.
-    s = periodic(thesis(1.2, 0.86), "R-R", N=8)
+    s = periodic(standard(1.2, 0.86), "R-R", N=8)
     assert s.converged
     r = switch(s, parameter="eta", kind="PD", amplitude=0.2)
     assert r.converged and list(r.winding[2:]) == [-2, -2]
     eta = r.info["value"]
     assert r.info["switched_from"] == "period_doubling" and r.balancer.eta[0] == eta
-    b = thesis(1.2, eta)
+    b = standard(1.2, eta)
     single = periodic(b, "R-R", N=8, guess=s)
     assert single.converged
     assert abs(r.period - 2 * single.period) < 0.02 * r.period
@@ -106,9 +106,9 @@ def test_period_doubling_switch_gives_the_orbit_simulation_reaches() -> None:
     # duration is the doubled orbit's period.
     d2 = r
     for e in (0.84, 0.82, 0.80):
-        d2 = periodic(thesis(1.2, e), "R-R", N=16, guess=d2)
+        d2 = periodic(standard(1.2, e), "R-R", N=16, guess=d2)
         assert d2.converged and list(d2.winding[2:]) == [-2, -2]
-    b = thesis(1.2, 0.80)
+    b = standard(1.2, 0.80)
     single = periodic(b, "R-R", N=8)
     assert single.converged
     y0 = single.state(0.0) + 1e-3 * np.array([1, 0, 1, -1, 0, 0, 0, 0])
@@ -119,7 +119,7 @@ def test_period_doubling_switch_gives_the_orbit_simulation_reaches() -> None:
 
 
 def _separation_after(Omega: float, merged: object, t: float) -> float:
-    b = thesis(Omega, 1.0, zeta_b=0.1)
+    b = standard(Omega, 1.0, zeta_b=0.1)
     y0 = merged.state(0.0) + 1e-4 * np.array([0, 0, 1, -1, 0, 0, 0, 0])  # type: ignore[attr-defined]
     df = bb.simulate(b, y0, [0.0, t])
     return float(abs(df["b1"][-1] - df["b2"][-1]))
@@ -128,12 +128,12 @@ def _separation_after(Omega: float, merged: object, t: float) -> float:
 def test_branch_point_switch_separates_the_balls() -> None:
     # Merged R-R at zeta_b 0.1, eta 1 continued up in Omega: the separation multiplier
     # passes +1 between Omega 1.38 and 1.40.
-    s = periodic(thesis(1.2, 1.0, zeta_b=0.1), "R-R", N=8)
+    s = periodic(standard(1.2, 1.0, zeta_b=0.1), "R-R", N=8)
     for om in (1.3, 1.35, 1.38):
-        s = periodic(thesis(om, 1.0, zeta_b=0.1), "R-R", N=8, guess=s)
+        s = periodic(standard(om, 1.0, zeta_b=0.1), "R-R", N=8, guess=s)
         assert s.converged
     s138 = s
-    s140 = periodic(thesis(1.40, 1.0, zeta_b=0.1), "R-R", N=8, guess=s)
+    s140 = periodic(standard(1.40, 1.0, zeta_b=0.1), "R-R", N=8, guess=s)
     assert s140.converged
     # Simulation: before the branch point a small separation dies out, beyond it grows.
     assert _separation_after(1.38, s138, 300.0) < 1e-5
@@ -143,7 +143,7 @@ def test_branch_point_switch_separates_the_balls() -> None:
     assert 1.38 < r.info["value"] < 1.40
     # Unmerged: the balls' mean positions differ; it is an orbit (scipy closure).
     assert abs(r.coeffs[2, 0] - r.coeffs[3, 0]) > 0.01
-    b = thesis(r.info["value"], 1.0, zeta_b=0.1)
+    b = standard(r.info["value"], 1.0, zeta_b=0.1)
     end = flow(b, r.state(0.0), r.period, rtol=1e-10, atol=1e-12)
     shift = np.zeros(8)
     shift[:4] = 2 * np.pi * r.winding
@@ -163,7 +163,7 @@ def _jacobian(b: bb.Balancer, q: np.ndarray) -> np.ndarray:
 
 
 def _critical(Omega: float) -> tuple[float, float]:
-    b = thesis(Omega, 1.0)
+    b = standard(Omega, 1.0)
     q = next(e for e in equilibria(b) if e.kind == "perfect_balance").q
     ev = np.linalg.eigvals(_jacobian(b, q))
     ev = ev[ev.imag > 1e-8]
@@ -183,7 +183,7 @@ def test_hopf_switch_gives_an_oo_orbit_at_the_hopf_frequency() -> None:
             hi = mid
     om_h = 0.5 * (lo + hi)
     freq = _critical(om_h)[1]
-    b = thesis(1.25, 1.0)
+    b = standard(1.25, 1.0)
     eq = next(e for e in equilibria(b) if e.kind == "perfect_balance")
     errors = []
     for amp in (0.1, 0.02):
@@ -191,7 +191,7 @@ def test_hopf_switch_gives_an_oo_orbit_at_the_hopf_frequency() -> None:
         assert r.converged and r.type == "O-O"
         assert abs(r.info["value"] - om_h) < 1e-2
         errors.append(abs(r.omega - freq))
-        bh = thesis(r.info["value"], 1.0)
+        bh = standard(r.info["value"], 1.0)
         end = flow(bh, r.state(0.0), r.period, rtol=1e-11, atol=1e-13)
         assert np.max(np.abs(end - r.state(0.0))) < 1e-6
     assert errors[1] < errors[0]
@@ -199,7 +199,7 @@ def test_hopf_switch_gives_an_oo_orbit_at_the_hopf_frequency() -> None:
 
 
 def test_switch_refuses_bad_input_by_name() -> None:
-    b = thesis(1.2, 1.0)
+    b = standard(1.2, 1.0)
     s = periodic(b, "R-R")
     with pytest.raises(ParameterError) as e:
         switch(s, parameter="eta", kind="Hopf")  # type: ignore[arg-type]
@@ -216,7 +216,7 @@ def test_switch_refuses_bad_input_by_name() -> None:
     assert e.value.parameter == "model"
 
 
-def test_homotopy_finds_the_thesis_rr_orbit_simulation_misses() -> None:
+def test_homotopy_finds_the_standard_rr_orbit_simulation_misses() -> None:
     # Table 4-7 / figure 4-12: zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.7. Every simulated
     # start settles to the perfect balance, yet a stable R-R orbit exists.
     b = bb.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50, Omega=1.3, eta=[0.7, 0.7])
@@ -243,7 +243,7 @@ def test_homotopy_finds_the_thesis_rr_orbit_simulation_misses() -> None:
 
 
 def test_homotopy_keeps_results_simulation_finds_and_refuses_bad_starts() -> None:
-    b = thesis(1.2, 1.0)
+    b = standard(1.2, 1.0)
     a = periodic(b, "R-R")
     h = periodic(b, "R-R", homotopy=True)
     assert h.info["guess_source"] == "simulation"
@@ -254,9 +254,9 @@ def test_homotopy_keeps_results_simulation_finds_and_refuses_bad_starts() -> Non
         assert e.value.parameter == "homotopy"
 
 
-def test_periodic_finds_the_thesis_ro_orbit_that_starts_at_rest_miss() -> None:
-    # Table 4-7's R-O row (zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.7; omega 0.30 in the
-    # thesis): every start at rest settles to the perfect balance, and only about one
+def test_periodic_finds_the_published_ro_orbit_that_starts_at_rest_miss() -> None:
+    # Table 4-7's R-O row (zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.7; omega 0.30 in
+    # Tien 2011): every start at rest settles to the perfect balance, and only about one
     # random start in sixty (with a knocked support) reaches the orbit. The whirl starts
     # (the rotating ball at the natural frequency, the disk on its resonant response)
     # reach it; the constructed starts used to (the core's own test keeps them).

@@ -14,7 +14,7 @@ import ballbal
 from ballbal.exceptions import ParameterError, ScanStoreError
 
 BASE = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50.0, Omega=1.2, eta=(1.0, 1.0))
-THESIS = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
+MAP_GRID = {"Omega": (1.0, 2.0, 0.1), "eta": (0.4, 1.5, 0.1)}
 
 
 def stable_rr(df):
@@ -27,12 +27,12 @@ def small():
 
 
 @pytest.fixture(scope="module")
-def thesis_maps():
-    """The thesis' R-R map (zeta 0.05, zeta_b 0.1) and its neighbours in zeta, zeta_b."""
+def omega_eta_maps():
+    """Tien's (2011) R-R map (zeta 0.05, zeta_b 0.1) and its neighbours in zeta, zeta_b."""
     maps = {}
     for zeta, zeta_b in [(0.05, 0.1), (0.05, 0.05), (0.05, 0.2), (0.02, 0.1), (0.1, 0.1)]:
         b = BASE.replace(zeta=zeta, zeta_b=zeta_b)
-        maps[zeta, zeta_b] = ballbal.scan(b, **THESIS)
+        maps[zeta, zeta_b] = ballbal.scan(b, **MAP_GRID)
     return maps
 
 
@@ -56,17 +56,17 @@ def test_same_table_for_one_and_two_threads(small):
     assert small.drop("seconds").equals(two.drop("seconds"))
 
 
-def test_omega_grows_with_Omega(thesis_maps):
-    df = stable_rr(thesis_maps[0.05, 0.1])
+def test_omega_grows_with_Omega(omega_eta_maps):
+    df = stable_rr(omega_eta_maps[0.05, 0.1])
     for eta in (0.7, 1.0, 1.3):
         w = df.filter(pl.col("eta") == eta).sort("Omega")["omega"].to_numpy()
         assert w.size >= 3 and np.all(np.diff(w) > 0), (eta, w)
 
 
-def test_thesis_stable_rr_region(thesis_maps):
-    """Thesis, zeta 0.05, zeta_b 0.1: stable R-R needs eta >= about 0.5 and lives near
+def test_stable_rr_region_of_the_standard_map(omega_eta_maps):
+    """Tien (2011), zeta 0.05, zeta_b 0.1: stable R-R needs eta >= about 0.5 and lives near
     Omega 1.0 to 1.6."""
-    s = stable_rr(thesis_maps[0.05, 0.1])
+    s = stable_rr(omega_eta_maps[0.05, 0.1])
     assert s.filter(pl.col("eta") < 0.45).height == 0
     assert s.filter(pl.col("Omega") > 1.75).height == 0
     for eta in (0.7, 1.0, 1.3):
@@ -74,20 +74,20 @@ def test_thesis_stable_rr_region(thesis_maps):
         assert min(om) == 1.0 and 1.15 < max(om) < 1.75, (eta, om)
 
 
-def test_stable_range_widens_with_eta(thesis_maps):
-    s = stable_rr(thesis_maps[0.05, 0.1])
+def test_stable_range_widens_with_eta(omega_eta_maps):
+    s = stable_rr(omega_eta_maps[0.05, 0.1])
     width = [s.filter(pl.col("eta") == e).height for e in (0.6, 0.8, 1.0, 1.2, 1.4)]
     assert width == sorted(width) and width[-1] > width[0], width
 
 
-def test_stable_region_shrinks_as_damping_grows(thesis_maps):
-    area = {k: stable_rr(v).height for k, v in thesis_maps.items()}
+def test_stable_region_shrinks_as_damping_grows(omega_eta_maps):
+    area = {k: stable_rr(v).height for k, v in omega_eta_maps.items()}
     assert area[0.05, 0.05] > area[0.05, 0.1] > area[0.05, 0.2], area
     assert area[0.02, 0.1] > area[0.05, 0.1] > area[0.1, 0.1], area
 
 
-def test_perfect_balance_region_comes_with_the_scan(thesis_maps):
-    df = thesis_maps[0.05, 0.1]
+def test_perfect_balance_region_comes_with_the_scan(omega_eta_maps):
+    df = omega_eta_maps[0.05, 0.1]
     pb = df.unique(subset=["Omega", "eta"])
     # closed form: the perfect balance exists for eta >= 1/2
     assert pb.filter(pl.col("pb_exists") != (pl.col("eta") >= 0.5)).height == 0

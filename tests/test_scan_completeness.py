@@ -73,8 +73,8 @@ GRIDS = {
     # The issue's first map: at Omega step 0.1 no R-O at all, at 0.05 a stable region.
     "issue_map": (ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.1, delta=50),
                   (0.8, 2.0), (0.4, 1.6, 0.2)),
-    # The thesis' map with the most R-O (zeta 0.02, zeta_b 0.05).
-    "thesis_map": (ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.05, delta=50),
+    # Tien's (2011) map with the most R-O (zeta 0.02, zeta_b 0.05).
+    "omega_eta_map": (ballbal.Balancer(mu=0.2, zeta=0.02, zeta_b=0.05, delta=50),
                    (1.0, 2.0), (0.4, 1.5, 0.1)),
     # Unequal balls, Omega only: at step 0.05 the continuation from 1.8 down to 1.75
     # jumped to the stable R-R branch and never came back up it, so that the stable

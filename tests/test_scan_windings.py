@@ -1,7 +1,7 @@
 """Scans of orbits that wind more than once per period (issue 31).
 
 A scan type may carry the balls' windings, ``"R-R[-2,-2]"``: each ball makes two turns
-per period, as the thesis' "balls rotating separately" do at Omega 1.2 (their turns
+per period, as Tien's (2011) "balls rotating separately" do at Omega 1.2 (their turns
 alternate between two durations). Scans never listed these; a seed whose turns did not
 repeat one by one gave nothing.
 

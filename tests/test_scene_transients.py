@@ -1,4 +1,4 @@
-"""Transients of scenes: speed disturbances, track-damping studies (seed 001)."""
+"""Transients of scenes: speed disturbances, track-damping studies ([TwoBallStrength])."""
 
 import math
 

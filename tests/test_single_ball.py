@@ -1,8 +1,8 @@
 """The single-ball balancer (n = 1): its named equilibria against the static equations
-written here, the residual imbalance against its closed form and the thesis' section
+written here, the residual imbalance against its closed form and Tien's (2011) section
 4-3, rotating (R) and oscillating (O) motions against a scipy shooting method on
 variational equations derived here with sympy and against long simulations, and the
-thesis' single-ball comparison (figures 4-7 and 4-8) on the model."""
+Tien's (2011) single-ball comparison (figures 4-7 and 4-8) on the model."""
 
 from __future__ import annotations
 
@@ -164,15 +164,15 @@ def test_residual_imbalance_closed_form_and_the_disk_whirl() -> None:
     assert pb.kind == "perfect_balance" and pb.residual_imbalance < 1e-14
 
 
-def test_residual_imbalance_of_the_thesis_single_ball_experiment() -> None:
+def test_residual_imbalance_of_the_single_ball_experiment() -> None:
     sb = data.single_ball()
     stated = dict(zip(sb["eta_stated"], sb["residual_imbalance"], strict=True))
-    # the thesis' numbers: (1 - eta) and (eta - 1) times 33.12 g mm, eta as printed
+    # Tien's (2011) numbers: (1 - eta) and (eta - 1) times 33.12 g mm, eta as printed
     assert data.residual_imbalance(33.12, 0.54) == pytest.approx(stated[0.54], abs=0.005)
     assert data.residual_imbalance(33.12, 1.85) == pytest.approx(stated[1.85], abs=0.005)
     assert data.residual_imbalance(33.12, [0.5, 0.5], [2.0, -2.0]) == pytest.approx(
         33.12 * abs(1 + np.exp(2j) / 2 + np.exp(-2j) / 2))
-    # on the model (the thesis' parameters, eta from the masses and radii) the stable
+    # on the model (Tien's (2011) parameters, eta from the masses and radii) the stable
     # equilibrium's residual falls towards m_d e |1 - eta| as the speed rises; at
     # 1000 rpm it is within 1 % of the stated values
     for row in sb.iter_rows(named=True):
@@ -253,7 +253,7 @@ def test_no_rotating_or_oscillating_motion_where_none_exists() -> None:
         assert abs(df["db1"][2]) < 1e-6 and abs(df["b1"][2] - df["b1"][1]) < 1e-4
 
 
-# --------------------------------------------------- the thesis' comparison (4-3)
+# --------------------------------------------------- Tien's (2011) comparison (4-3)
 
 SPEEDS = [550.0, 625.0, 700.0, 775.0, 850.0, 925.0, 1000.0]
 
@@ -301,7 +301,7 @@ def _rotating(rpm: float, eta: float, **change: float) -> float | None:
 
 
 def test_rotating_vibration_figure_4_8() -> None:
-    """In the rotating motion. At the thesis' model parameters (zeta_b 0.05) only the
+    """In the rotating motion. At Tien's (2011) model parameters (zeta_b 0.05) only the
     two heavier balls rotate: 1.85 > 0.99 where both do, both above no balls; the
     0.54 ball has no rotating motion at all there. With the lighter track damping of a
     dry track (zeta_b 0.01; the single-ball experiment used no oil) all three rotate and

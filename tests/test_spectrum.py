@@ -1,5 +1,5 @@
 """Ground-frame spectra and the vibration indicator (ballbal.spectrum), each checked
-against something computed another way: the thesis' published Fourier magnitudes, the
+against something computed another way: Tien's (2011) published Fourier magnitudes, the
 series evaluated in time, simulations (ballbal's and an independent ground-frame
 formulation), and synthetic signals with known lines."""
 
@@ -14,7 +14,7 @@ import ballbal
 from ballbal import spectrum as sp
 from ballbal.exceptions import ParameterError
 
-THESIS = dict(mu=0.2, delta=50.0)
+STANDARD_MU_DELTA = dict(mu=0.2, delta=50.0)
 
 
 def _continue(b, pattern, steps, N):
@@ -30,8 +30,8 @@ def _continue(b, pattern, steps, N):
 @pytest.fixture(scope="module")
 def rr():
     """Table 4-7's R-R: zeta 0.02, zeta_b 0.1, Omega 1.3, eta 0.7 (omega 0.32), reached by
-    continuation from the thesis' standard R-R (a simulation from rest lands elsewhere)."""
-    b = ballbal.Balancer(**THESIS, zeta=0.05, zeta_b=0.05, Omega=1.2, eta=(1.0, 1.0))
+    continuation from Tien's (2011) standard R-R (a simulation from rest lands elsewhere)."""
+    b = ballbal.Balancer(**STANDARD_MU_DELTA, zeta=0.05, zeta_b=0.05, Omega=1.2, eta=(1.0, 1.0))
     return _continue(b, "R-R", [dict(zeta_b=0.1, zeta=0.02), dict(Omega=1.3),
                                 dict(eta=(0.7, 0.7))], N=3)
 
@@ -40,14 +40,14 @@ def rr():
 def ro():
     """Table 4-7's R-O, at zeta = 0.02 (model.md: the printed zeta = 0.1 is a typo),
     continued from a point where simulation finds it (as test_periodic does)."""
-    b = ballbal.Balancer(**THESIS, zeta=0.02, zeta_b=0.05, Omega=1.4, eta=(0.8, 0.8))
+    b = ballbal.Balancer(**STANDARD_MU_DELTA, zeta=0.02, zeta_b=0.05, Omega=1.4, eta=(0.8, 0.8))
     return _continue(b, "R-O", [dict(zeta_b=0.075), dict(zeta_b=0.1), dict(Omega=1.35),
                                 dict(Omega=1.3), dict(eta=(0.7, 0.7))], N=3)
 
 
 @pytest.fixture(scope="module")
 def oo():
-    b = ballbal.Balancer(**THESIS, zeta=0.1, zeta_b=0.1, Omega=1.1, eta=(1.3, 1.3))
+    b = ballbal.Balancer(**STANDARD_MU_DELTA, zeta=0.1, zeta_b=0.1, Omega=1.1, eta=(1.3, 1.3))
     return _continue(b, "O-O", [], N=3)
 
 
@@ -67,7 +67,7 @@ def _harmonics_from_lines(spec):
     return np.array(hx), np.array(hy)
 
 
-# Thesis (seed 000) table 4-7, "Fourier spectra of the periodic solutions": |a_0|,
+# Tien (2011) table 4-7, "Fourier spectra of the periodic solutions": |a_0|,
 # sqrt(a_1^2 + b_1^2), sqrt(a_2^2 + b_2^2), sqrt(a_3^2 + b_3^2) of x and y, N = 3.
 TABLE_4_7 = {
     "R-R": ([0.5064, 4.8416, 0.0251, 0.0004], [0.1138, 4.8383, 0.0252, 0.0004]),
@@ -86,13 +86,13 @@ def test_lines_reproduce_table_4_7(case, rr, oo, ro):
                        rtol=0, atol=1e-15)
     hx, hy = _harmonics_from_lines(spec)
     px, py = TABLE_4_7[case]
-    # printed to 4 decimals (+-5e-5); the thesis stopped Newton at 1 % relative
+    # printed to 4 decimals (+-5e-5); Tien (2011) stopped Newton at 1 % relative
     # coefficient change, which leaves its first harmonics 1e-4 off the converged series
     tol = 5e-5 + 2e-4 * np.array(px)
     assert np.all(np.abs(hx - px) <= tol), (hx, px)
     tol = 5e-5 + 2e-4 * np.array(py)
     assert np.all(np.abs(hy - py) <= tol), (hy, py)
-    # the thesis' frequencies: omega 0.32 (R-R), 0.09 (O-O), 0.30 (R-O); main line
+    # Tien's (2011) frequencies: omega 0.32 (R-R), 0.09 (O-O), 0.30 (R-O); main line
     # Omega - omega (its figures 4-12, 4-27, 4-28 and section 4-4-7)
     assert abs(sol.omega - {"R-R": 0.32, "O-O": 0.09, "R-O": 0.30}[case]) < 0.005
     acc = sol.spectrum("acceleration")
@@ -205,18 +205,18 @@ def test_hann_and_flattop_scaling_on_a_synthetic_whirl():
     assert abs(p["amplitude"].sum() * df - np.mean(x**2)) < 1e-12
 
 
-def _thesis_tone(rpm, amp, t):
+def _rig_tone(rpm, amp, t):
     return amp * np.cos(2 * np.pi * rpm / 60 * t)
 
 
 def test_label_peaks_on_a_synthetic_record_flags_the_off_family_line():
-    """The 800 rpm R-R record of the thesis' section 4-4-2 rebuilt as a signal in
+    """The 800 rpm R-R record of Tien's (2011) section 4-4-2 rebuilt as a signal in
     seconds: lines at 498 (ball whirl, largest), 800 (spin), 1102 rpm, an off-family
     line at 996 rpm (twice the ball whirl), a little noise."""
     rng = np.random.default_rng(1)
     t = np.arange(0.0, 60.0, 1 / 500)  # 60 s at 500 Hz
-    x = (_thesis_tone(498, 1.0, t) + _thesis_tone(800, 0.3, t) + _thesis_tone(1102, 0.1, t)
-         + _thesis_tone(996, 0.08, t) + 0.01 * rng.standard_normal(t.size))
+    x = (_rig_tone(498, 1.0, t) + _rig_tone(800, 0.3, t) + _rig_tone(1102, 0.1, t)
+         + _rig_tone(996, 0.08, t) + 0.01 * rng.standard_normal(t.size))
     spec = sp.signal_spectrum(t, x, time_unit="s", natural_frequency_rpm=513)
     assert {"frequency", "frequency_hz", "frequency_rpm"} <= set(spec.columns)
     peaks = sp.label_peaks(spec, 800.0, column="frequency_rpm", threshold=0.03)
@@ -228,8 +228,8 @@ def test_label_peaks_on_a_synthetic_record_flags_the_off_family_line():
     assert abs(peaks["omega"][0] - 302) < 0.2
 
 
-def test_label_lines_recovers_the_thesis_experimental_labels():
-    """Section 4-4-7's measured peaks (rpm) and their labels as the thesis gives them."""
+def test_label_lines_recovers_the_measured_labels():
+    """Section 4-4-7's measured peaks (rpm) and their labels as Tien (2011) gives them."""
     oo = sp.label_lines([507, 532, 555, 579, 602, 627], 555)  # O-O at 555 rpm
     assert oo["k"].to_list() == [-2, -1, 0, 1, 2, 3] and oo["in_family"].all()
     assert abs(oo["omega"][0] - 24) < 0.5  # "about 24 rpm"
@@ -314,7 +314,7 @@ def test_vibration_indicator_exact_against_simulation(case, rr8, ro):
 
 
 def test_equilibrium_spectrum_is_the_synchronous_line():
-    b = ballbal.Balancer(**THESIS, zeta=0.05, zeta_b=0.05, Omega=1.6, eta=(0.3, 0.3))
+    b = ballbal.Balancer(**STANDARD_MU_DELTA, zeta=0.05, zeta_b=0.05, Omega=1.6, eta=(0.3, 0.3))
     eqs = ballbal.equilibria(b)
     eq = next(e for e in eqs if math.hypot(e.q[0], e.q[1]) > 1e-3)
     with pytest.raises(ParameterError) as err:
@@ -394,7 +394,7 @@ def test_waterfall_table_and_plots(rr, tmp_path):
 def test_ground_signal_during_a_ramp_matches_the_ground_frame_equations():
     """The disk's rate theta' is read off the theta column: during a run-up the
     accelerations still agree with the independent ground-frame formulation."""
-    b = ballbal.Balancer(**THESIS, zeta=0.05, zeta_b=0.05, Omega=1.0, eta=(0.7, 0.7))
+    b = ballbal.Balancer(**STANDARD_MU_DELTA, zeta=0.05, zeta_b=0.05, Omega=1.0, eta=(0.7, 0.7))
     ramp = ballbal.Ramp(to=1.6, start=5.0, duration=20.0)
     sc = ballbal.Scene(balancer=b, ramp=ramp)
     h = 0.01

@@ -28,7 +28,7 @@ KW = dict(Omega=[1.0, 1.3, 1.6], eta=[0.5, 0.9, 1.3, 1.5], threads=1,
 SCAN_FLIPS, BASIN_FLIPS = 6, 12
 
 
-def thesis() -> ballbal.Balancer:
+def standard() -> ballbal.Balancer:
     # The basins of tests/test_basins.py (figure 4-16): 16 starts in 4 chunks of 4.
     return ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50, Omega=1.35,
                             eta=(0.7, 0.7))
@@ -58,13 +58,13 @@ def scan_written(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def basin_reference():
-    return basins(thesis(), **BASINS, execution=basin_execution()).table
+    return basins(standard(), **BASINS, execution=basin_execution()).table
 
 
 @pytest.fixture(scope="module")
 def basin_written(tmp_path_factory):
     out = tmp_path_factory.mktemp("basins") / "b"
-    basins(thesis(), **BASINS, execution=basin_execution(out))
+    basins(standard(), **BASINS, execution=basin_execution(out))
     return out
 
 
@@ -95,7 +95,7 @@ def resume_scan(out):
 def resume_basins(out):
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        r = basins(thesis(), **BASINS, execution=basin_execution(out))
+        r = basins(standard(), **BASINS, execution=basin_execution(out))
     return r.table, store_warnings(w)
 
 

@@ -1,4 +1,4 @@
-"""Speed sweeps (the thesis' section 4-2 procedure) on its bistable case: mu 0.2,
+"""Speed sweeps (Tien's (2011) section 4-2 procedure) on its bistable case: mu 0.2,
 zeta 0.05, zeta_b 0.05, delta 50, eta 0.7. Steps of 0.05 dwelling 1000 time units (the
 perfect balance decays at 0.004 or faster from Omega 1.2 up, the R-R orbit settles
 within a few hundred); a step costs a few milliseconds."""
@@ -15,19 +15,19 @@ STEP = 0.05
 SPEEDS = np.round(np.arange(1.0, 1.8 + 1e-9, STEP), 3)
 
 
-def thesis(omega: float = 1.2) -> ballbal.Balancer:
+def standard(omega: float = 1.2) -> ballbal.Balancer:
     return ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.05, delta=50, Omega=omega,
                             eta=(0.7, 0.7))
 
 
 @pytest.fixture(scope="module")
 def sweep() -> ballbal.sweep.Sweep:
-    return speed_sweep(thesis(), SPEEDS, dwell=1000.0)
+    return speed_sweep(standard(), SPEEDS, dwell=1000.0)
 
 
 def test_up_transition_is_where_the_stable_rr_branch_ends(sweep):
     # A fine scan of the R-R orbit over Omega (harmonic balance + Floquet).
-    df = ballbal.scan(thesis(), Omega=(1.3, 1.7, 0.01), eta=[0.7], patterns=["R-R"])
+    df = ballbal.scan(standard(), Omega=(1.3, 1.7, 0.01), eta=[0.7], patterns=["R-R"])
     stable = df.filter(pl.col("stability") == "stable")["Omega"]
     end = float(stable.max())
     assert sweep.up is not None
@@ -37,7 +37,7 @@ def test_up_transition_is_where_the_stable_rr_branch_ends(sweep):
 def test_down_transition_is_the_perfect_balance_stability_boundary(sweep):
     # The perfect balance's stability from its eigenvalues, on a fine grid going down.
     om = np.round(np.arange(1.4, 1.0, -0.005), 4)
-    stable = [next(e for e in ballbal.equilibria(thesis(o)) if e.kind == "perfect_balance")
+    stable = [next(e for e in ballbal.equilibria(standard(o)) if e.kind == "perfect_balance")
               .stability == "stable" for o in om]
     boundary = float(om[stable.index(False)])  # first unstable speed going down
     assert sweep.down is not None
@@ -56,7 +56,7 @@ def test_table_and_vibration(sweep):
     assert pb["vibration"].max() < 1e-4 < rr["vibration"].min()
     # A merged R-R step's mean ball rate is the orbit's omega (harmonic balance).
     r = rr.filter(pl.col("Omega") == 1.4).row(0, named=True)
-    sol = ballbal.periodic(thesis(1.4), "R-R")
+    sol = ballbal.periodic(standard(1.4), "R-R")
     assert abs(r["omega"] - sol.omega) < 1e-4 * sol.omega
 
 
@@ -85,13 +85,13 @@ def test_a_slow_ramp_gives_the_same_transitions(sweep):
         return df["t"].to_numpy()[np.nonzero(np.diff(k))[0]]
 
     T = (1.8 - 1.3) / rate
-    up = ballbal.Scene(balancer=thesis(1.3), ramp=ballbal.Ramp(to=1.8, duration=T))
+    up = ballbal.Scene(balancer=standard(1.3), ramp=ballbal.Ramp(to=1.8, duration=T))
     df = ballbal.simulate(up, [0, 0, 0.3, 0.302, 0, 0, -1.3, -1.3],
                           t_eval=np.arange(0, T, 0.5), rtol=1e-6, atol=1e-8)
     om_up = 1.3 + rate * turns(df)[-1]
     assert abs(om_up - sweep.up) <= STEP
     T = (1.45 - 1.0) / rate
-    m = thesis(1.45)
+    m = standard(1.45)
     pb = next(e for e in ballbal.equilibria(m) if e.kind == "perfect_balance")
     y0 = np.concatenate([pb.q, np.zeros(4)])
     y0[2:4] += (1e-3, -1e-3)
@@ -103,15 +103,15 @@ def test_a_slow_ramp_gives_the_same_transitions(sweep):
 
 def test_errors():
     with pytest.raises(ParameterError) as e:
-        speed_sweep(thesis(), [1.2, 1.1])
+        speed_sweep(standard(), [1.2, 1.1])
     assert e.value.parameter == "speeds"
     with pytest.raises(ParameterError) as e:
-        speed_sweep(thesis(), [1.2, 1.3], direction="sideways")  # type: ignore[arg-type]
+        speed_sweep(standard(), [1.2, 1.3], direction="sideways")  # type: ignore[arg-type]
     assert e.value.parameter == "direction"
 
 
 def test_waterfall_puts_the_main_line_at_omega_minus_ball_rate(sweep):
-    # The thesis' main vibration frequency on R-R is Omega - omega (section 4-4-2): at
+    # Tien's (2011) main vibration frequency on R-R is Omega - omega (section 4-4-2): at
     # every merged R-R step the largest line of the recorded spectrum sits there, within
     # two bins (record 100: bins of 2 pi / 100 in rad per time; the flat-top window's
     # main lobe is five bins wide) and forward (positive frequency).

@@ -1,4 +1,4 @@
-"""The tilting disk on a flexible shaft (seed 004), checked against a closed-form whirl
+"""The tilting disk on a flexible shaft (Rezaee et al. 2017), checked against a closed-form whirl
 spectrum, an energy integral computed from a Lagrangian written here independently,
 the planar model it must reduce to, and time simulation of the stability it reports."""
 
@@ -118,7 +118,7 @@ def lagrangian(scene, q, v, theta, Omega):
     phi = np.asarray(q[4:])
     gaps = np.append(np.diff(phi), phi[0] + 2 * np.pi - phi[-1]) - 2 * np.pi / n
     if scene.spring_layout == "chain":
-        gaps = gaps[:-1]  # seed 004's chain: no spring from ball n back to ball 1
+        gaps = gaps[:-1]  # Rezaee et al.'s (2017) chain: no spring from ball n back to ball 1
     V += 0.5 * scene.springs * dl**2 * np.sum(gaps**2)
     return T - V
 
@@ -201,8 +201,8 @@ def test_classic_map_of_a_centred_disk_is_the_planar_map():
     assert (a.filter(a["stability"] == "unstable").height > 5)
 
 
-def test_seed004_run_up_springs_cut_the_peak_and_leave_a_residual_whirl():
-    """Seed 004: the ball-spring balancer lowers the run-up's peak whirl and tilt. The
+def test_ball_spring_run_up_springs_cut_the_peak_and_leave_a_residual_whirl():
+    """Rezaee et al. (2017): the ball-spring balancer lowers the run-up's peak whirl and tilt. The
     springs' rest spacing (pi for two balls) is not the balancing spacing, so a residual
     whirl remains; it must be the one balanced_state computes at the final speed."""
     base = tilting().replace(Omega=0.3, zeta=0.05, zeta_b=0.05,

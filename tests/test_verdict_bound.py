@@ -50,7 +50,7 @@ FAMILIES = {
     "random_RO": (ballbal.Balancer(mu=0.262, zeta=0.074, zeta_b=0.035, delta=26.1,
                                    eta=(0.906, 0.906)), "R-O", (1.4, 1.45), 2),
 }
-# The thesis maps' families (delta = 50) are left out: their stiff ball equations make
+# Tien (2011) maps' families (delta = 50) are left out: their stiff ball equations make
 # one shooting point take 40 s here (zeta 0.02, zeta_b 0.2, eta 1.4: R-R crosses at
 # Omega 1.6993).
 

@@ -12,7 +12,7 @@ from .analysis import (
 )
 from .balance import balance_map, balanced_state, plot_balance_map
 from .exceptions import ScanInterrupted
-from .model import Balancer, from_seed003, zeta_from_log_decrement
+from .model import Balancer, from_disk_units, zeta_from_log_decrement
 from .options import (
     Execution,
     Floquet,
@@ -69,7 +69,7 @@ __all__ = [
     "data",
     "exceptions",
     "flat",
-    "from_seed003",
+    "from_disk_units",
     "label_peaks",
     "line_spectrum",
     "load_scene",

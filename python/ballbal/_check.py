@@ -315,11 +315,11 @@ MAX_BRANCH_POINTS = 10**5
 MAX_NEWTON = 100
 #: Largest ``Omega`` for which :func:`ballbal.periodic` searches its start by
 #: simulation (without ``guess``). The balls turn ``Omega`` radians per time unit, so the
-#: integrator's steps per time unit grow with it (about 20 at the thesis' 1.2, 2000 at
+#: integrator's steps per time unit grow with it (about 20 at Tien's (2011) 1.2, 2000 at
 #: 100); a pattern that no start reaches is simulated some 100 times for ``settle +
 #: window`` time units: 4 s at 1.2, 12 s at 10, 22 s at 30, 106 s at 100, many minutes at
 #: 1e3 (one loaded 2-core machine). Balancers run at a few times the support's natural
-#: frequency (the thesis below 3): 30 leaves a wide margin.
+#: frequency (Tien (2011) below 3): 30 leaves a wide margin.
 MAX_SEARCH_OMEGA = 30.0
 #: Largest damping ratio ``zeta`` and ``zeta_b`` for the same search: past a few times
 #: critical damping the explicit integrator's step is held by stability, and the search

@@ -1,7 +1,7 @@
 """Continuation of equilibria: one-parameter branches with their stability and located
 events (fold, Hopf, branch point / pitchfork), branch switching at a branch point, and
 two-parameter curves of those bifurcations (the core's
-``rust/core/src/continuation/equilibria.rs``); and seed 003's nondimensionalisation.
+``rust/core/src/continuation/equilibria.rs``); and the balancer in the disk's units.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from ballbal._branch import (
 )
 from ballbal.analysis import Equilibrium, _equilibrium, capacities, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
-from ballbal.model import Balancer, Seed003
+from ballbal.model import Balancer, DiskUnits
 from ballbal.scene import Scene, model_argument
 
 __all__ = ["equilibrium_branch", "equilibrium_curve", "switch_equilibrium"]
@@ -37,30 +37,30 @@ def _options(options: Any) -> Continuation:
     return options
 
 
-def _native_model(model: Any) -> tuple[Balancer | Scene, Seed003 | None]:
-    """What the binding takes: the model, and seed 003's parameters when continued in them."""
-    if isinstance(model, Seed003):
+def _native_model(model: Any) -> tuple[Balancer | Scene, DiskUnits | None]:
+    """What the binding takes: the model, and the disk's units when continued in them."""
+    if isinstance(model, DiskUnits):
         return model.balancer, model
     return model, None
 
 
-def _seed_at(seed: Seed003, names: tuple[str, ...], values: tuple[float, ...]) -> Seed003:
+def _seed_at(seed: DiskUnits, names: tuple[str, ...], values: tuple[float, ...]) -> DiskUnits:
     return seed.replace(**dict(zip(names, values, strict=True)))
 
 
 def _eta_at(model: Any, parameter: str, value: float) -> np.ndarray:
     """The balls' capacities at a branch point (they vary only along an ``eta`` branch, or
-    ``m0`` / ``e`` in seed 003's units)."""
-    if isinstance(model, Seed003):
+    ``m0`` / ``e`` in the disk's units)."""
+    if isinstance(model, DiskUnits):
         return capacities(_seed_at(model, (parameter,), (value,)).balancer)
     if parameter.startswith("eta"):
         return capacities(model_at(model, parameter, value))
     return capacities(model)
 
 
-def _to_seed(rows: list[dict[str, Any]], seed: Seed003, names: tuple[str, ...],
+def _to_seed(rows: list[dict[str, Any]], seed: DiskUnits, names: tuple[str, ...],
              keys: tuple[str, ...]) -> list[dict[str, Any]]:
-    """Rows in seed 003's units: ``x, y`` times ``e`` (lengths by the track radius), rates
+    """Rows in the disk's units: ``x, y`` times ``e`` (lengths by the track radius), rates
     (eigenvalues, ``max_real``, ``omega``) over ``S = sqrt(1 + n m0)`` (its time unit)."""
     out = []
     for r in rows:
@@ -88,7 +88,7 @@ def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, flo
     meta = {"model": model, "range": rng, "options": options,
             "event_x": [list(e["x"]) for e in evs],
             "event_tangent": [list(e["tangent"]) for e in evs]}
-    if isinstance(model, Seed003):
+    if isinstance(model, DiskUnits):
         pts = _to_seed(pts, model, (parameter,), ("p",))
         evs = _to_seed(evs, model, (parameter,), ("p",))
     marks: list[str | None] = [None] * len(pts)
@@ -139,9 +139,9 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     ``"mu"``, ``"delta"``, scene parameters) by pseudo-arclength over ``range``, through
     folds.
 
-    ``model`` may also be a :class:`~ballbal.model.Seed003`: then ``parameter`` is one of
-    seed 003's (``"omega0"``, ``"m0"``, ``"e"``, ``"C0"``, ``"D0"``), ``start`` an
-    equilibrium of ``model.balancer`` or a kind name, and the tables are in the seed's
+    ``model`` may also be a :class:`~ballbal.model.DiskUnits`: then ``parameter`` is one
+    of its (``"omega0"``, ``"m0"``, ``"e"``, ``"C0"``, ``"D0"``), ``start`` an
+    equilibrium of ``model.balancer`` or a kind name, and the tables are in the disk's
     units: its parameter, ``q`` with ``x, y`` over the track radius, eigenvalues,
     ``max_real`` and ``omega`` in its time unit (ballbal's over ``S = sqrt(1 + n m0)``);
     ``solutions`` stay ballbal's :class:`~ballbal.Equilibrium` objects.
@@ -214,15 +214,15 @@ def equilibrium_curve(branch: Branch, event: int | str, parameter2: str, *,
     branch point of the balls-together branch the pitchfork curve (folds and pitchforks
     of that branch are continued on its invariant subspace ``b_1 = ... = b_n``).
 
-    With a branch continued in seed 003's units (a :class:`~ballbal.model.Seed003`
-    model), ``parameter2`` is one of the seed's parameters and the tables are in its
+    With a branch continued in the disk's units (a :class:`~ballbal.model.DiskUnits`
+    model), ``parameter2`` is one of its parameters and the tables are in those
     units, as for :func:`equilibrium_branch`.
 
     ``points`` lists the codimension-two points found, each once: ``"BT"`` (a double
     zero eigenvalue with a Jordan block: Bogdanov–Takens), ``"ZH"`` (zero-Hopf),
     ``"cusp"`` (the curve reverses in the parameter plane), ``"pitchfork"`` (a
     saddle-node curve meets the pitchfork; for two balls at (Omega, eta) = (1, 1/2),
-    seed 003's (omega0, m0) = (1/sqrt(1 + 2 m0), e/2), where the second zero
+    in the disk's units (omega0, m0) = (1/sqrt(1 + 2 m0), e/2), where the second zero
     eigenvalue is the antisymmetric ball mode's), ``"saddle_node"`` (a pitchfork curve
     meets the saddle-node curve)."""
     i = _event(branch, event)

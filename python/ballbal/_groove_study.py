@@ -1,4 +1,4 @@
-"""Groove study: a parallel scan over herringbone groove parameters (seed 002, ``bearing.md``
+"""Groove study: a parallel scan over herringbone groove parameters ([Yen2005], ``bearing.md``
 section 3). Re-exported from :mod:`ballbal.bearing`.
 
 Every point is the given bearing with one groove geometry and ``L / D``, solved on its own

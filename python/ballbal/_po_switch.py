@@ -12,7 +12,7 @@ from . import _check, _native
 from ._branch import Branch, _listing, event_name, event_row, model_at
 from .analysis import Equilibrium, PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
-from .model import Balancer, Seed003
+from .model import Balancer, DiskUnits
 from .options import PERIODIC_DEFAULTS, PeriodicOptions, refuses_keywords, with_harmonics
 from .scene import Scene, model_argument
 
@@ -36,10 +36,10 @@ def _from_branch(branch: Branch, event: Any, kind: str | None, parameter: str | 
     solution = branch.event_solutions[i]
     if branch.kind == "equilibrium" and model is None:
         own = branch.meta["model"]
-        if isinstance(own, Seed003):
-            raise ParameterError("branch", "a branch continued in seed 003's units has no "
+        if isinstance(own, DiskUnits):
+            raise ParameterError("branch", "a branch continued in the disk's units has no "
                                  "ballbal model at its events: continue the Balancer "
-                                 "(ballbal.continuation.from_seed003) to switch")
+                                 "(ballbal.continuation.from_disk_units) to switch")
         model = model_at(own, branch.parameter, float(branch.events[branch.parameter][i]))
     return solution, etype, branch.parameter, model
 

@@ -1,4 +1,4 @@
-"""A rigid rotor on one journal bearing, in the fixed frame, without balls (seed 002).
+"""A rigid rotor on one journal bearing, in the fixed frame, without balls ([Yen2005]).
 
 Nondimensional equations (the core's ``analysis/journal.rs``; positions over the radial
 clearance ``c``, time ``tau = w t``, film forces over ``F_S = mu w L R^3 / c^2``)::
@@ -9,12 +9,12 @@ clearance ``c``, time ``tau = w t``, film forces over ``F_S = mu w L R^3 / c^2``
 * ``mass_parameter`` ``m = M c w^2 / F_S = M c^3 w / (mu L R^3)``, the classical bearing
   mass parameter (also the critical mass of the whirl threshold);
 * ``gravity`` ``g_n = W / (M c w^2) = g / (c w^2)`` along ``gravity_direction`` (degrees,
-  0 = the seed's ``x``, pointing down); the film's static load is ``m g_n`` in ``F_S``,
+  0 = Yen's (2005) ``x``, pointing down); the film's static load is ``m g_n`` in ``F_S``,
   i.e. the Sommerfeld number is ``1 / (pi m g_n)``;
 * ``unbalance`` ``rho_u = e_u / c``: the unbalance force ``M e_u w^2`` is ``rho_u / g_n``
   times the weight;
 * :class:`RotorImpulse`: ``amplitude`` times the weight, ``exp(-sharpness (tau - center)^2)``,
-  along ``direction`` (degrees); the seed's ``5 W exp(-5e5 (t - 0.006)^2)`` at 500 rad/s
+  along ``direction`` (degrees); Yen's (2005) ``5 W exp(-5e5 (t - 0.006)^2)`` at 500 rad/s
   is ``RotorImpulse(5, 3, 2)``.
 
 Runs end ``"completed"``, ``"contact"`` (eccentricity reached ``eps_contact``, the time
@@ -46,7 +46,7 @@ METHODS = ("explicit", "implicit")
 @dataclass(frozen=True)
 class RotorImpulse:
     """Force ``amplitude * W * exp(-sharpness (tau - center)^2)`` along ``direction``
-    (degrees in the fixed frame; 0 is the seed's gravity direction ``x``)."""
+    (degrees in the fixed frame; 0 is Yen's (2005) gravity direction ``x``)."""
 
     amplitude: float = 5.0
     center: float = 3.0
@@ -101,7 +101,7 @@ class RotorOnBearing:
         """From SI quantities: journal ``radius``, bearing ``length``, radial ``clearance``
         (m), ``viscosity`` (Pa s), rotor ``mass`` carried by the bearing (kg), ``speed``
         (rad/s), unbalance eccentricity ``unbalance`` ``e_u`` (m), gravity ``g`` (m/s^2,
-        along the seed's ``x``). ``m = M c^3 w / (mu L R^3)``, ``g_n = g / (c w^2)``,
+        along Yen's (2005) ``x``). ``m = M c^3 w / (mu L R^3)``, ``g_n = g / (c w^2)``,
         ``rho_u = e_u / c``; ``length / (2 radius)`` must be the bearing's
         ``length_ratio``. Time: ``t = tau / speed``."""
         from . import _native
@@ -218,7 +218,7 @@ def simulate_rotor(rotor: RotorOnBearing, x0: Any, t_span: Any, *, samples: int 
 
 def plot_trajectory(trajectories: RotorTrajectory | dict[str, RotorTrajectory], *,
                     title: str | None = None) -> tuple[Figure, Figure]:
-    """The seed's two views of one or more labelled trajectories: the journal orbit inside
+    """Yen's (2005) two views of one or more labelled trajectories: the journal orbit inside
     the clearance circle (``x`` down, as the seed draws it), and the tangential film
     force against time. Returns ``(orbit_figure, force_figure)``."""
     from .plot import _pyplot

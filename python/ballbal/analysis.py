@@ -73,7 +73,7 @@ def simulate(
     """Integrate the equations of motion with the core's Dormand–Prince 5(4).
 
     ``y0 = (q, q')`` in the rotating frame, ``q = (x, y, b_1..b_n)`` (with a tilting disk
-    ``(x, y, A, B, b_1..b_n)``: ``model.coordinates``); default: the thesis' start, at
+    ``(x, y, A, B, b_1..b_n)``: ``model.coordinates``); default: Tien's (2011) start, at
     rest in the ground frame, balls spread over half the track. The
     state is given at ``t0`` (default ``t_span[0]``, else 0). Give output times ``t_eval``
     (strictly monotone, not before ``t0``) or ``t_span`` for 1001 evenly spaced outputs.
@@ -386,7 +386,7 @@ class PeriodicSolution(LineSource):
         return np.asarray(row)
 
     def verify(self, rtol: float = 1e-10, atol: float = 1e-12) -> float:
-        """Simulate one period from the orbit's state (the thesis' "NI" check) and return
+        """Simulate one period from the orbit's state (Tien's (2011) "NI" check) and return
         the largest distance from where the orbit says the motion should be."""
         if self.omega is None:
             raise ValueError(f"nothing to verify: status {self.status}")
@@ -421,7 +421,7 @@ def _windings(windings: Any) -> list[int]:
 
 #: The ``Omega`` offsets ``periodic(homotopy=True)`` (and by default, last) starts from, in
 #: order. The nearest come first; the far ones reach orbits that simulation finds only near
-#: the perfect balance's stability boundary: the stable R-R orbit of the thesis map
+#: the perfect balance's stability boundary: the stable R-R orbit of the Tien (2011) map
 #: ``zeta = 0.02, zeta_b = 0.2`` at ``Omega = 1.6, eta = 1.4`` is reached from 1.2 only,
 #: that of ``zeta_b = 0.05`` at ``Omega = 1.75, eta = 1`` (N = 8) from 1.2 too.
 HOMOTOPY_OMEGA_STEPS = (-0.1, 0.1, -0.2, 0.2, -0.4, 0.4, -0.6, 0.6)
@@ -494,7 +494,7 @@ def periodic(
     :class:`~ballbal.exceptions.ParameterError` naming ``windings``.
 
     ``homotopy``: where no simulated start reaches the pattern although a stable orbit
-    exists (every start settling to the perfect balance, as at the thesis' R-R point of
+    exists (every start settling to the perfect balance, as at Tien's (2011) R-R point of
     its table 4-7), find the orbit at a nearby parameter point instead and follow it
     here by natural-parameter continuation (secant predictor, each step certified, the
     step halved on failure). ``True`` tries ``Omega`` 0.1, 0.2, 0.4 and 0.6 below and
@@ -520,7 +520,7 @@ def periodic(
       velocity error one simulated period from the series' state would show before the
       linearised flow amplifies or damps it, so unlike a simulated closure (``verify()``)
       it does not grow with the multipliers of a strongly unstable orbit. Above
-      ``max_closure`` (default 6; genuine orbits of the thesis grid at N = 3 give at
+      ``max_closure`` (default 6; genuine orbits of the Tien (2011) grid at N = 3 give at
       most 4.9, the series near a rotating branch's infinite-period end that are no
       orbits 23 and more) the status is ``not_closed``.
     * ``tail`` above ``max_tail``: status ``truncated`` (N does not resolve the orbit).
@@ -540,7 +540,7 @@ def periodic(
     * ``modulus_error``: every verdict is judged against a bound on the error of the
       leading non-trivial modulus ``max_modulus``, not only the trivial multiplier's
       (which does not bound it: at N = 3 the leading modulus' real error exceeded the
-      trivial one's in a quarter of the thesis rows, by up to 195 times). The series is
+      trivial one's in a quarter of the Tien (2011) rows, by up to 195 times). The series is
       solved again with half as many harmonics more (at least two) and its multipliers
       computed with the same options; the bound is twice the two leading moduli's
       difference plus the finer series' own error measures, and the verdict needs

@@ -1,4 +1,4 @@
-"""The balanced state of a scene and where it is stable (seed 004's stability maps)."""
+"""The balanced state of a scene and where it is stable (the stability maps of [Rezaee2017])."""
 
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def balance_map(
     (``"ok"``; ``"no_balance"`` where the balls cannot balance the disk;
     ``"not_converged"`` where the continuation from the planar balancer's perfect
     balance failed, e.g. springs near the critical speed), ``stability``,
-    ``index`` (largest real part of the eigenvalues, seed 001's relative-stability
+    ``index`` (largest real part of the eigenvalues, [TwoBallStrength]'s relative-stability
     index), ``whirl`` (residual ``hypot(x, y)``), ``tilt`` (residual ``hypot(A, B)``,
     0 for a planar disk), ``residual`` (of the equilibrium equations).
 

@@ -1,9 +1,9 @@
-"""Basins of attraction in the plane of the initial ball angles (the thesis' figures
+"""Basins of attraction in the plane of the initial ball angles (Tien's (2011) figures
 4-15 and 4-16).
 
 Every start is at rest in the ground frame (``x = x' = y = y' = 0``, ``b_i' = -Omega``
 in the rotating frame) with given ball angles, simulated in the Rust core for ``t_end``
-time units (the thesis: 1000) and labelled by the motion over the last ``window``
+time units (Tien (2011): 1000) and labelled by the motion over the last ``window``
 (:mod:`ballbal_core::analysis::basins`): ``perfect_balance`` (rest with ``|x + i y|``
 below ``rest_tol``), ``other_equilibrium``, ``merged_R-R`` (both balls rotate with
 their gap below ``merge_tol``), ``separated_R-R`` (both rotate apart: the gap
@@ -14,13 +14,13 @@ so the table does not depend on the thread count.
 
 A start whose motion is not settled after ``t_end`` (``not_settled``, or a moving class
 whose period does not repeat over its last three periods to 1e-3: a torus too, whose
-steady look at 1000 time units was, on the thesis' Omega 1.2 grid, separated rotations
+steady look at 1000 time units was, on Tien's (2011) Omega 1.2 grid, separated rotations
 still converging) is simulated further, ``t_end`` at a time, up to ``extend_factor *
 t_end`` in all (``extensions`` counts the extensions); what is still unsettled then
 keeps its label (``motion``: ``not_settled`` or ``quasi_periodic``). Every periodic
 class is then linked to its orbit: the harmonic balance solved from the series fitted to
 a representative start's own motion (:func:`ballbal.analysis.periodic`, with its
-windings: the thesis' balls rotating separately take two turns per period, windings
+windings: Tien's (2011) balls rotating separately take two turns per period, windings
 ``(-2, -2)``), each start pointing at it by the ``orbit`` column (see :func:`basins`).
 
 The default grid avoids the diagonal ``b1 = b2``: merged balls stay merged in
@@ -255,7 +255,7 @@ def _fitted_orbit(model: Balancer | Scene, y0: Any, wind: Sequence[Any] | None, 
     """:func:`ballbal.analysis.periodic` of the attractor reached from ``y0``: the series
     fitted to it after ``settle`` time units, observed for ``window`` at a thousandth of
     the basin run's tolerances over as many whole turns per period as the windings
-    ``wind`` say (two for the thesis' separated rotations; any pattern without them),
+    ``wind`` say (two for Tien's (2011) separated rotations; any pattern without them),
     solved with its pattern and those windings. ``None`` when no series is fitted."""
     d = len(model.coordinates)
     rot = None if wind is None else [w != 0 for w in wind]
@@ -389,7 +389,7 @@ def basins(
     Starts: ``b1`` and ``b2`` axis values (every pair of the product), or ``n`` per
     axis on the default grid (:func:`default_grid`, offset from the diagonal; default
     ``n = 20``), or ``samples`` uniform random starts in ``[0, 2 pi)^2`` from ``seed``.
-    ``t_end``: time simulated per start (the thesis: 1000; overrides ``options``).
+    ``t_end``: time simulated per start (Tien (2011): 1000; overrides ``options``).
     ``settle_check``: simulate every start again for ``3 t_end`` (``options.
     settle_factor``) and report ``long_label`` and ``settled`` (the labels agree).
     ``execution``: ``threads`` (default all cores), ``chunk`` (starts per task,

@@ -1,11 +1,11 @@
-"""Hydrodynamic journal bearings, plain and herringbone-grooved (seed 002, ``bearing.md``).
+"""Hydrodynamic journal bearings, plain and herringbone-grooved ([Yen2005], ``bearing.md``).
 
 Nondimensional description of the film (``bearing.md`` section 1): ``length_ratio`` is
 ``L / D``; positions are over the radial clearance ``c``, pressures over
 ``mu w R^2 / c^2`` and forces over ``F_S = mu w L R^3 / c^2``.
 
 :class:`Grooves` are symmetric herringbone grooves over the bearing's length, on the
-stationary ``"sleeve"`` (the seed's configuration) or on the rotating ``"journal"``; the
+stationary ``"sleeve"`` (Yen's (2005) configuration) or on the rotating ``"journal"``; the
 angle is in degrees **from the circumferential direction** (90 would be axial grooves).
 The apex at the mid-plane points in the direction in which the smooth surface moves
 relative to the grooved one, so the grooves pump towards the mid-plane.

@@ -1,4 +1,4 @@
-"""Command line: ``ballbal run`` solves the thesis' standard case; ``ballbal periodic``
+"""Command line: ``ballbal run`` solves Tien's (2011) standard case; ``ballbal periodic``
 and ``ballbal equilibria`` take parameters, or a scene file (``--scene SCENE.toml``,
 whose balancer the parameter options given change); ``ballbal scan SCENE.toml --Omega 1:2:0.1
 --eta 0.4:1.5:0.1 -o out.parquet`` maps a parameter plane (Ctrl-C keeps the finished
@@ -155,7 +155,7 @@ def _print_map(b: Balancer) -> None:
     t = time.perf_counter()
     df = scan(b, Omega=(1.0, 2.0, 0.1), eta=(0.4, 1.5, 0.1), patterns=["R-R", "O-O", "R-O"])
     dt = time.perf_counter() - t
-    print(f"Scan of the thesis grid (zeta {b.zeta}, zeta_b {b.zeta_b}; R-R, O-O, R-O; "
+    print(f"Scan of the Tien (2011) grid (zeta {b.zeta}, zeta_b {b.zeta_b}; R-R, O-O, R-O; "
           f"{dt:.2f} s): S stable R-R, u unstable R-R, o other stable type, "
           "+ perfect balance stable, . nothing")
     oms = sorted(set(df["Omega"].to_list()))
@@ -280,7 +280,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = _Parser(prog="ballbal", description=__doc__)
     ap.add_argument("--version", action="version", version=f"ballbal {__version__}")
     sub = ap.add_subparsers(dest="cmd", required=True, parser_class=_Parser)
-    sub.add_parser("run", help="the thesis' standard case: equilibria and R-R solution")
+    sub.add_parser("run", help="Tien's (2011) standard case: equilibria and R-R solution")
     pp = sub.add_parser("periodic", help="a periodic solution with Floquet stability")
     _params(pp)
     pp.add_argument("--pattern", default="R-R")
@@ -288,7 +288,7 @@ def main(argv: list[str] | None = None) -> int:
     pe = sub.add_parser("equilibria", help="all equilibria with stability")
     _params(pe)
     ps = sub.add_parser("scan", help="scan a parameter grid; one Parquet row per solution")
-    ps.add_argument("scene", nargs="?", help="scene TOML (default: the thesis' standard case)")
+    ps.add_argument("scene", nargs="?", help="scene TOML (default: Tien's (2011) standard case)")
     for name in SCANNABLE:
         # one spelling for every subcommand: --zeta-b, as periodic and equilibria
         ps.add_argument(f"--{name.replace('_', '-')}", dest=name, metavar="START:STOP:STEP")
@@ -311,7 +311,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if a.cmd == "run":
             b = Balancer()
-            print(f"ballbal: thesis standard case {b}")
+            print(f"ballbal: Tien (2011) standard case {b}")
             _print_equilibria(b)
             print("Periodic solutions (balls merged, rotating):")
             found = [_print_periodic(b, "R-R", N) for N in (3, 8)]

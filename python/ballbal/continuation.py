@@ -19,9 +19,9 @@ from ballbal._eq_continuation import (
 from ballbal._po_continuation import periodic_branch
 from ballbal._po_curves import periodic_curve
 from ballbal._po_switch import switch
-from ballbal.model import Seed003, from_seed003
+from ballbal.model import DiskUnits, from_disk_units
 
-__all__ = ["Branch", "Continuation", "Curve", "Seed003", "equilibrium_branch", "event_name",
+__all__ = ["Branch", "Continuation", "Curve", "DiskUnits", "equilibrium_branch", "event_name",
            "event_vocabulary",
-           "equilibrium_curve", "from_seed003", "periodic_branch", "periodic_curve", "switch",
+           "equilibrium_curve", "from_disk_units", "periodic_branch", "periodic_curve", "switch",
            "switch_equilibrium"]

@@ -1,11 +1,11 @@
-"""The thesis' experiments as data (seed 000, chapter 4), and lab-side helpers.
+"""The experiments of [Tien2011] as data (chapter 4), and lab-side helpers.
 
-Every experimental number of the thesis' chapter 4 is here with its source (section,
+Every experimental number of Tien's (2011) chapter 4 is here with its source (section,
 table or figure), its unit and notes: :func:`experiments` returns them as one long
 polars table, :func:`peaks` the spectral peaks of the measured records with the labels
-the thesis gives them, :func:`transitions` the measured critical speeds.
+Tien (2011) gives them, :func:`transitions` the measured critical speeds.
 
-The thesis' figures did not survive transcription: only numbers stated in its text and
+Tien's (2011) figures did not survive transcription: only numbers stated in its text and
 tables are here. Where the text and a table disagree, or a stated number does not follow
 from the others, both are kept and the notes say which reproduces.
 
@@ -38,7 +38,7 @@ __all__ = [
 #: The rig's measured first natural frequency without balls (section 4-1-2), rpm.
 NATURAL_FREQUENCY_RPM = 513.0
 
-#: The model parameters the thesis compares with its rig (section 4-4-2, fig. 4-13: its
+#: The model parameters Tien (2011) compares with its rig (section 4-4-2, fig. 4-13: its
 #: MIHB "at mu 0.2, zeta 0.05, zeta_b 0.05, delta 50" with f_n = 513 rpm). The rig's own
 #: disk mass and support damping without pads are not stated.
 MODEL_PARAMETERS: dict[str, float] = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
@@ -107,7 +107,7 @@ _ROWS: list[tuple[str, float, str, str, str, str]] = [
      "measured Omega - omega over the speeds, 25 rpm steps"),
     ("main_frequency_max", 500.0, "rpm", "two balls eta 1.30", "4-4-2, fig. 4-13", ""),
     ("main_frequency_model_min", 460.0, "rpm", "two balls eta 1.30", "4-4-2, fig. 4-13",
-     "the thesis' MIHB at mu 0.2, zeta 0.05, zeta_b 0.05, delta 50, f_n 513 rpm"),
+     "Tien's (2011) MIHB at mu 0.2, zeta 0.05, zeta_b 0.05, delta 50, f_n 513 rpm"),
     ("main_frequency_model_max", 510.0, "rpm", "two balls eta 1.30", "4-4-2, fig. 4-13", ""),
     ("main_frequency_max_error", 6.0, "%", "two balls eta 1.30", "4-4-2", "model vs rig"),
     # 4-4-3: track damping (oils)
@@ -192,7 +192,7 @@ _TRANSITIONS: list[tuple[str, str, float, str, str, float, float, str, str]] = [
 
 
 def experiments() -> pl.DataFrame:
-    """Every experimental number of the thesis' chapter 4: one row per number with
+    """Every experimental number of Tien's (2011) chapter 4: one row per number with
     ``quantity, value, unit, case, source, notes``."""
     cols = list(zip(*_ROWS, strict=True))
     return pl.DataFrame(
@@ -204,7 +204,7 @@ def experiments() -> pl.DataFrame:
 
 
 def peaks() -> pl.DataFrame:
-    """The measured spectral peaks (rpm) with the thesis' labels: ``k`` for a line at
+    """The measured spectral peaks (rpm) with Tien's (2011) labels: ``k`` for a line at
     ``Omega + k omega``, null for a peak of no such form; ``largest`` marks the highest."""
     cols = list(zip(*_PEAKS, strict=True))
     return pl.DataFrame(
@@ -248,7 +248,7 @@ def residual_imbalance(imbalance: float, eta: Any, angles: Any = math.pi) -> flo
     (units of ``imbalance``): ``eta`` one capacity or several, ``angles`` the balls' angles
     from the disk's mass centre (default: straight opposite it, ``pi``). ``eta`` may also
     be an :class:`~ballbal.Equilibrium`, whose own ``residual_imbalance`` is scaled.
-    The thesis' section 4-3: 33.12 g mm with one ball of eta 0.54 opposite leaves
+    Tien's (2011) section 4-3: 33.12 g mm with one ball of eta 0.54 opposite leaves
     15.24 g mm, with eta 1.85 (over-balance) 28.15 g mm."""
     from .analysis import Equilibrium
     from .analysis import residual_imbalance as relative
@@ -319,7 +319,7 @@ def ratio_to_rpm(ratio: Any, natural_frequency_rpm: float = NATURAL_FREQUENCY_RP
 def leaf_spring_stiffness(modulus: float, width: float, thickness: float,
                           length: float) -> float:
     """Stiffness ``17 E b h^3 / (8 l^3)`` of the rig's L-shaped leaf-spring support, the
-    formula of the thesis' section 4-1-2 (its reference [20]); SI units give N/m."""
+    formula of Tien's (2011) section 4-1-2 (its reference [20]); SI units give N/m."""
     e, b, h, l_ = (_check.real(k, v, 0.0, lo_open=True) for k, v in (
         ("modulus", modulus), ("width", width), ("thickness", thickness), ("length", length)))
     return 17.0 * e * b * h**3 / (8.0 * l_**3)
@@ -345,7 +345,7 @@ def log_decrement(signal: Sequence[float] | np.ndarray, *, n_peaks: int = 5) -> 
     A cycle peak is the largest sample of a positive lobe (between sign changes); lobes
     under 5 % of the record's largest value (noise about a zero crossing) are skipped, and
     so is a lobe whose largest sample is the record's first or last (a cut cycle). A noisy
-    record should be low-pass filtered first, as the thesis did (50 Hz).
+    record should be low-pass filtered first, as Tien (2011) did (50 Hz).
     """
     x = _check.array("signal", signal)
     if x.size < 3 or not np.all(np.isfinite(x)):

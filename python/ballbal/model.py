@@ -44,7 +44,7 @@ def _unknown_fields(cls: type, changes: dict[str, Any]) -> None:
 
 @dataclass(frozen=True)
 class Balancer:
-    """A planar automatic ball balancer in the thesis' nondimensional parameters.
+    """A planar automatic ball balancer in the nondimensional parameters of [Tien2011].
 
     ``eta`` has one entry per ball (its length is the number of balls ``n``); ``zeta_b``
     is one value shared by all balls or one per ball. The core checks the parameters
@@ -164,17 +164,17 @@ def zeta_from_log_decrement(d: float) -> float:
     return d / math.sqrt(4 * math.pi**2 + d**2)
 
 
-def from_seed003(
+def from_disk_units(
     omega0: float, m0: float, e: float, C0: float = 0.05, D0: float = 0.1, n: int = 2
 ) -> Balancer:
-    """A balancer given in seed 003's nondimensionalisation, in the thesis' parameters.
+    """A balancer given in units of the disk alone [EccentricRotorABB], in ballbal's parameters.
 
-    Seed 003 scales lengths by the track radius (``e = eps / R``), masses by the disk
-    mass (``m0 = m / M``) and time by ``omega_n = sqrt(K / M)`` of the disk alone, with no
+    Lengths are scaled by the track radius (``e = eps / R``), masses by the disk mass
+    (``m0 = m / M``) and time by ``omega_n = sqrt(K / M)`` of the disk alone, with no
     further rotor mass; ``C0 = C / (2 sqrt(K M))`` and ``D0 = D / (m R^2 omega_n)``. The total
     mass is ``M (1 + n m0)``, hence ``Omega = omega0 sqrt(1 + n m0)``, ``eta = m0 / e``,
     ``mu = 1 / (1 + n m0)``, ``delta = 1 / e``, ``zeta = C0 / sqrt(1 + n m0)`` and
-    ``zeta_b = D0 sqrt(1 + n m0) / 2``. Its pitchfork point ``(0.5773, 1)`` with ``e = 2``
+    ``zeta_b = D0 sqrt(1 + n m0) / 2``. The pitchfork point ``(0.5773, 1)`` with ``e = 2``
     is ``(Omega, eta) = (1, 0.5)``.
     """
     omega0, C0, D0 = (_check.real(k, v, 0.0) for k, v in
@@ -193,24 +193,25 @@ def from_seed003(
     )
 
 
-#: Seed 003's parameter names, the ones continuation in its units takes.
-SEED003_PARAMETERS = ("omega0", "m0", "e", "C0", "D0")
+#: The parameter names in the disk's units, the ones continuation in them takes.
+DISK_UNITS_PARAMETERS = ("omega0", "m0", "e", "C0", "D0")
 
 
 @dataclass(frozen=True)
-class Seed003:
-    """A balancer in seed 003's own parameters, a family continuation can vary in them.
+class DiskUnits:
+    """A balancer in units of the disk alone [EccentricRotorABB], a family continuation can
+    vary in these units' own parameters.
 
     ``omega0`` spin speed over ``sqrt(K / M)`` of the disk alone, ``m0 = m / M`` (each of
     the ``n`` balls over the disk), ``e = eps / R`` (eccentricity over track radius),
-    ``C0 = C / (2 sqrt(K M))``, ``D0 = D / (m R^2 omega_n)``; see :func:`from_seed003`
+    ``C0 = C / (2 sqrt(K M))``, ``D0 = D / (m R^2 omega_n)``; see :func:`from_disk_units`
     for the conversion. ``balancer`` is the same balancer in ballbal's parameters.
 
     The equilibrium-continuation functions of :mod:`ballbal.continuation` accept it as
-    their model and then take and report the seed's parameter names
-    (``equilibrium_branch(Seed003(0.3, 2.0, 2.0, 0.35, 0.35), "m0", ...)``): one of them
+    their model and then take and report these parameter names
+    (``equilibrium_branch(DiskUnits(0.3, 2.0, 2.0, 0.35, 0.35), "m0", ...)``): one of them
     moves several of ballbal's at once (``m0`` moves ``mu``, ``eta``, ``Omega``, ``zeta``
-    and ``zeta_b``), and the model is rebuilt from the seed's values at every point.
+    and ``zeta_b``), and the model is rebuilt from these values at every point.
     """
 
     omega0: float
@@ -229,19 +230,19 @@ class Seed003:
 
     @property
     def balancer(self) -> Balancer:
-        """The same balancer in ballbal's parameters (:func:`from_seed003`)."""
-        return from_seed003(self.omega0, self.m0, self.e, C0=self.C0, D0=self.D0, n=self.n)
+        """The same balancer in ballbal's parameters (:func:`from_disk_units`)."""
+        return from_disk_units(self.omega0, self.m0, self.e, C0=self.C0, D0=self.D0, n=self.n)
 
     @property
     def scale(self) -> float:
-        """``S = sqrt(1 + n m0)``: ballbal's ``Omega`` over ``omega0``; the seed's time is
-        ``S`` times ballbal's (its rates and eigenvalues are ballbal's over ``S``)."""
+        """``S = sqrt(1 + n m0)``: ballbal's ``Omega`` over ``omega0``; the disk's time unit
+        is ``S`` times ballbal's (its rates and eigenvalues are ballbal's over ``S``)."""
         return math.sqrt(1.0 + self.n * self.m0)
 
-    def replace(self, **changes: Any) -> Seed003:
-        """A copy with some of the seed's parameters changed."""
+    def replace(self, **changes: Any) -> DiskUnits:
+        """A copy with some of these parameters changed."""
         for k in changes:
-            if k not in (*SEED003_PARAMETERS, "n"):
-                raise ParameterError(k, "is not a parameter of seed 003's units",
-                                     allowed=", ".join(SEED003_PARAMETERS))
+            if k not in (*DISK_UNITS_PARAMETERS, "n"):
+                raise ParameterError(k, "is not a parameter of the disk's units",
+                                     allowed=", ".join(DISK_UNITS_PARAMETERS))
         return replace(self, **changes)

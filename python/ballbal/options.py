@@ -50,7 +50,7 @@ AUTO_START = 3
 
 #: A scan's default ``Floquet.hill_band``: Hill cross-checks the solutions whose
 #: leading non-trivial multiplier lies within it of the unit circle (and those without a
-#: monodromy verdict). Hill beside every monodromy, on the nine thesis maps at N = 3 and
+#: monodromy verdict). Hill beside every monodromy, on the nine Tien (2011) maps at N = 3 and
 #: 8 and two fine grids (all three types, 21 879 solutions), contradicted no verdict and
 #: gave the monodromy's own everywhere outside it but once (a modulus-55 orbit it left
 #: undetermined); 7 % of those solutions lie inside, and a fine-grid scan costs 4 to 8 %

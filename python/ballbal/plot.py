@@ -22,7 +22,7 @@ def _pyplot() -> Any:
 def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = "R-R",
              ax: Any = None, title: str | None = None,
              shade: str = "perfect balance stable", curves: Any = ()) -> Any:
-    """The thesis' map (figures 3-6 to 3-16): solutions of ``type`` over the (x, y) plane,
+    """Tien's (2011) map (figures 3-6 to 3-16): solutions of ``type`` over the (x, y) plane,
     stable and unstable markers, and the perfect balance's stable region shaded (for a
     scene with springs, its balanced state's: name it with ``shade``). ``curves``:
     :class:`~ballbal.continuation` curves (``Curve`` objects whose tables have the columns
@@ -75,7 +75,7 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
 
 def omega_curves(df: pl.DataFrame, *, x: str = "eta", by: str = "Omega",
                  type: str = "R-R", stable_only: bool = True, ax: Any = None) -> Any:
-    """omega against ``x`` for each value of ``by`` (the thesis' figure 3-7)."""
+    """omega against ``x`` for each value of ``by`` (Tien's (2011) figure 3-7)."""
     plt = _pyplot()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))

@@ -4,17 +4,18 @@ A scene is a :class:`Balancer` with optional effects (``model.md`` units: length
 the eccentricity ``e``, time over ``1/w_n``, forces over ``M e w_n^2``):
 
 * ``springs``: circumferential springs between neighbouring balls, stiffness ``k_d / k``,
-  rest spacing ``2 pi / n`` (seed 004's ball-spring balancer); ``spring_layout``
-  ``"ring"`` (n springs, ball n to ball 1 closing the ring) or ``"chain"`` (seed 004's
-  n - 1 springs, ball 1 to ball n; for two balls a ring of stiffness k is a chain of 2 k);
+  rest spacing ``2 pi / n`` (the ball-spring balancer of [Rezaee2017]); ``spring_layout``
+  ``"ring"`` (n springs, ball n to ball 1 closing the ring) or ``"chain"`` (the
+  [Rezaee2017] form: n - 1 springs, ball 1 to ball n; for two balls a ring of stiffness k
+  is a chain of 2 k);
 * ``ramp``: the spin changes linearly from ``Omega`` to ``ramp.to`` over
-  ``ramp.duration`` from ``ramp.start`` (a run-up, or seed 001's speed disturbance);
+  ``ramp.duration`` from ``ramp.start`` (a run-up, or the speed disturbance of [TwoBallStrength]);
 * ``gravity``: ``g / (e w_n^2)`` for a horizontal spin axis (gravity along -Y of the
   ground frame; the disk's x axis is along +X at t = 0);
-* ``impulse``: seed 002's load on the rotor ``amplitude exp(-sharpness (t - t0)^2)``
+* ``impulse``: Yen's (2005) load on the rotor ``amplitude exp(-sharpness (t - t0)^2)``
   along the ground direction ``angle``;
 * ``tilt``: the disk tilts on a flexible, simply supported shaft, with gyroscopic
-  coupling (seed 004; :class:`Tilt`). The state gains two coordinates after ``x, y``:
+  coupling (Rezaee et al. 2017; :class:`Tilt`). The state gains two coordinates after ``x, y``:
   ``A, B``, the Euler tilts ``alpha, beta`` scaled by ``delta`` (the track rim's axial
   displacement over ``e``; radians are ``A / delta``).
 
@@ -109,7 +110,7 @@ class Impulse:
 
 @dataclass(frozen=True)
 class Tilt:
-    """A disk that tilts on a massless, simply supported shaft (seed 004).
+    """A disk that tilts on a massless, simply supported shaft (Rezaee et al. 2017).
 
     ``a, b``: the disk's distances from the two bearings, over the track radius ``r_t``;
     ``j_t, j_z``: the disk's transverse and polar moments of inertia about its mass
@@ -293,7 +294,7 @@ class Scene:
         return self.balancer.n_balls
 
     @property
-    def Omega(self) -> float:  # noqa: N802 - the thesis' symbol
+    def Omega(self) -> float:  # noqa: N802 - Tien's (2011) symbol
         return self.balancer.Omega
 
     @property

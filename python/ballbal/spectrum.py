@@ -13,7 +13,7 @@ t``, the same for ``y``), ``c_0 = a_0x + i a_0y``,
 ``c_-m = ((a_mx - b_my) + i (a_my + b_mx)) / 2``; velocity and acceleration lines are
 ``(i f_k) c_k`` and ``-f_k^2 c_k``. These lines are exact (no FFT, no leakage); the
 functions below also give the windowed spectrum of a sampled signal (a simulation or a
-measured record), label its peaks as ``Omega + k omega``, and the thesis' vibration
+measured record), label its peaks as ``Omega + k omega``, and Tien's (2011) vibration
 indicator: the mean, least and largest support acceleration magnitude ``|Z''|``.
 
 Units. Frequencies are ratios to ``w_n`` (the model's angular frequencies), optionally
@@ -124,7 +124,7 @@ def line_spectrum(
     solution: PeriodicSolution | Equilibrium,
     quantity: Quantity = "acceleration",
     *,
-    Omega: float | None = None,  # noqa: N803 - the thesis' symbol
+    Omega: float | None = None,  # noqa: N803 - Tien's (2011) symbol
     natural_frequency_hz: float | None = None,
     natural_frequency_rpm: float | None = None,
     eccentricity: float | None = None,
@@ -201,7 +201,7 @@ class Vibration:
     """Statistics of ``|Z|``, ``|Z'|`` or ``|Z''|`` (``quantity``) over the motion.
 
     ``mean``, ``min``, ``max`` and ``rms`` in the units of :func:`line_spectrum`
-    (``e w_n^2`` for the acceleration: the thesis' "amplitude" is ``|Z''|``, the root of
+    (``e w_n^2`` for the acceleration: Tien's (2011) "amplitude" is ``|Z''|``, the root of
     the two accelerometers' squares, its mean the vibration level of its tables).
     ``exact``: from a periodic solution's coefficients (see :func:`vibration`), else from
     samples of a simulation; ``mean_error``: the last change of the mean as the samples
@@ -354,7 +354,7 @@ def vibration(
     t_min: float | None = None,
 ) -> Vibration:
     """The vibration indicator: mean, least, largest and rms value of ``|Z''|`` (the
-    support acceleration magnitude, the thesis' "amplitude"), or of ``|Z|`` / ``|Z'|``.
+    support acceleration magnitude, Tien's (2011) "amplitude"), or of ``|Z|`` / ``|Z'|``.
 
     * A :class:`~ballbal.PeriodicSolution`: exact from its coefficients. ``|Z^(p)(t)| =
       |g(omega t)|`` with ``g(s) = sum_k C_k exp(i k s)`` (the factor ``exp(i Omega t)``
@@ -750,7 +750,7 @@ def waterfall(items: Iterable[tuple[float, pl.DataFrame]], *, name: str = "Omega
 def plot_spectrum(spectrum: pl.DataFrame, *, column: str = "frequency",
                   amplitude: str = "amplitude", ax: Any = None, label: float = 0.05,
                   min_relative: float = 1e-4, title: str | None = None) -> Any:
-    """Plot a spectrum: stems for :func:`line_spectrum` (the thesis' figures 4-12, 4-27,
+    """Plot a spectrum: stems for :func:`line_spectrum` (Tien's (2011) figures 4-12, 4-27,
     4-28; lines below ``min_relative`` of the largest omitted, lines above ``label``
     annotated with their ``k``), a curve for :func:`signal_spectrum`. Returns the axes."""
     from .plot import _pyplot

@@ -1,4 +1,4 @@
-"""Speed sweeps as an experiment is run (the thesis' section 4-2): the speed is stepped
+"""Speed sweeps as an experiment is run (Tien's (2011) section 4-2): the speed is stepped
 up, then down, with a dwell at each step, the state carried over from step to step, and
 the motion at each step labelled by the basins' classifier
 (:func:`ballbal.basins.basins`' labels).
@@ -73,7 +73,7 @@ class Sweep:
     direction, Omega, Omega_index`` (the speed's position on the ``speeds`` axis, for
     exact joins), ``label, omega`` (mean ball rate), ``period``, ``rotating``, and
     ``vibration`` (mean ``|Z''|`` over the last ``record`` time units of the dwell) when
-    recorded); ``up`` and ``down``: the transition speeds (the thesis' critical speeds:
+    recorded); ``up`` and ``down``: the transition speeds (Tien's (2011) critical speeds:
     the first speed going up at which the motion is at rest on an equilibrium after
     moving, the first speed going down at which it moves again; ``None`` if none)."""
 
@@ -87,7 +87,7 @@ class Sweep:
 
     def waterfall(self) -> pl.DataFrame:
         """The steps' spectra as one long table (:func:`ballbal.spectrum.waterfall`),
-        each row tagged with its ``step``, ``direction`` and ``Omega``: the thesis'
+        each row tagged with its ``step``, ``direction`` and ``Omega``: Tien's (2011)
         spectra over a speed sweep, forward and backward whirl apart."""
         from .spectrum import waterfall
 

@@ -1,4 +1,4 @@
-"""Transients after a spin-speed disturbance (seed 001): the peak radial amplitude, the
+"""Transients after a spin-speed disturbance ([TwoBallStrength]): the peak radial amplitude, the
 time to settle inside a band, and the track damping that trades the two off."""
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def disturbance_response(
     rtol: float = 1e-8,
 ) -> DisturbanceResponse:
     """Start at the stable perfect balance at ``model.Omega``, change the spin to
-    ``to`` linearly over ``duration`` from ``start`` (seed 001: 100 rad/s in 0.11 s), and
+    ``to`` linearly over ``duration`` from ``start`` ([TwoBallStrength]: 100 rad/s in 0.11 s), and
     measure the radial vibration. ``band`` is in units of the eccentricity ``e``.
 
     ``model`` may be an autonomous scene (ball springs, a tilting disk): it starts at
@@ -107,7 +107,7 @@ def track_damping_study(
     **kw: Any,
 ) -> pl.DataFrame:
     """Peak amplitude and settling time after the disturbance for each track damping,
-    and seed 001's combined index ``peak * s + settle_time`` with the scale ``s`` = mean
+    and [TwoBallStrength]'s combined index ``peak * s + settle_time`` with the scale ``s`` = mean
     settling time / mean peak (so both terms count alike); ``optimal`` marks its
     minimum. At most :data:`~ballbal._check.MAX_STUDY_VALUES` dampings (each a
     simulation of ``t_end``)."""

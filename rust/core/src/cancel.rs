@@ -68,7 +68,7 @@ pub fn current() -> Option<Token> {
 
 /// Whether this thread's token asks to stop.
 pub fn cancelled() -> bool {
-    #[cfg(test)]
+    #[cfg(all(test, feature = "studies"))]
     gaps::mark();
     CURRENT.with(|c| c.borrow().as_ref().is_some_and(Token::is_cancelled))
 }
@@ -83,8 +83,8 @@ pub fn check() -> Result<()> {
 }
 
 /// The longest stretch between two polls of this thread: the longest that a cancellation
-/// waits (a measuring aid for the `#[ignore]`d latency reports).
-#[cfg(test)]
+/// waits (a measuring aid for the latency studies, so only with the `studies` feature).
+#[cfg(all(test, feature = "studies"))]
 pub(crate) mod gaps {
     use std::cell::Cell;
     use std::time::Instant;

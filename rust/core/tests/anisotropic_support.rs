@@ -203,7 +203,7 @@ fn damped_eigenvalues_solve_the_characteristic_quartic() {
 
 #[test]
 fn harmonic_balance_runs_unchanged_and_its_orbit_closes_under_simulation() {
-    // The thesis balancer (mu 0.2, zeta 0.05, zeta_b 0.05, delta 50, two balls of
+    // Tien (2011) balancer (mu 0.2, zeta 0.05, zeta_b 0.05, delta 50, two balls of
     // eta 1) near its R-R branch at Omega = 1.19, on the isotropic support plus the new
     // shaft adding stiffness 0.1 along y only: four components. The generic guess from
     // a simulated attractor and the Newton solve run with nothing told about the new

@@ -13,7 +13,7 @@ use ballbal_core::continuation::equilibria::{
 use ballbal_core::continuation::event::VOCABULARY;
 use ballbal_core::continuation::{ArcStop, Event};
 use ballbal_core::equilibria::EquilibriumKind;
-use ballbal_core::model::Seed003;
+use ballbal_core::model::DiskUnits;
 use ballbal_core::numerics::problem::{Parametric, Problem};
 use ballbal_core::periodic::require_autonomous;
 use ballbal_core::Planar;
@@ -78,10 +78,10 @@ fn check_q(q: &[f64], d: usize) -> Result<()> {
     Ok(())
 }
 
-/// Seed 003's parameters (`ballbal.continuation.Seed003`'s fields): when given, the
-/// continued parameters are the seed's own and the model is rebuilt from them.
+/// The balancer in the disk's units (`ballbal.continuation.DiskUnits`' fields): when
+/// given, the continued parameters are these units' own and the model is rebuilt from them.
 #[derive(FromPyObject)]
-pub struct Seed003Args {
+pub struct DiskUnitsArgs {
     omega0: f64,
     m0: f64,
     e: f64,
@@ -92,21 +92,21 @@ pub struct Seed003Args {
     n: usize,
 }
 
-impl Seed003Args {
-    fn core(&self) -> Result<Seed003> {
-        Seed003::new(self.omega0, self.m0, self.e, self.c0, self.d0, self.n)
+impl DiskUnitsArgs {
+    fn core(&self) -> Result<DiskUnits> {
+        DiskUnits::new(self.omega0, self.m0, self.e, self.c0, self.d0, self.n)
     }
 }
 
-/// The equilibrium family in `names`: the model's own parameters, or seed 003's.
+/// The equilibrium family in `names`: the model's own parameters, or the disk's units'.
 fn family<'a, D: Parametric>(
     d: &'a D,
-    seed: Option<&Seed003Args>,
+    seed: Option<&DiskUnitsArgs>,
     names: &[&str],
 ) -> Result<Family<'a, D>> {
     Ok(match seed {
         None => Family::Model(EqSystem::family(d, names)?),
-        Some(s) => Family::Seed(EqSystem::seed003(s.core()?, names)?),
+        Some(s) => Family::Seed(EqSystem::disk_units(s.core()?, names)?),
     })
 }
 
@@ -127,7 +127,7 @@ macro_rules! with_family {
 
 fn run_branch<D: Parametric>(
     d: &D,
-    seed: Option<&Seed003Args>,
+    seed: Option<&DiskUnitsArgs>,
     parameter: &str,
     q: &[f64],
     kind: EquilibriumKind,
@@ -149,7 +149,7 @@ fn run_branch<D: Parametric>(
 #[allow(clippy::too_many_arguments)]
 fn run_switch<D: Parametric>(
     d: &D,
-    seed: Option<&Seed003Args>,
+    seed: Option<&DiskUnitsArgs>,
     parameter: &str,
     x: &[f64],
     p: f64,
@@ -169,7 +169,7 @@ fn run_switch<D: Parametric>(
 #[allow(clippy::too_many_arguments)]
 fn run_curve<D: Parametric>(
     d: &D,
-    seed: Option<&Seed003Args>,
+    seed: Option<&DiskUnitsArgs>,
     kind: CurveKind,
     names: (&str, &str),
     q: &[f64],
@@ -263,7 +263,7 @@ fn curve_dict(py: Python<'_>, c: EqCurve) -> PyResult<Bound<'_, PyDict>> {
 /// A branch of equilibria from `q` (the model's equilibrium of kind `kind`) in
 /// `parameter` over `range`: a dict of `points`, `events` and `stop`.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, q, kind, range, options, both=false, seed003=None))]
+#[pyo3(signature = (model, parameter, q, kind, range, options, both=false, disk_units=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn equilibrium_branch<'py>(
     py: Python<'py>,
@@ -274,21 +274,21 @@ pub fn equilibrium_branch<'py>(
     range: (f64, f64),
     options: ContinuationArgs,
     both: bool,
-    seed003: Option<Seed003Args>,
+    disk_units: Option<DiskUnitsArgs>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let k = kind_from(&kind).py()?;
     let opts = options_checked(&m, &options, range)?;
     let b = guarded(
         py,
-        || dispatch!(&m, d => run_branch(d, seed003.as_ref(), &parameter, &q, k, both, &opts)),
+        || dispatch!(&m, d => run_branch(d, disk_units.as_ref(), &parameter, &q, k, both, &opts)),
     )?;
     branch_dict(py, b)
 }
 
 /// The other branch through a branch point `(x, p)` reached along `tangent`.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, x, p, tangent, range, options, seed003=None))]
+#[pyo3(signature = (model, parameter, x, p, tangent, range, options, disk_units=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn equilibrium_switch<'py>(
     py: Python<'py>,
@@ -299,13 +299,13 @@ pub fn equilibrium_switch<'py>(
     tangent: Vec<f64>,
     range: (f64, f64),
     options: ContinuationArgs,
-    seed003: Option<Seed003Args>,
+    disk_units: Option<DiskUnitsArgs>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let opts = options_checked(&m, &options, range)?;
     let b = guarded(
         py,
-        || dispatch!(&m, d => run_switch(d, seed003.as_ref(), &parameter, &x, p, &tangent, &opts)),
+        || dispatch!(&m, d => run_switch(d, disk_units.as_ref(), &parameter, &x, p, &tangent, &opts)),
     )?;
     branch_dict(py, b)
 }
@@ -315,7 +315,7 @@ pub fn equilibrium_switch<'py>(
 /// `(q, p1)` in `(parameter, parameter2)`, `range` bounding `parameter2`; `together`:
 /// on the balls-together subspace.
 #[pyfunction]
-#[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options, seed003=None))]
+#[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options, disk_units=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn equilibrium_curve<'py>(
     py: Python<'py>,
@@ -328,7 +328,7 @@ pub fn equilibrium_curve<'py>(
     together: bool,
     range: (f64, f64),
     options: ContinuationArgs,
-    seed003: Option<Seed003Args>,
+    disk_units: Option<DiskUnitsArgs>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let k = match Event::parse(&kind, "event").py()? {
@@ -348,7 +348,7 @@ pub fn equilibrium_curve<'py>(
     let opts = options_checked(&m, &options, range)?;
     let c = guarded(
         py,
-        || dispatch!(&m, d => run_curve(d, seed003.as_ref(), k, (&parameter, &parameter2), &q, p1, together, &opts)),
+        || dispatch!(&m, d => run_curve(d, disk_units.as_ref(), k, (&parameter, &parameter2), &q, p1, together, &opts)),
     )?;
     curve_dict(py, c)
 }

@@ -48,7 +48,7 @@ impl Default for GuessOptions {
 }
 
 /// Deterministic initial states: at rest in the ground frame (`b_i' = -Omega`, the
-/// thesis' basin set-up) from merged, opposed and spread ball positions.
+/// Tien's (2011) basin set-up) from merged, opposed and spread ball positions.
 pub fn initial_states<D: Dynamics + ?Sized>(p: &D) -> Vec<Vec<f64>> {
     let o = p.first_ball();
     let n = p.ndof() - o;
@@ -222,10 +222,10 @@ pub fn seed_guess<D: Dynamics + ?Sized>(
 /// coordinate axes and two diagonals). Inside `rate / (SAFETY * K)` the quadratic
 /// terms are a fraction `1 / SAFETY` of the slowest decay, so the linear picture holds
 /// (`SAFETY` also covers the eigenvectors' conditioning and the mixed derivatives the
-/// probes do not see); it is capped at `MAX_RADIUS`. On the thesis grids `K` is about
+/// probes do not see); it is capped at `MAX_RADIUS`. On Tien (2011) grids `K` is about
 /// 5 and `rate` 0.01-0.05, so the radius is 1e-4 to 1e-3; the test below starts on
 /// the box's corners and checks the decay. Reaching 1e-3 rather than the watch's
-/// thresholds saved 4.5 % of a thesis scan's instructions (the transient's steps
+/// thresholds saved 4.5 % of an Omega-eta map scan's instructions (the transient's steps
 /// before it are most of a rest seed's cost).
 #[derive(Debug, Clone)]
 pub struct Capture {
@@ -591,7 +591,7 @@ fn classify_with<D: Dynamics + ?Sized>(
     all_t.extend(times.iter().copied());
     // As if from t = 0 even when quick: re-simulating from the observation's start
     // instead perturbs the guess at the integration tolerance, enough to send the
-    // harmonic balance to another of the coexisting O-O orbits on the thesis maps. The
+    // harmonic balance to another of the coexisting O-O orbits on the Tien (2011) maps. The
     // settling run's steps up to its last one are those steps, so it continues from
     // there rather than integrating them again.
     let traj = if early {
@@ -753,7 +753,7 @@ mod tests {
 
     #[test]
     fn standard_case_settles_on_the_rr_orbit_with_its_period() {
-        // The thesis' standard case: the R-R orbit of omega 0.25141 (independent
+        // Tien's (2011) standard case: the R-R orbit of omega 0.25141 (independent
         // shooting value in the spec), reached from rest in the ground frame.
         let p = Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
         let y0 = &initial_states(&p)[0];
@@ -870,7 +870,7 @@ mod tests {
 
     #[test]
     fn a_motion_inside_the_capture_radius_decays_to_its_equilibrium() {
-        // Over the thesis grid's stable equilibria (perfect balances and balls together):
+        // Over Tien (2011) grid's stable equilibria (perfect balances and balls together):
         // starts on the corners and axes of the capture box, integrated at tight
         // tolerances for 300 time units, must stay near and decay at the slowest rate.
         use crate::analysis::family::Family;
@@ -945,7 +945,7 @@ mod tests {
 
     #[test]
     fn capture_stops_rest_seeds_only() {
-        // On the thesis grid, seeds with and without the capture test give the same
+        // On Tien (2011) grid, seeds with and without the capture test give the same
         // guesses (both none, or the same series): the capture radius never ends a start
         // that the full seed search would have turned into a periodic guess.
         use crate::analysis::family::Family;

@@ -10,7 +10,7 @@ use crate::model::assembly::Assembly;
 use crate::model::{Dynamics, Scene};
 use std::f64::consts::PI;
 
-/// The balanced state and its stability (seed 004's "stable balanced region"): the
+/// The balanced state and its stability (Rezaee et al.'s (2017) "stable balanced region"): the
 /// equilibrium that continues the planar balancer's perfect balance (`x = y = 0`,
 /// balls cancelling the unbalance) to this scene. Springs whose rest spacing differs
 /// from the balancing positions shift it to a nearly balanced state with a residual

@@ -1,5 +1,5 @@
 //! Basins of attraction: where starts from given ball angles (at rest in the ground
-//! frame, the thesis' set-up of its figures 4-15 and 4-16) settle, each simulated for
+//! frame, Tien's (2011) set-up of its figures 4-15 and 4-16) settle, each simulated for
 //! `t_end` time units and labelled by the motion seen over the last `window`.
 //!
 //! The labels, for two balls: the perfect balance (rest with `x = y = 0`), another
@@ -11,7 +11,7 @@
 //! window, or whose oscillation still grows; `failed` an integration that failed.
 //!
 //! The periods come from whole-turn crossings of a rotating ball (one to
-//! [`MAX_TURNS`] turns per period: the thesis' balls rotating separately take two)
+//! [`MAX_TURNS`] turns per period: Tien's (2011) balls rotating separately take two)
 //! and from mean crossings of `x` otherwise ([`super::attractors`]' detector); a motion
 //! without a regular period (a torus: two separated balls whose gap is modulated) keeps
 //! its label and has no period. A start that is not settled after `t_end` (see
@@ -31,7 +31,7 @@ use std::f64::consts::PI;
 /// How a start is simulated and judged.
 #[derive(Debug, Clone)]
 pub struct BasinOptions {
-    /// Time simulated (the thesis: 1000).
+    /// Time simulated (Tien (2011): 1000).
     pub t_end: f64,
     /// The last part of `[0, t_end]` the motion is judged on; it must hold at least one
     /// turn of a rotating ball per half.
@@ -73,7 +73,7 @@ impl Default for BasinOptions {
     }
 }
 
-/// Largest `extend_factor`: a start that has not settled in 64 times the thesis' 1000
+/// Largest `extend_factor`: a start that has not settled in 64 times Tien's (2011) 1000
 /// time units is a torus or chaos, not a slow transient.
 pub const MAX_EXTEND_FACTOR: f64 = 64.0;
 
@@ -169,7 +169,7 @@ impl Outcome {
     /// `not_settled` label, or a moving class (rotating or oscillating) whose period
     /// does not repeat strictly (see [`STRICT_PERIOD_TOL`]). A torus is extended too,
     /// up to the longest time: the torus test (steady mean rates and gap) is no proof,
-    /// on the thesis' Omega 1.2 grid it passes separated rotations still converging to
+    /// on Tien's (2011) Omega 1.2 grid it passes separated rotations still converging to
     /// their two-turn orbit after 800 time units.
     pub fn needs_more(&self) -> bool {
         match self.label {
@@ -194,7 +194,7 @@ impl Outcome {
     }
 }
 
-/// The thesis' start: at rest in the ground frame (`x = y = x' = y' = 0`,
+/// Tien's (2011) start: at rest in the ground frame (`x = y = x' = y' = 0`,
 /// `b_i' = -Omega`) with ball angles `balls`.
 pub fn ground_rest_start<D: Dynamics + ?Sized>(model: &D, balls: &[f64]) -> Vec<f64> {
     let d = model.ndof();
@@ -491,7 +491,7 @@ impl EarlyStop {
                 0
             };
             // What looks like a torus may be an orbit of several turns per period
-            // still converging (the thesis' separated rotations at Omega 1.2): stop
+            // still converging (Tien's (2011) separated rotations at Omega 1.2): stop
             // only once its period repeats; a torus runs on to `t_end`.
             if self.torus_runs >= TORUS_RUNS && whole.period_strict && torus_is_clear(long, o, opts)
             {
@@ -615,7 +615,7 @@ fn rest_is_clear(win: Window<'_>, d: usize, t_end: f64, opts: &BasinOptions) -> 
 /// The torus test of [`EarlyStop`], over a whole final window: two balls rotating apart (their gap modulated, no
 /// periodic orbit to converge to) for `TORUS_RUNS` checkpoints, with steady mean rates
 /// (the halves of the window agree to `TORUS_RATE`, where the final judgement allows
-/// 10 %; a torus modulates them by 3 to 6 % at the thesis' Omega 1.2), a gap beyond `1.2 merge_tol` in the second half whose largest value has stopped
+/// 10 %; a torus modulates them by 3 to 6 % at Tien's (2011) Omega 1.2), a gap beyond `1.2 merge_tol` in the second half whose largest value has stopped
 /// growing (the halves agree to `TORUS_GAP`: the torus has settled, so its mean rates
 /// are those of later windows), and an undiminished
 /// vibration (a rotation dying out on its way to rest takes `|x + i y|` down).
@@ -646,7 +646,7 @@ fn torus_is_clear(win: Window<'_>, o: usize, opts: &BasinOptions) -> bool {
     g2 > 1.2 * opts.merge_tol && (g2 - g1).abs() < TORUS_GAP * g2 && z2 > 0.95 * z1
 }
 
-/// Most whole turns of a rotating ball per period looked for (the thesis' separated
+/// Most whole turns of a rotating ball per period looked for (Tien's (2011) separated
 /// rotations take two).
 const MAX_TURNS: usize = 4;
 /// Relative agreement of the durations of one period with the next that calls a
@@ -1056,16 +1056,16 @@ mod tests {
     use crate::equilibria::{equilibria, EquilibriumKind};
     use crate::Planar;
 
-    fn thesis(omega: f64) -> Planar {
+    fn standard(omega: f64) -> Planar {
         Planar::new(0.2, 0.05, &[0.05], 50.0, omega, &[0.7, 0.7]).unwrap()
     }
 
     #[test]
-    fn labels_of_the_thesis_bistable_case() {
+    fn labels_of_the_standard_bistable_case() {
         // Omega 1.35 (figure 4-16): balls started close together stay merged on the
         // R-R orbit; far apart they settle on the perfect balance, which
         // equilibria() calls stable there.
-        let p = thesis(1.35);
+        let p = standard(1.35);
         let pb = equilibria(&p)
             .into_iter()
             .find(|e| e.kind == EquilibriumKind::PerfectBalance)
@@ -1086,7 +1086,7 @@ mod tests {
         // Omega 1.2 (figure 4-15): balls started apart rotate separately, with turns
         // that alternate between two durations (about 21.9 and 32.1 time units, measured
         // from a simulation at rtol 1e-10): a period of two turns, windings (-2, -2).
-        let p = thesis(1.2);
+        let p = standard(1.2);
         let o = BasinOptions::default();
         // the first start of the default 12 x 12 grid
         let start = ground_rest_start(&p, &[PI / 24.0, PI / 8.0]);
@@ -1119,7 +1119,7 @@ mod tests {
 
     #[test]
     fn a_cancelled_grid_stops() {
-        let p = thesis(1.2);
+        let p = standard(1.2);
         let tok = cancel::Token::new();
         tok.cancel();
         let starts = vec![vec![0.3, 0.5]; 4];
@@ -1131,7 +1131,7 @@ mod tests {
 
     #[test]
     fn options_are_checked_by_name() {
-        let p = thesis(1.2);
+        let p = standard(1.2);
         let o = BasinOptions {
             window: 2000.0,
             ..Default::default()

@@ -1,5 +1,5 @@
 //! Starts built from the pattern instead of simulated: where no simulated start reaches
-//! an orbit of the pattern (its basin misses every start at rest, as for the thesis'
+//! an orbit of the pattern (its basin misses every start at rest, as for Tien's (2011)
 //! R-O orbit of table 4-7, reached by about one random start in sixty), Newton is
 //! started from the orbit's skeleton: each rotating ball turning uniformly at a trial
 //! rate `omega`, each oscillating ball at rest at a trial angle, the support at rest.
@@ -48,7 +48,7 @@ pub fn periodic_discover<D: Parametric>(
 }
 
 /// Trial rates of the rotating balls relative to the disk, as fractions of the spin
-/// rate: the R-R and R-O orbits of the thesis' maps turn at 0.2 to 0.5 of it.
+/// rate: the R-R and R-O orbits of Tien's (2011) maps turn at 0.2 to 0.5 of it.
 const RATE_FRACTIONS: [f64; 5] = [0.12, 0.23, 0.35, 0.5, 0.7];
 /// Trial angles of the oscillating balls (and phase offsets of rotating ones).
 const ANGLES: usize = 8;
@@ -166,7 +166,7 @@ mod tests {
 
     #[test]
     fn finds_the_r_o_orbit_that_no_simulated_start_reaches() {
-        // The thesis' table 4-7 R-O point: every start at rest goes to the perfect
+        // Tien's (2011) table 4-7 R-O point: every start at rest goes to the perfect
         // balance, yet a stable R-O orbit exists (random starts with a knocked support
         // reach it, with a ball rate of 0.304 measured over 500 time units).
         let p = Planar::new(0.2, 0.02, &[0.1], 50.0, 1.3, &[0.7, 0.7]).unwrap();

@@ -92,7 +92,7 @@ pub struct Equilibrium {
     pub residual: f64,
     /// Eigenvalues of the `2(n+2)` first-order Jacobian, largest real part first.
     pub eigenvalues: Vec<(f64, f64)>,
-    /// Relative-stability index of seed 001: the largest real part (of the
+    /// Relative-stability index of [TwoBallStrength]: the largest real part (of the
     /// non-neutral eigenvalues for a perfect-balance family, n >= 3).
     pub index: f64,
     pub verdict: Verdict,

@@ -1,5 +1,5 @@
 //! Trajectories of a rigid rotor on one journal bearing, in the fixed frame, without balls
-//! (bearing.md sections 3 and 4: the seed's scenarios and the classical checks).
+//! (bearing.md sections 3 and 4: Yen's (2005) scenarios and the classical checks).
 //!
 //! # Equations
 //!
@@ -16,12 +16,12 @@
 //!   (the same `m` as [`crate::model::bearing::rigid_rotor_stability`]'s critical mass);
 //!   it grows like `w`, so at fixed geometry a speed sweep is a sweep of `m` and of `g_n`;
 //! * `g_n = W / (M c w^2) = g / (c w^2)` the gravity load along `e_g` (angle
-//!   `gravity_direction`; the seed's `x` points down, angle 0). The static load on the film
+//!   `gravity_direction`; Yen's (2005) `x` points down, angle 0). The static load on the film
 //!   is `m g_n = W / F_S`, so the Sommerfeld number is `S = 1 / (pi m g_n)`;
 //! * `rho_u = e_u / c` the mass unbalance (force `M e_u w^2` turning with the journal): a
 //!   rotating load of `rho_u / g_n` times the weight;
-//! * the seed's impulse `F = a W exp(-s (tau - tau_c)^2)` along `e_i` (`a` over the weight,
-//!   so it needs gravity; the seed's is `a = 5`, `s = 2`, `tau_c = 3` at 500 rad/s).
+//! * Yen's (2005) impulse `F = a W exp(-s (tau - tau_c)^2)` along `e_i` (`a` over the weight,
+//!   so it needs gravity; Yen's (2005) is `a = 5`, `s = 2`, `tau_c = 3` at 500 rad/s).
 //!
 //! Dimensional conversion ([`RotorOnBearing::from_dimensions`]): with radius `R`, length
 //! `L`, clearance `c`, viscosity `mu`, rotor mass `M` (carried by this bearing), speed `w`,
@@ -43,7 +43,7 @@ use crate::model::bearing::{Bearing, Dimensions, FilmSolver, JournalState};
 use crate::numerics::ode::{check_times, Dopri5, Options, Stats};
 use crate::numerics::rosenbrock::Rosenbrock23;
 
-/// The seed's impulse: `amplitude` times the weight, `exp(-sharpness (tau - center)^2)`,
+/// Yen's (2005) impulse: `amplitude` times the weight, `exp(-sharpness (tau - center)^2)`,
 /// along `direction` (radians in the fixed frame).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Impulse {
@@ -61,7 +61,7 @@ pub struct RotorOnBearing {
     pub mass: f64,
     /// `g_n = W / (M c w^2)`.
     pub gravity: f64,
-    /// Direction of gravity in the fixed frame (radians; 0 = the seed's `x`, down).
+    /// Direction of gravity in the fixed frame (radians; 0 = Yen's (2005) `x`, down).
     pub gravity_direction: f64,
     /// `rho_u = e_u / c`.
     pub unbalance: f64,

@@ -225,7 +225,7 @@ impl AutoHarmonics {
 }
 
 /// Default of [`PeriodicOptions::max_closure`]. Measured (the ignored test
-/// `measure_certificates`, and the thesis maps of tests/test_scan.py): the genuine orbits'
+/// `measure_certificates`, and the Tien (2011) maps of tests/test_scan.py): the genuine orbits'
 /// integrated defect at N = 3 is at most 4.9 at zeta 0.05 (Omega 1.0, eta 0.6, omega
 /// 0.03-0.04, simulated closure 0.14-0.25; typically 1e-5 to 1e-1), 10 to 50 times their
 /// simulated closure since the damping forgets old errors; strongly unstable O-O and R-R
@@ -538,7 +538,7 @@ pub fn periodic_searched<D: Parametric>(
 /// the resonance a single ball's rotating motion (its ground-frame rate locked just
 /// below the natural frequency, the disk whirling with it at resonant amplitude) is
 /// stable but reached from rest only from a sliver of ball angles (none of the 16 at
-/// the thesis' rig with `eta = 1.85`, `Omega` 1.5 to 1.7, or `eta = 0.99`, `Omega` 1.35).
+/// Tien's (2011) rig with `eta = 1.85`, `Omega` 1.5 to 1.7, or `eta = 0.99`, `Omega` 1.35).
 /// Each start puts the ball at angle `beta` turning at ground rate `s` (1 and 0.95,
 /// four angles) and the disk on the linear response to the ball and the imbalance,
 /// `Z = mu eta s^2 e^(i beta) / (1 - s^2 + 2 i zeta s) + mu Omega^2 / (1 - Omega^2 + 2 i
@@ -584,7 +584,7 @@ pub fn whirl_starts<D: Parametric>(p: &D) -> Vec<Vec<f64>> {
 }
 
 /// Simulation starts for a pattern in which some balls rotate and others do not, built
-/// as [`whirl_starts`] builds them for one ball: the stable R-O orbits of the thesis'
+/// as [`whirl_starts`] builds them for one ball: the stable R-O orbits of Tien's (2011)
 /// maps have the rotating ball turning in the ground frame just below the natural
 /// frequency (omega close to `Omega - 1`) with the disk whirling at resonant amplitude
 /// (|Z| about 6 at `zeta 0.02`), and no start at rest reaches them (of 36 such starts at
@@ -627,7 +627,7 @@ pub fn pattern_whirl_starts<D: Parametric>(p: &D, rotating: &[bool]) -> Vec<Vec<
     let n_rot = rotating.iter().filter(|r| **r).count();
     let s = 1.0;
     // The resting balls a quarter turn ahead: a quarter turn behind found no stable R-O
-    // that ahead missed on the nine thesis maps, the map and the census' point,
+    // that ahead missed on the nine Tien (2011) maps, the map and the census' point,
     // at twice the starts' cost.
     const AHEAD: f64 = PI / 2.0;
     let mut out = vec![];
@@ -878,7 +878,7 @@ fn finish_inner<D: Dynamics + ?Sized>(
 }
 
 /// Most harmonics [`bound_verdict`] raises a series to before its verdict is left
-/// undetermined. At the thesis' hardest verdict (`mu 0.25, zeta 0.08, zeta_b 0.02,
+/// undetermined. At Tien's (2011) hardest verdict (`mu 0.25, zeta 0.08, zeta_b 0.02,
 /// delta 20, Omega 1.3584277344`, leading modulus 1.0000036) the modulus is off by 2.4e-5
 /// at N = 3, 3.3e-6 at 4, 4e-8 at 5 and 5e-10 at 6: a verdict that N = 27 cannot settle
 /// sits within round-off of 1.
@@ -886,7 +886,7 @@ pub const BOUND_N_MAX: usize = 27;
 
 /// The harmonics of the series a verdict at `n` harmonics is checked against: half as
 /// many again, at least two more (the modulus' error then falls by one to three orders
-/// of magnitude on the thesis orbits).
+/// of magnitude on Tien (2011) orbits).
 pub fn finer_harmonics(n: usize) -> usize {
     n + n.div_ceil(2).max(2)
 }
@@ -1165,7 +1165,7 @@ pub fn no_guess_wound<D: Dynamics + ?Sized>(
     )
 }
 
-/// The thesis' "NI" check: simulate from the solution's state for one period and return
+/// Tien's (2011) "NI" check: simulate from the solution's state for one period and return
 /// the max-norm distance to where the orbit says it should be (angles advanced by whole
 /// turns).
 pub fn closure_error<D: Dynamics + ?Sized>(
@@ -1290,111 +1290,6 @@ mod tests {
         assert_eq!(outside.floquet.unwrap().max_modulus, f.max_modulus);
     }
 
-    /// Measurement, not a check: `cargo test --release -p ballbal-core measure_certificates
-    /// -- --ignored --nocapture` prints the integrated defect against the simulated
-    /// closure on the reproduction and on the thesis grid.
-    #[test]
-    #[ignore]
-    fn measure_certificates() {
-        let fo = FloquetOptions::default();
-        let b = |om: f64| Planar::new(0.2, 0.05, &[0.1], 50.0, om, &[1.0, 1.0]).unwrap();
-        for n in [8, 3] {
-            let opts = PeriodicOptions {
-                hb: HbOptions {
-                    n_harm: n,
-                    ..Default::default()
-                },
-                floquet: Some(fo.clone()),
-                max_closure: f64::INFINITY,
-                max_tail: f64::INFINITY,
-                ..Default::default()
-            };
-            let mut prev = periodic(&b(1.0), &[true, true], None, &opts);
-            let mut w = 1.0;
-            while w > 0.615 {
-                let p = b(w);
-                let r = periodic(&p, &[true, true], Some(&prev.sol), &opts);
-                if r.sol.status != Status::Converged {
-                    println!("N={n} W={w:.3} {:?}", r.sol.status);
-                    break;
-                }
-                let sim = closure_error(&p, &r.sol, 1e-10, 1e-12).unwrap_or(f64::NAN);
-                let f = r.floquet.as_ref();
-                println!(
-                    "N={n} W={w:.3} omega={:.3e} defect={:.2e} sim={:.2e} tail={:.2e} triv={:.2e} sep={:?} maxmod={:.2e}",
-                    r.sol.omega,
-                    r.closure.unwrap(),
-                    sim,
-                    r.sol.tail_ratio(),
-                    f.map_or(f64::NAN, |f| f.trivial_error),
-                    f.and_then(|f| f.separation_error),
-                    f.map_or(f64::NAN, |f| f.max_modulus)
-                );
-                prev = r;
-                w -= 0.02;
-            }
-        }
-        // The thesis grid at N = 3 with the scan's options, certificates off.
-        use crate::scan::{scan, scan_floquet_default, ScanSpec};
-        let base = Planar::new(0.2, 0.05, &[0.1], 50.0, 1.2, &[1.0, 1.0]).unwrap();
-        let om: Vec<f64> = (0..=10).map(|i| 1.0 + 0.1 * i as f64).collect();
-        let eta: Vec<f64> = (0..=11).map(|i| 0.4 + 0.1 * i as f64).collect();
-        let spec = ScanSpec {
-            base: &base,
-            names: vec!["Omega".into(), "eta".into()],
-            values: vec![om.clone(), eta.clone()],
-            patterns: [[true, true], [false, false], [true, false]]
-                .iter()
-                .map(|r| plain_windings(r))
-                .collect(),
-            opts: PeriodicOptions {
-                floquet: Some(scan_floquet_default()),
-                guess: GuessOptions {
-                    settle: 1000.0,
-                    window: 2000.0,
-                    rtol: 1e-5,
-                    atol: 1e-8,
-                },
-                max_closure: f64::INFINITY,
-                ..Default::default()
-            },
-            seeds: 4,
-            starts: 4,
-            chunk: 12,
-            block: 12,
-            threads: 2,
-            max_tail: 0.25,
-        };
-        let rows = scan(&spec).unwrap();
-        let mut worst_defect = 0.0f64;
-        for r in rows.iter().filter(|r| r.result.is_some()) {
-            let res = r.result.as_ref().unwrap();
-            let p = base
-                .with_param("Omega", om[r.index[0]])
-                .unwrap()
-                .with_param("eta", eta[r.index[1]])
-                .unwrap();
-            let sim = closure_error(&p, &res.sol, 1e-10, 1e-12).unwrap_or(f64::NAN);
-            let f = res.floquet.as_ref();
-            worst_defect = worst_defect.max(res.closure.unwrap());
-            println!(
-                "grid Om={:.2} eta={:.2} type={} omega={:.3e} defect={:.2e} sim={:.2e} tail={:.2e} triv={:.2e} sep={:?} maxmod={:.2e} {}",
-                om[r.index[0]],
-                eta[r.index[1]],
-                r.pattern,
-                res.sol.omega,
-                res.closure.unwrap(),
-                sim,
-                res.sol.tail_ratio(),
-                f.map_or(f64::NAN, |f| f.trivial_error),
-                f.and_then(|f| f.separation_error),
-                f.map_or(f64::NAN, |f| f.max_modulus),
-                f.map_or("-", |f| f.stability.as_str()),
-            );
-        }
-        println!("grid worst defect {worst_defect:.3e}");
-    }
-
     #[test]
     fn solution_types_carry_windings_in_brackets() {
         assert_eq!(parse_solution_type("R-O", 2).unwrap(), vec![-1.0, 0.0]);
@@ -1444,7 +1339,7 @@ mod tests {
         }
     }
 
-    fn thesis(om: f64, eta: f64) -> Planar {
+    fn standard(om: f64, eta: f64) -> Planar {
         Planar::new(0.2, 0.05, &[0.05], 50.0, om, &[eta, eta]).unwrap()
     }
 
@@ -1503,7 +1398,7 @@ mod tests {
         assert_ne!(rr.status, Status::Equilibrium);
     }
 
-    /// The thesis' heaviest single ball (eta 1.85) at Omega 1.6: its rotating motion is
+    /// Tien's (2011) heaviest single ball (eta 1.85) at Omega 1.6: its rotating motion is
     /// stable, but no start at rest in the ground frame reaches it; a start whirling
     /// with the support does. Two balls get no such starts.
     #[test]
@@ -1525,7 +1420,7 @@ mod tests {
         let ground = 1.6 - r.sol.omega;
         assert!(ground > 0.9 && ground < 1.0, "{ground}");
         assert_eq!(whirl_starts(&p).len(), 8);
-        assert!(whirl_starts(&thesis(1.6, 1.0)).is_empty());
+        assert!(whirl_starts(&standard(1.6, 1.0)).is_empty());
     }
 
     /// The reproduction: R-R continued at N = 8 from Omega 1 into the branch's
@@ -1710,8 +1605,8 @@ mod tests {
     }
 
     #[test]
-    fn thesis_rr_standard_case() {
-        let p = thesis(1.2, 1.0);
+    fn rr_standard_case() {
+        let p = standard(1.2, 1.0);
         let opts = PeriodicOptions {
             hb: HbOptions {
                 n_harm: 8,
@@ -1739,3 +1634,6 @@ mod tests {
         assert!(closure < 1e-5, "closure {closure}");
     }
 }
+
+#[cfg(all(test, feature = "studies"))]
+mod studies;

@@ -31,7 +31,7 @@ use crate::continuation::curves::{join_halves, Extended, TwoParameter};
 use crate::continuation::event::Event;
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
-use crate::model::seed003::Seed003;
+use crate::model::disk_units::DiskUnits;
 use crate::model::{Dynamics, Planar};
 use crate::numerics::problem::{Parametric, Problem};
 use nalgebra::DMatrix;
@@ -77,7 +77,7 @@ impl<'a, D: Dynamics + Clone> EqSystem<'a, D> {
     }
 
     /// A family given by its builder (e.g. another nondimensionalisation's parameters,
-    /// as [`EqSystem::seed003`]).
+    /// as [`EqSystem::disk_units`]).
     pub fn new(make: Maker<'a, D>, d: usize, o: usize, p0: f64) -> Self {
         EqSystem {
             make,
@@ -275,11 +275,11 @@ impl<'a, D: Dynamics + Clone> EqSystem<'a, D> {
 }
 
 impl EqSystem<'static, Planar> {
-    /// The family of seed 003's balancer `base` in its own parameters `names` (one or
-    /// two of [`crate::model::seed003::SEED003_PARAMS`]): the planar model is rebuilt from the seed's values at
+    /// The family of the balancer `base` in the disk's units, in its parameters `names` (one
+    /// or two of [`crate::model::disk_units::DISK_UNITS_PARAMS`]): the planar model is rebuilt from those values at
     /// every point, so that `m0` moves `mu`, `eta`, `Omega`, `zeta` and `zeta_b` together.
     /// Unknowns and coordinates stay the model's.
-    pub fn seed003(base: Seed003, names: &[&str]) -> Result<Self> {
+    pub fn disk_units(base: DiskUnits, names: &[&str]) -> Result<Self> {
         if names.is_empty() || names.len() > 2 {
             return Err(Error::param("parameter", "one or two parameters"));
         }

@@ -180,7 +180,7 @@ pub fn fd_add_jacobians<F>(
 }
 
 /// The spin profile: constant `Omega`, or a linear change to `to` over `duration` from
-/// `start` (a run-up, or seed 001's speed disturbance). It hands `Omega(t)`,
+/// `start` (a run-up, or [TwoBallStrength]'s speed disturbance). It hands `Omega(t)`,
 /// `Omega'(t)` and `theta(t)` (with `theta(0) = 0`) to the other components.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Drive {

@@ -10,19 +10,19 @@ pub mod assembly;
 pub mod bearing;
 pub mod component;
 pub mod components;
+pub mod disk_units;
 mod dynamics;
 pub mod layout;
 pub mod params;
 pub mod planar;
 pub mod scene;
-pub mod seed003;
 #[rustfmt::skip]
 pub mod tilt_terms;
 
 pub use component::{Component, Composed, Ctx, Drive, Spin};
+pub use disk_units::DiskUnits;
 pub use dynamics::{first_order_rhs, Dynamics};
 pub use layout::Layout;
 pub use params::{ParamId, ParamRef};
 pub use planar::Planar;
 pub use scene::{Scene, SpringLayout};
-pub use seed003::Seed003;

@@ -17,7 +17,7 @@
 //! and rest spacing `2 pi / n`: potential
 //! `V = kappa delta^2 / 2 sum_j (b_{j+1} - b_j - 2 pi / n)^2` with `kappa = k_d / k`, and
 //! ball row i gains `dV/db_i / m_i`. In a ring (the default) `j` runs over all `n`
-//! neighbours, ball n to ball 1 closing it with spacing `b_1 + 2 pi - b_n`; seed 004's
+//! neighbours, ball n to ball 1 closing it with spacing `b_1 + 2 pi - b_n`; Rezaee et al.'s (2017)
 //! chain (its eq. 16) has the `n - 1` springs from ball 1 to ball n only. For two balls
 //! the ring's two springs are the chain's one at twice the stiffness.
 //!
@@ -25,10 +25,10 @@
 //! `(cos th F_X + sin th F_Y, -sin th F_X + cos th F_Y)`. Gravity (spin axis
 //! horizontal, `g` over `e w_n^2`) pulls every mass along `-Y`: the support rows gain
 //! `g sin th` and `g cos th`, ball row i gains `g cos(th + b_i)`. An impulsive load on the
-//! rotor (seed 002's form) `F(t) = A exp(-s (t - t0)^2)` along the ground direction at
+//! rotor (Yen's (2005) form) `F(t) = A exp(-s (t - t0)^2)` along the ground direction at
 //! angle `psi` enters the support rows only.
 //!
-//! Tilting disk on a flexible shaft (seed 004): coordinates `(x, y, A, B, b_1..b_n)`,
+//! Tilting disk on a flexible shaft (Rezaee et al. 2017): coordinates `(x, y, A, B, b_1..b_n)`,
 //! where `A, B` are the disk's Euler tilts scaled by `delta` (the rim's axial
 //! displacement over `e`). The rotor and ball terms, including spin ramp and gravity,
 //! come from `scripts/derive_tilt.py`, which derives them from the Lagrangian and
@@ -62,7 +62,7 @@ use std::sync::Arc;
 
 pub use crate::model::components::{Impulse, SpringLayout};
 
-/// A disk that tilts on a flexible shaft, with gyroscopic coupling (seed 004).
+/// A disk that tilts on a flexible shaft, with gyroscopic coupling (Rezaee et al. 2017).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tilt {
     /// Distance of the disk from the first bearing, over the track radius.
@@ -111,7 +111,7 @@ impl Tilt {
 }
 
 /// A change of spin speed from the scene's `Omega` to `to`, linear over `duration`
-/// starting at `start` (a run-up, or seed 001's speed disturbance).
+/// starting at `start` (a run-up, or [TwoBallStrength]'s speed disturbance).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ramp {
     pub to: f64,

@@ -17,8 +17,8 @@ use faer::linalg::triangular_solve::{
 use faer::prelude::{Reborrow, ReborrowMut};
 use faer::{Accum, Mat, Par};
 
-/// Systems with at least this many rows are factorised panel by panel (faer's LU of a
-/// 1024-row matrix takes about 50 ms here, the longest Ctrl-C then waits).
+/// Systems with at least this many rows are factorised panel by panel: faer's one-call LU
+/// of a smaller one is short enough for Ctrl-C to wait for it (docs/measurements.md).
 pub const BLOCKED_MIN_ROWS: usize = 1024;
 
 /// Columns per panel: wide enough that the trailing update is a real matrix product,
@@ -37,10 +37,10 @@ pub struct BlockedLu {
 
 /// The column-major copy of the row-major `n x n` matrix `a`, filled [`PANEL`] columns
 /// at a time with a cancellation poll before each, or `None` once cancellation was asked
-/// for. The copy of a 6157-row harmonic-balance Jacobian (10 balls at N = 256, 300 MB)
-/// took 2-3 s in one `Mat::from_fn` on a loaded machine, most of it the first touch of
-/// fresh pages, and Ctrl-C waited for it (lags up to 2.3 s measured). The same values in
-/// a matrix of the same shape (so the same layout) as `Mat::from_fn` makes.
+/// for: in one `Mat::from_fn` the copy of a large harmonic-balance Jacobian takes seconds,
+/// most of it the first touch of fresh pages, and Ctrl-C waited for all of it
+/// (docs/measurements.md). The same values in a matrix of the same shape (so the same
+/// layout) as `Mat::from_fn` makes.
 pub fn column_major_copy(a: &[f64], n: usize) -> Option<Mat<f64>> {
     let mut m = Mat::<f64>::with_capacity(n, n);
     for j in (0..n).step_by(PANEL) {
@@ -106,9 +106,9 @@ impl BlockedLu {
                 let mut u12 = top.subrows_mut(k, b);
                 let panel = left.rb().submatrix(k, k, m, b);
                 solve_unit_lower_triangular_in_place(panel.subrows(0, b), u12.rb_mut(), Par::Seq);
-                // The trailing update is most of a panel's work (0.4 s for the first
-                // panel of a 4105-row system on a loaded machine): in column slices,
-                // each preceded by a poll.
+                // The trailing update is most of a panel's work (a large fraction of a
+                // second on big systems, docs/measurements.md): in column slices, each
+                // preceded by a poll.
                 let mut bottom = bottom;
                 let cols = bottom.ncols();
                 for j in (0..cols).step_by(UPDATE_COLS) {
@@ -150,7 +150,7 @@ mod tests {
     use super::*;
 
     /// A reproducible, well-mixed test matrix that needs pivoting: small diagonal.
-    fn matrix(n: usize) -> Mat<f64> {
+    pub(super) fn matrix(n: usize) -> Mat<f64> {
         let mut s = 0x2545_f491_4f6c_dd1du64;
         Mat::from_fn(n, n, |i, j| {
             s ^= s << 13;
@@ -239,54 +239,7 @@ mod tests {
         let out = crate::cancel::with(Some(tok), || BlockedLu::factor(matrix(300)));
         assert!(out.is_none());
     }
-
-    /// How long Ctrl-C can wait during `lu_factor` of harmonic-balance-sized systems (the
-    /// copy into column-major order included): the call's time and the longest stretch
-    /// between two cancellation polls. `BLU_N=4105,6157 cargo test --release -p
-    /// ballbal-core lu_cancel_latency -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn lu_cancel_latency() {
-        let sizes: Vec<usize> = std::env::var("BLU_N").map_or(vec![4105, 6157], |v| {
-            v.split(',').map(|x| x.parse().unwrap()).collect()
-        });
-        for n in sizes {
-            let m = matrix(n);
-            let a: Vec<f64> = (0..n * n).map(|k| m[(k / n, k % n)]).collect();
-            drop(m);
-            let (ok, total, longest) = crate::cancel::gaps::longest(|| {
-                crate::numerics::linalg::lu_factor(&a, n).is_some()
-            });
-            assert!(ok);
-            println!("n {n}: lu_factor {total:.3} s, longest between polls {longest:.3} s");
-        }
-    }
-
-    /// Wall time against faer's one-call LU at harmonic-balance sizes:
-    /// `cargo test --release -p ballbal-core blocked_lu_timing -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn blocked_lu_timing() {
-        // BLU_N / BLU_ONLY (blocked | faer): one size, one method (for callgrind).
-        let sizes: Vec<usize> =
-            std::env::var("BLU_N").map_or(vec![1024, 2048, 4105], |v| vec![v.parse().unwrap()]);
-        let only = std::env::var("BLU_ONLY").unwrap_or_default();
-        for n in sizes {
-            let a = matrix(n);
-            let t = std::time::Instant::now();
-            if only != "faer" {
-                let _ = BlockedLu::factor(a.clone()).unwrap();
-            }
-            let blocked = t.elapsed().as_secs_f64();
-            let t = std::time::Instant::now();
-            if only != "blocked" {
-                let _ = a.partial_piv_lu();
-            }
-            let faer = t.elapsed().as_secs_f64();
-            println!(
-                "n {n}: blocked {blocked:.3} s, faer {faer:.3} s, ratio {:.2}",
-                blocked / faer
-            );
-        }
-    }
 }
+
+#[cfg(all(test, feature = "studies"))]
+mod studies;

@@ -17,7 +17,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 /// Relative size of the harmonics below which a series without winding is an
-/// equilibrium ([`Status::Equilibrium`]). On the nine thesis maps at N = 3 the series
+/// equilibrium ([`Status::Equilibrium`]). On the nine Tien (2011) maps at N = 3 the series
 /// Newton converged on in O-O scans had harmonics either between 0.1 and 10 (orbits) or of
 /// 1e-16 to 1e-15 (equilibria, with pivot ratios of 1e8 to 3e10 because `omega` is
 /// free); 1e-9 sits between with six decades to spare on either side.
@@ -104,13 +104,12 @@ impl Basis {
 /// The products and trigonometric functions in the equations reach beyond harmonic `N`,
 /// and what lies beyond `S - N` aliases onto the retained harmonics. Four samples per
 /// harmonic project products of three series exactly (`S > 4N`); the twenty more cover
-/// the tails of the trigonometric terms. Measured at N = 8 against 144 samples (where
-/// aliasing is at round-off), 2026-11-24: the nine thesis maps' 933 solutions with the
-/// same verdicts, none lost or gained, omega within 6e-11 (`8 (N + 1) = 72` samples:
-/// 5e-15), multipliers within 6e-9 of the 72-sample ones; the period-106 orbit's
-/// coefficients within 3e-16. Up to N = 3 the count is unchanged (scans at N = 3 keep
-/// every result); above it the samples, and with them the residual, the Jacobian's
-/// sampling and the certificate, grow half as fast with N.
+/// the tails of the trigonometric terms: against a count where aliasing is at round-off,
+/// the maps' solutions keep their verdicts, and omega and the multipliers move far less
+/// than their truncation errors (docs/measurements.md, "Default samples per period").
+/// Up to N = 3 the count is unchanged (scans at N = 3 keep every result); above it the
+/// samples, and with them the residual, the Jacobian's sampling and the certificate,
+/// grow half as fast with N.
 pub fn default_samples(n_harm: usize) -> usize {
     (8 * (n_harm + 1)).min(4 * (n_harm + 5)).max(16)
 }
@@ -431,7 +430,7 @@ impl HbSolution {
 /// coexisting O-O orbit a Newton run from a simulated seed reaches on the zeta 0.02
 /// maps) changed on such round-off in an earlier attempt. This is a deliberate switch on
 /// N, not a hidden one: N <= 3 gives the results saved before it, N >= 4 moves at
-/// round-off (omega 2e-16, multipliers 4e-13 relative on the thesis N = 8 scans).
+/// round-off (omega 2e-16, multipliers 4e-13 relative on Tien (2011) N = 8 scans).
 /// From N = 4 on the product-to-sum path is the cheaper one: at N = 8 the projection
 /// and its omega column fell from about 8 M to 1.2 M instructions per warm solve.
 pub const DIRECT_PROJECTION_MAX_HARM: usize = 3;
@@ -1778,7 +1777,7 @@ mod tests {
 
     /// The default sample count keeps aliasing below round-off of the results: solved
     /// again with three times the samples (the projections of the equations' products
-    /// then exact far beyond the retained harmonics), the thesis' standard orbit and
+    /// then exact far beyond the retained harmonics), Tien's (2011) standard orbit and
     /// its period-106 hard case at N = 6, 8 and 12 move by less than 1e-13 in omega and
     /// 1e-12 in any coefficient (measured: at most 6e-17 and 8e-15, round-off; their
     /// truncation errors are 1e-14 and 7e-8 in omega at N = 8; 36 samples at N = 8
@@ -1827,79 +1826,7 @@ mod tests {
             assert!((a - b).abs() < 1e-13);
         }
     }
-
-    /// Warm-started solves at N = 3, 6, 8, 12 for callgrind (`--ignored --exact
-    /// numerics::hb::tests::hb_profile`): 20 solves per N, all four N, or only the N in
-    /// `BALLBAL_HB_N`. Per solve: `warm_solve`'s inclusive count / 20 with
-    /// `BALLBAL_HB_N` set (the per-N copies of `warm_solve` compile to one function, so
-    /// callgrind cannot tell the N apart in a run of all four).
-    #[test]
-    #[ignore]
-    fn hb_profile() {
-        use crate::periodic::{periodic, PeriodicOptions};
-        let p = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &[1.0, 1.0]).unwrap();
-        let near = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.19, &[1.0, 1.0]).unwrap();
-        let seed = periodic(&near, &[true, true], None, &PeriodicOptions::default()).sol;
-        let opts = |n_harm| PeriodicOptions {
-            hb: HbOptions {
-                n_harm,
-                ..Default::default()
-            },
-            ..Default::default()
-        };
-        let seed12 = periodic(&near, &[true, true], Some(&seed), &opts(12)).sol;
-        let only: Option<usize> = std::env::var("BALLBAL_HB_N")
-            .ok()
-            .map(|v| v.parse().expect("BALLBAL_HB_N: a harmonic count"));
-        let ns: Vec<usize> = only.map_or(vec![3, 6, 8, 12], |n| vec![n]);
-        let mut acc = 0.0;
-        for _ in 0..20 {
-            for &n in &ns {
-                acc += warm_solve(&p, &seed12, &opts(n));
-            }
-        }
-        println!("{acc}");
-    }
-
-    /// How long Ctrl-C can wait during `periodic` with many balls at N = 256 (stability
-    /// included), from an N = 3 guess as in `tests/test_interrupts.py`: the call's time and
-    /// the longest stretch between two cancellation polls. `BALLBAL_HB_BALLS=6,10 cargo test
-    /// --release -p ballbal-core hb_cancel_latency -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn hb_cancel_latency() {
-        use crate::periodic::{periodic, PeriodicOptions};
-        let balls: Vec<usize> = std::env::var("BALLBAL_HB_BALLS").map_or(vec![6, 10], |v| {
-            v.split(',').map(|x| x.parse().unwrap()).collect()
-        });
-        let opts = |n_harm| PeriodicOptions {
-            hb: HbOptions {
-                n_harm,
-                ..Default::default()
-            },
-            ..Default::default()
-        };
-        for b in balls {
-            let p = crate::Planar::new(0.2, 0.05, &[0.05], 50.0, 1.2, &vec![0.3; b]).unwrap();
-            let pattern = vec![true; b];
-            let guess = periodic(&p, &pattern, None, &opts(3)).sol;
-            let (sol, total, longest) = crate::cancel::gaps::longest(|| {
-                periodic(&p, &pattern, Some(&guess), &opts(256)).sol
-            });
-            println!(
-                "{b} balls, N = 256 ({} unknowns): {total:.3} s, longest between polls \
-                 {longest:.3} s (omega {:.6})",
-                sol.coeffs.len() + 1,
-                sol.omega
-            );
-        }
-    }
-
-    /// One warm solve (certificates included): the frame callgrind reports.
-    #[inline(never)]
-    fn warm_solve(p: &crate::Planar, g: &HbSolution, o: &crate::periodic::PeriodicOptions) -> f64 {
-        crate::periodic::periodic(p, &[true, true], Some(g), o)
-            .sol
-            .omega
-    }
 }
+
+#[cfg(all(test, feature = "studies"))]
+mod studies;

@@ -112,11 +112,10 @@ impl Cholesky {
     const MAX_RHS: usize = 4;
 
     fn new(pattern: &SymbolicSparseColMat<usize>) -> Result<Self> {
-        // AMD with faer's automatic (here simplicial) choice. Measured with callgrind on the
-        // 256 x 16 half strip, per grooved force evaluation: AMD simplicial 14.5 M
-        // instructions, AMD supernodal 19.4 M, natural order supernodal 16.8 M, a column
-        // nested dissection supernodal 17.2 M / simplicial 37 M; wall clock agrees (the
-        // supernodes of a 16-wide strip are too small for the blocked kernels to pay).
+        // AMD with faer's automatic (here simplicial) choice: the cheapest of the orderings
+        // and factorisations tried on the half strip (callgrind and wall clock agree; the
+        // supernodes of a 16-wide strip are too small for the blocked kernels to pay;
+        // counts in docs/measurements.md).
         let symbolic = factorize_symbolic_cholesky(
             pattern.as_ref(),
             Side::Upper,
@@ -598,8 +597,8 @@ impl FiniteSolver {
     /// Fast path for a plain film: one periodic tridiagonal solve per odd sine mode. The
     /// same face films, conductances and right-hand side as [`Self::film`] and [`Self::rhs`],
     /// once per theta column since nothing depends on `zeta`. Not polled for cancellation:
-    /// `O(n_theta n_zeta^2)` work, 0.06 s at 2048 x 256 on a loaded machine, and a poll per
-    /// mode made this path several per cent slower (callgrind, 128 x 32).
+    /// `O(n_theta n_zeta^2)` work, short even on the largest grids, and a poll per mode
+    /// made this path several per cent slower (docs/measurements.md).
     fn solve_plain(&self, pb: &Problem) -> Vec<f64> {
         let (nt, nz) = (self.nt, self.nz);
         let (ctf, czf) = (self.dz / self.dth, self.dth / self.dz);
@@ -943,7 +942,7 @@ mod tests {
     use super::super::*;
     use crate::cancel::{with, Token};
 
-    fn herringbone() -> Grooves {
+    pub(super) fn herringbone() -> Grooves {
         Grooves {
             count: 8,
             angle: 30f64.to_radians(),
@@ -956,7 +955,7 @@ mod tests {
 
     /// An eccentric, moving journal: the state the cancellation tests and the latency
     /// report solve the film at.
-    fn moving_state() -> JournalState {
+    pub(super) fn moving_state() -> JournalState {
         JournalState {
             x: 0.4,
             y: -0.3,
@@ -1052,66 +1051,7 @@ mod tests {
         assert_eq!(out, Err(Error::Cancelled));
         assert_eq!(solves, 3);
     }
-
-    /// How long Ctrl-C can wait during one film-force call as `ballbal.bearing.film_force`
-    /// makes it (a new solver, one force): the call's time and the longest stretch between
-    /// two cancellation polls. `FILM_GRIDS=1024x128,2048x256 cargo test --release -p
-    /// ballbal-core film_cancel_latency -- --ignored --nocapture` (`FILM_CASES`: some of
-    /// the labels, comma-separated).
-    #[test]
-    #[ignore]
-    fn film_cancel_latency() {
-        let grids = std::env::var("FILM_GRIDS").unwrap_or("512x64,1024x128,2048x256".into());
-        let grooves = herringbone();
-        for g in grids.split(',') {
-            let (a, b) = g.split_once('x').expect("grid as NTxNZ");
-            let (n_theta, n_zeta): (usize, usize) = (a.parse().unwrap(), b.parse().unwrap());
-            let cases = [
-                ("plain finite", None, Cavitation::HalfSommerfeld, false),
-                (
-                    "grooved finite",
-                    Some(grooves),
-                    Cavitation::HalfSommerfeld,
-                    false,
-                ),
-                (
-                    "grooved finite Reynolds",
-                    Some(grooves),
-                    Cavitation::Reynolds,
-                    false,
-                ),
-                (
-                    "narrow groove",
-                    Some(grooves),
-                    Cavitation::HalfSommerfeld,
-                    true,
-                ),
-            ];
-            let only = std::env::var("FILM_CASES").unwrap_or_default();
-            for (label, grooves, cavitation, narrow) in cases {
-                if !only.is_empty() && !only.split(',').any(|c| label == c) {
-                    continue;
-                }
-                let b = Bearing {
-                    lambda: 1.0,
-                    grooves,
-                    cavitation,
-                    model: if narrow {
-                        FilmModel::NarrowGroove { n_theta, n_zeta }
-                    } else {
-                        FilmModel::Finite { n_theta, n_zeta }
-                    },
-                };
-                let st = moving_state();
-                let (f, total, longest) = crate::cancel::gaps::longest(|| {
-                    b.solver().and_then(|mut s| s.force(&st, false))
-                });
-                println!(
-                    "{label} {n_theta}x{n_zeta}: call {total:.3} s, longest between polls \
-                     {longest:.3} s (fx {:.6})",
-                    f.unwrap().fx
-                );
-            }
-        }
-    }
 }
+
+#[cfg(all(test, feature = "studies"))]
+mod studies;

@@ -25,6 +25,8 @@ pub mod linear;
 pub mod long;
 pub mod narrow;
 pub mod short;
+#[cfg(all(test, feature = "studies"))]
+mod studies;
 pub mod study;
 #[cfg(test)]
 mod tests;
@@ -43,7 +45,7 @@ pub use narrow::NarrowSolver;
 /// Which surface carries the grooves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum GrooveSide {
-    /// Stationary sleeve (the seed's configuration): the film is steady in the fixed frame
+    /// Stationary sleeve (Yen's (2005) configuration): the film is steady in the fixed frame
     /// for a fixed journal position.
     Sleeve,
     /// Rotating journal: the groove pattern turns with the journal angle `tau`.
@@ -114,7 +116,7 @@ impl Grooves {
 /// Cavitation model.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Cavitation {
-    /// Solve the linear problem, then clip `P <- max(P, 0)` (the seed's model).
+    /// Solve the linear problem, then clip `P <- max(P, 0)` (Yen's (2005) model).
     #[default]
     HalfSommerfeld,
     /// Swift–Stieber: the complementarity problem `P >= 0`, flow residual `>= 0`,

@@ -211,7 +211,7 @@ pub enum SpringLayout {
     /// `n` springs round the track, the last from ball n to ball 1.
     #[default]
     Ring,
-    /// `n - 1` springs, ball 1 to 2, ..., n - 1 to n (seed 004).
+    /// `n - 1` springs, ball 1 to 2, ..., n - 1 to n (Rezaee et al. 2017).
     Chain,
 }
 

@@ -49,7 +49,7 @@ impl Component for Gravity {
     }
 }
 
-/// Seed 002's impulsive load on the rotor, `F(t) = amplitude exp(-sharpness (t - t0)^2)`
+/// Yen's (2005) impulsive load on the rotor, `F(t) = amplitude exp(-sharpness (t - t0)^2)`
 /// along the ground direction `angle`, turned into the rotating frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Impulse {

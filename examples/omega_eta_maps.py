@@ -1,8 +1,8 @@
-"""The thesis' Omega-eta maps (its figures 3-6 to 3-16): where R-R, O-O and R-O motions
+"""Tien's (2011) Omega-eta maps (its figures 3-6 to 3-16): where R-R, O-O and R-O motions
 exist and are stable, for zeta in {0.02, 0.05, 0.1} and zeta_b in {0.05, 0.1, 0.2}
 (mu 0.2, delta 50, N 3), and omega against eta for several Omega (figure 3-7).
 
-    python examples/thesis_maps.py [output-directory]      # about 10 s on 2 cores
+    python examples/omega_eta_maps.py [output-directory]      # about 10 s on 2 cores
 
 Writes one PNG per (zeta, zeta_b) with a panel per solution type, a 3 x 3 overview of
 the R-R maps, the omega curves, and the tables as Parquet.
@@ -37,7 +37,7 @@ TYPES = ("R-R", "O-O", "R-O")
 
 
 def main() -> None:
-    default = tempfile.mkdtemp(prefix="thesis_maps-") if SMALL else "thesis_maps"
+    default = tempfile.mkdtemp(prefix="omega_eta_maps-") if SMALL else "omega_eta_maps"
     out = Path(sys.argv[1] if len(sys.argv) > 1 else default)
     out.mkdir(parents=True, exist_ok=True)
     overview, axes = plt.subplots(3, 3, figsize=(15, 12), sharex=True, sharey=True)

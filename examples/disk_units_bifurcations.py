@@ -1,15 +1,16 @@
-"""Seed 003: the two-ball balancer's equilibria continued with ballbal's own
-continuation (the seed used AUTO), drawn in the seed's units.
+"""Bifurcation diagrams of the two-ball balancer in units of the disk alone, after
+[EccentricRotorABB]: its equilibria continued with ballbal's own continuation (the paper
+used AUTO), drawn in the disk's units.
 
-Figure 4: the (omega0, m0) plane at e = 2, C0 = D0 = 0.35, continued in the seed's own
-parameters (a ``Seed003`` model: m0 moves mu, eta, Omega, zeta and zeta_b at once):
+Figure 4: the (omega0, m0) plane at e = 2, C0 = D0 = 0.35, continued in these units' own
+parameters (a ``DiskUnits`` model: m0 moves mu, eta, Omega, zeta and zeta_b at once):
 the saddle-node curve SN_2+ of the balls-together state, the pitchfork PF (m0 = e/2)
 and the perfect balance's Hopf curve H_1, meeting at (omega0, m0) = (0.5773, 1).
 Figure 5: saddle-node curves of the balls-together equilibria and the Hopf curve of the
 perfect balance in the (omega0, C0) and (omega0, D0) planes at its defaults (table 2:
-m0 = 2, e = 2, C0 = D0 = 0.35), converted by ``from_seed003``.
+m0 = 2, e = 2, C0 = D0 = 0.35), converted by ``from_disk_units``.
 
-Run: python examples/seed003.py [OUTDIR]   (a few seconds)
+Run: python examples/disk_units_bifurcations.py [OUTDIR]   (a few seconds)
 """
 
 import math
@@ -21,7 +22,7 @@ import numpy as np
 
 import ballbal
 from ballbal._branch import Continuation
-from ballbal.continuation import Seed003, equilibrium_branch, equilibrium_curve, from_seed003
+from ballbal.continuation import DiskUnits, equilibrium_branch, equilibrium_curve, from_disk_units
 
 M0 = 2.0
 S = math.sqrt(1 + 2 * M0)  # Omega = omega0 S, zeta = C0 / S, zeta_b = D0 S / 2
@@ -31,7 +32,7 @@ OPTS = Continuation(ds=0.01, ds_max=0.1 if SMALL else 0.05, max_points=150 if SM
 
 def curves(second: str, lo: float, hi: float) -> list:
     # from low speed upwards: branches are continued forwards from their start
-    b = from_seed003(0.3, M0, 2.0, C0=0.35, D0=0.35)
+    b = from_disk_units(0.3, M0, 2.0, C0=0.35, D0=0.35)
     out = []
     for start in ("together", "perfect_balance"):
         br = equilibrium_branch(b, "Omega", start=start, range=(0.25 * S, 2.2 * S), options=OPTS)
@@ -45,16 +46,16 @@ def curves(second: str, lo: float, hi: float) -> list:
 
 
 def figure4(ax: plt.Axes) -> None:
-    """SN_2+, PF and H_1 in (omega0, m0), continued in the seed's parameters."""
-    seed = Seed003(omega0=0.3, m0=M0, e=2.0, C0=0.35, D0=0.35)
-    tog = equilibrium_branch(seed, "omega0", start="together", range=(0.25, 2.2), options=OPTS)
+    """SN_2+, PF and H_1 in (omega0, m0), continued in the disk's units."""
+    units = DiskUnits(omega0=0.3, m0=M0, e=2.0, C0=0.35, D0=0.35)
+    tog = equilibrium_branch(units, "omega0", start="together", range=(0.25, 2.2), options=OPTS)
     sn = equilibrium_curve(tog, "fold", "m0", range=(0.05, 5.0), options=OPTS)
-    at = seed.replace(omega0=1.5, m0=0.5)  # the state 2+ (balls opposite the imbalance)
+    at = units.replace(omega0=1.5, m0=0.5)  # the state 2+ (balls opposite the imbalance)
     start = next(e for e in ballbal.equilibria(at.balancer)
                  if e.kind == "together" and np.cos(e.q[2]) < 0)
     up = equilibrium_branch(at, "m0", start=start, range=(0.05, 5.0), options=OPTS)
     pf = equilibrium_curve(up, "branch_point", "omega0", range=(0.01, 2.2), options=OPTS)
-    pb = equilibrium_branch(seed.replace(omega0=0.8), "omega0", start="perfect_balance",
+    pb = equilibrium_branch(units.replace(omega0=0.8), "omega0", start="perfect_balance",
                             range=(0.6, 2.2), options=OPTS)
     h1 = equilibrium_curve(pb, "hopf", "m0", range=(1.0 + 1e-4, 5.0), options=OPTS)
     for c, name, style in ((sn, "SN_2+", "-"), (pf, "PF", "-."), (h1, "H_1", "--")):
@@ -69,7 +70,7 @@ def figure4(ax: plt.Axes) -> None:
     ax.set_ylim(0, 5)
     ax.set_xlabel("omega0")
     ax.set_ylabel("m0")
-    ax.set_title("seed 003, figure 4: (omega0, m0) at e = 2")
+    ax.set_title("disk units, figure 4: (omega0, m0) at e = 2")
     ax.legend(fontsize=8)
 
 
@@ -89,10 +90,10 @@ def main() -> None:
         ax.set_xlim(0, 2.2)
         ax.set_xlabel("omega0")
         ax.set_ylabel(label)
-        ax.set_title(f"seed 003, figure 5: (omega0, {label}) at m0 = {M0}")
+        ax.set_title(f"disk units, figure 5: (omega0, {label}) at m0 = {M0}")
         ax.legend(fontsize=8)
     fig.tight_layout()
-    path = os.path.join(outdir, "seed003.png")
+    path = os.path.join(outdir, "disk_units_bifurcations.png")
     fig.savefig(path, dpi=110)
     print(f"wrote {path}")
 

@@ -1,4 +1,4 @@
-"""Seed 002's scenarios: a rigid rotor in a herringbone-grooved journal bearing.
+"""Yen's (2005) scenarios: a rigid rotor in a herringbone-grooved journal bearing.
 
 The seed (an NSC report, 2004) gives no geometry, so the numbers here are ours, chosen so
 that its qualitative regimes appear (the choice is printed):
@@ -11,15 +11,15 @@ that its qualitative regimes appear (the choice is printed):
   static load ``m g_n`` in ``F_S``), with ``m`` below the whirl threshold; the unbalance
   ratios of the seed, 2.55 W, 0.255 W and 0.0255 W, are then ``e_u / c = (2.55, 0.255,
   0.0255) g_n``;
-* the seed's impulse ``5 W exp(-5e5 (t - 0.006)^2)`` at 500 rad/s, i.e.
+* Yen's (2005) impulse ``5 W exp(-5e5 (t - 0.006)^2)`` at 500 rad/s, i.e.
   ``5 W exp(-2 (tau - 3)^2)`` along gravity, applied at the static equilibrium.
 
 Panels (seed figures 2-19): two starts converging to one equilibrium (plain bearing, as the
-seed's smooth one), the impulse response against groove angle, L/D, depth and width ratio
+Yen's (2005) smooth one), the impulse response against groove angle, L/D, depth and width ratio
 (orbit and tangential film force), and the three unbalance regimes.
 
-Run: ``python examples/seed002.py [--out seed002.png]``; ``BALLBAL_EXAMPLE_SMALL=1`` runs a
-shortened version (fewer values, shorter times) for the tests.
+Run: ``python examples/grooved_bearing_rotor.py [--out grooved_bearing_rotor.png]``;
+``BALLBAL_EXAMPLE_SMALL=1`` runs a shortened version (fewer values, shorter times) for the tests.
 """
 
 from __future__ import annotations
@@ -117,8 +117,9 @@ def describe(label: str, tr: RotorTrajectory, seconds: float) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    default = os.path.join(tempfile.mkdtemp(prefix="seed002-"), "seed002.png") if SMALL \
-        else os.path.join(os.path.dirname(os.path.abspath(__file__)), "seed002.png")
+    name = "grooved_bearing_rotor.png"
+    default = os.path.join(tempfile.mkdtemp(prefix="grooved_bearing_rotor-"), name) if SMALL \
+        else os.path.join(os.path.dirname(os.path.abspath(__file__)), name)
     ap.add_argument("--out", default=default)
     args = ap.parse_args()
     t_all = time.perf_counter()

@@ -1,12 +1,12 @@
-"""Seed 004: the ball-spring balancer on a tilting rotor with gyroscopic coupling.
+"""Rezaee et al. (2017): the ball-spring balancer on a tilting rotor with gyroscopic coupling.
 
 1. The balanced state's stable region from the eigenvalues of the linearised system, in
    the (track damping, speed) and (ball mass, speed) planes, classic balancer against
-   ball springs (seed 004's figures 4 and 5).
+   ball springs (Rezaee et al.'s (2017) figures 4 and 5).
 2. The run-up through the critical speed of both (its figures 8 to 10): peak whirl and
    peak tilt.
 
-Run: python examples/seed004.py [--out seed004.png]   (about 5 s)
+Run: python examples/ball_spring_tilt.py [--out ball_spring_tilt.png]   (about 5 s)
 """
 
 import argparse
@@ -74,8 +74,8 @@ def run_up(ax):
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    default = os.path.join(tempfile.mkdtemp(prefix="seed004-"), "seed004.png") if SMALL \
-        else "seed004.png"
+    name = "ball_spring_tilt.png"
+    default = os.path.join(tempfile.mkdtemp(prefix="ball_spring_tilt-"), name) if SMALL else name
     ap.add_argument("--out", default=default)
     args = ap.parse_args()
     fig, ax = plt.subplots(3, 2, figsize=(10, 12))

@@ -1,9 +1,9 @@
-"""The thesis' chapter 4 (seed 000) in the model: fixed-frame spectra of its figures
+"""Tien's (2011) chapter 4 in the model: fixed-frame spectra of its figures
 4-12 (R-R), 4-27 (O-O) and 4-28 (R-O), the main vibration frequency against speed of
 figure 4-13 against the measured band (``ballbal.data``), the basins of attraction of
 figures 4-15 / 4-16 and a speed sweep up and down with its hysteresis.
 
-Run: python examples/thesis_ch4.py [out_dir]   (about a minute; small mode seconds)
+Run: python examples/rig_observables.py [out_dir]   (about a minute; small mode seconds)
 """
 
 import os
@@ -96,8 +96,8 @@ def main(out: Path) -> None:
     ax.legend()
     axes[1, 3].axis("off")
     fig.tight_layout()
-    fig.savefig(out / "thesis_ch4.png", dpi=80)
-    print(f"wrote {out / 'thesis_ch4.png'}")
+    fig.savefig(out / "rig_observables.png", dpi=80)
+    print(f"wrote {out / 'rig_observables.png'}")
 
 
 if __name__ == "__main__":

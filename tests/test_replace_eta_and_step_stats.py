@@ -1,5 +1,5 @@
-"""Two mends of the public API: ``Balancer.replace`` with one ``eta`` keeps the balls, and
-``simulate`` reports the integrator's step statistics, checked against scipy's RK45."""
+"""``Balancer.replace`` with one ``eta`` keeps the number of balls, and ``simulate``
+reports the integrator's step statistics, checked against scipy's RK45."""
 
 import numpy as np
 import pytest

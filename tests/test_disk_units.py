@@ -1,10 +1,10 @@
-"""Equilibrium continuation in seed 003's own parameters (omega0, m0, e, C0, D0), its
-figure 4: the saddle-node curve SN_2+ against the closed form of its condition (14) taken
-as an equality, the pitchfork at m0 = e/2, the perfect balance's Hopf curve H_1 against a
-Routh–Hurwitz computation (the characteristic polynomial built in
-test_eq_continuation.py from model.md's equations, with the seed-to-model conversion
-written out here), and the point where they meet, (omega0, m0) = (1/sqrt(1 + 2 m0), e/2)
-= (0.5773, 1)."""
+"""Equilibrium continuation in units of the disk alone (omega0, m0, e, C0, D0) and
+[EccentricRotorABB]'s figure 4: the saddle-node curve SN_2+ against the closed form of its
+condition (14) taken as an equality, the pitchfork at m0 = e/2, the perfect balance's Hopf
+curve H_1 against a Routh–Hurwitz computation (the characteristic polynomial built in
+test_eq_continuation.py from model.md's equations, with the conversion to the model's
+units written out here), and the point where they meet, (omega0, m0) =
+(1/sqrt(1 + 2 m0), e/2) = (0.5773, 1)."""
 
 from __future__ import annotations
 
@@ -17,15 +17,15 @@ from test_eq_continuation import _char_poly, _hurwitz_last, _pb_matrices
 
 from ballbal import equilibria
 from ballbal._branch import Branch, Continuation, Curve
-from ballbal.continuation import Seed003, equilibrium_branch, equilibrium_curve
+from ballbal.continuation import DiskUnits, equilibrium_branch, equilibrium_curve
 from ballbal.exceptions import ParameterError
 
-E, C0, D0 = 2.0, 0.35, 0.35  # the seed's table 2
+E, C0, D0 = 2.0, 0.35, 0.35  # the paper's table 2
 OPTS = Continuation(ds=0.01, ds_max=0.05, max_points=400, tol=1e-12)
 
 
-def seed(omega0: float, m0: float) -> Seed003:
-    return Seed003(omega0=omega0, m0=m0, e=E, C0=C0, D0=D0)
+def units(omega0: float, m0: float) -> DiskUnits:
+    return DiskUnits(omega0=omega0, m0=m0, e=E, C0=C0, D0=D0)
 
 
 def m0_on_sn(omega0: float, near: float) -> float:
@@ -43,7 +43,7 @@ def m0_on_sn(omega0: float, near: float) -> float:
 @cache
 def together_in_omega0() -> Branch:
     # m0 = 2: the balls-together state 2+ exists from low speed up to omega01 (its fold)
-    return equilibrium_branch(seed(0.3, 2.0), "omega0", start="together", range=(0.25, 2.2),
+    return equilibrium_branch(units(0.3, 2.0), "omega0", start="together", range=(0.25, 2.2),
                               options=OPTS)
 
 
@@ -54,7 +54,7 @@ def sn_curve() -> Curve:
     return equilibrium_curve(br, i, "m0", range=(0.5, 5.0), options=OPTS)
 
 
-def test_tables_are_in_the_seeds_units() -> None:
+def test_tables_are_in_the_disks_units() -> None:
     br = together_in_omega0()
     assert br.parameter == "omega0" and "omega0" in br.table.columns
     k = br.table.height // 3
@@ -65,7 +65,7 @@ def test_tables_are_in_the_seeds_units() -> None:
                                np.sort(sol.eigenvalues.real / s), atol=1e-14)
     q = np.asarray(br.table["q"][k])
     np.testing.assert_allclose(q[:2], sol.q[:2] * E, atol=1e-14)
-    # the statics of seed 003's eq. (8) (rotating frame, its units), every row
+    # the statics of [EccentricRotorABB]'s eq. (8) (rotating frame, its units), every row
     m0 = 2.0
     for w, (x, y, p1, p2) in zip(br.table["omega0"], br.table["q"].to_list(), strict=True):
         g = w**2 * (1 + 2 * m0) - 1
@@ -83,7 +83,7 @@ def test_saddle_node_curve_against_condition_14() -> None:
     assert c.table.height > 30 and m0.min() < 1.01 and m0.max() > 4.0
     err = max(abs(m - m0_on_sn(x, m)) for x, m in zip(w, m0, strict=True))
     assert err < 1e-9, err
-    # its two sides (omega01 and omega02 of the seed's text) meet at the tip m0 = e/2
+    # its two sides (omega01 and omega02 of the paper's text) meet at the tip m0 = e/2
     assert m0[0] > 4.0 and m0[-1] > 4.0 and m0.min() < E / 2 + 1e-4
 
 
@@ -96,7 +96,7 @@ def test_the_codimension_two_point_is_flagged_once() -> None:
 def test_pitchfork_at_half_e() -> None:
     # At omega0 = 1.5 the together state with the balls opposite the imbalance (cos b < 0)
     # meets the perfect balance at m0 = e/2, where the balanced pair is born
-    s = seed(1.5, 0.5)
+    s = units(1.5, 0.5)
     start = next(e for e in equilibria(s.balancer)
                  if e.kind == "together" and np.cos(e.q[2]) < 0)
     br = equilibrium_branch(s, "m0", start=start, range=(0.3, 3.0), options=OPTS)
@@ -110,19 +110,19 @@ def test_pitchfork_at_half_e() -> None:
 
 
 def _hurwitz(omega0: float, m0: float) -> float:
-    s = np.sqrt(1 + 2 * m0)  # seed 003 -> model.md
+    s = np.sqrt(1 + 2 * m0)  # [EccentricRotorABB] -> model.md
     M, C, K = _pb_matrices(omega0 * s, m0 / E, 1 / s**2, C0 / s, D0 * s / 2, 1 / E)
     return _hurwitz_last(_char_poly(M, C, K))
 
 
 def test_hopf_curve_of_the_perfect_balance_against_routh_hurwitz() -> None:
-    br = equilibrium_branch(seed(0.8, 2.0), "omega0", start="perfect_balance",
+    br = equilibrium_branch(units(0.8, 2.0), "omega0", start="perfect_balance",
                             range=(0.6, 2.2), options=OPTS)
     h = br.events.filter(br.events["type"] == "hopf")
     assert h.height >= 1, br.events
     w0 = float(h["omega0"][0])
     assert abs(brentq(lambda w: _hurwitz(w, 2.0), w0 - 1e-3, w0 + 1e-3, xtol=1e-14) - w0) < 1e-7
-    # the seed's figure 4: right of H_1 the perfect balance is stable
+    # the paper's figure 4: right of H_1 the perfect balance is stable
     after = br.table.filter(br.table["omega0"] > w0 + 0.05)
     assert after.height > 0 and (after["stability"] == "stable").all()
     i = br.events["type"].to_list().index("hopf")
@@ -134,7 +134,7 @@ def test_hopf_curve_of_the_perfect_balance_against_routh_hurwitz() -> None:
         root = brentq(lambda x, m0=m0: _hurwitz(x, m0), w - 1e-3, w + 1e-3, xtol=1e-14)
         worst = max(worst, abs(root - w))
     assert worst < 1e-7, worst
-    # the Hopf frequency, in the seed's time unit, from the eigenvalues (ballbal's / S)
+    # the Hopf frequency, in the disk's time unit, from the eigenvalues (ballbal's / S)
     k = c.table.height // 2
     s = np.sqrt(1 + 2 * float(c.table["m0"][k]))
     lam = np.asarray(c.table["omega"][k]) * s
@@ -146,13 +146,13 @@ def test_hopf_curve_of_the_perfect_balance_against_routh_hurwitz() -> None:
     assert abs(np.abs(ev[np.argmin(np.abs(ev.real))].imag) - lam) < 1e-7
 
 
-def test_seed_parameters_are_named() -> None:
+def test_disk_unit_parameters_are_named() -> None:
     with pytest.raises(ParameterError) as e:
-        equilibrium_branch(seed(0.3, 2.0), "Omega", start="together", range=(0.2, 2.0))
+        equilibrium_branch(units(0.3, 2.0), "Omega", start="together", range=(0.2, 2.0))
     assert e.value.parameter == "Omega"
     with pytest.raises(ParameterError) as e:
-        Seed003(omega0=0.3, m0=0.0, e=2.0)
+        DiskUnits(omega0=0.3, m0=0.0, e=2.0)
     assert e.value.parameter == "m0"
     with pytest.raises(ParameterError) as e:
-        seed(0.3, 2.0).replace(Omega=1.0)
+        units(0.3, 2.0).replace(Omega=1.0)
     assert e.value.parameter == "Omega"

@@ -1,30 +1,30 @@
-//! Seed 003's nondimensionalisation of the planar balancer, as a parameter family.
+//! The planar balancer in units of the disk alone, as a parameter family
+//! ([EccentricRotorABB], see docs/references.md).
 //!
-//! The seed scales lengths by the track radius (`e = eps / R`), masses by the disk's
+//! Lengths are scaled by the track radius (`e = eps / R`), masses by the disk's
 //! (`m0 = m / M`, no further rotor mass) and time by `omega_n = sqrt(K / M)` of the disk
 //! alone; `C0 = C / (2 sqrt(K M))`, `D0 = D / (m R^2 omega_n)`. With `S = sqrt(1 + n m0)`
-//! (the total mass is `M S^2`) its parameters are the planar model's
+//! (the total mass is `M S^2`) these parameters are the planar model's
 //!
 //! ```text
 //!   Omega = omega0 S,  mu = 1 / S^2,  eta = m0 / e,  delta = 1 / e,
 //!   zeta = C0 / S,     zeta_b = D0 S / 2,
 //! ```
 //!
-//! so one of the seed's parameters moves several of the model's at once (`m0` moves all
-//! but `delta`): continuation in the seed's own parameters builds the model through
-//! [`Seed003::planar`] at every point. Its coordinates are the model's with `x, y`
-//! multiplied by `e` (lengths by `R`, not `eps`) and its time `S` times the model's
-//! (rates and eigenvalues divided by `S`).
+//! so one of them moves several of the model's at once (`m0` moves all but `delta`):
+//! continuation in these units builds the model through [`DiskUnits::planar`] at every
+//! point. Its coordinates are the model's with `x, y` multiplied by `e` (lengths by `R`,
+//! not `eps`) and its time `S` times the model's (rates and eigenvalues divided by `S`).
 
 use crate::error::{check_range, Error, Result};
 use crate::model::Planar;
 
-/// The seed's parameter names, in [`Seed003::values`]' order.
-pub const SEED003_PARAMS: [&str; 5] = ["omega0", "m0", "e", "C0", "D0"];
+/// The parameter names in the disk's units, in [`DiskUnits::values`]' order.
+pub const DISK_UNITS_PARAMS: [&str; 5] = ["omega0", "m0", "e", "C0", "D0"];
 
-/// A balancer in seed 003's parameters (`n` equal balls).
+/// A balancer in the disk's units (`n` equal balls).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Seed003 {
+pub struct DiskUnits {
     pub omega0: f64,
     pub m0: f64,
     pub e: f64,
@@ -33,8 +33,8 @@ pub struct Seed003 {
     pub n: usize,
 }
 
-impl Seed003 {
-    /// Validates the seed's ranges (`omega0, C0, D0 >= 0`, `m0, e > 0`, `1 <= n <= 1024`).
+impl DiskUnits {
+    /// Validates the ranges (`omega0, C0, D0 >= 0`, `m0, e > 0`, `1 <= n <= 1024`).
     pub fn new(omega0: f64, m0: f64, e: f64, c0: f64, d0: f64, n: usize) -> Result<Self> {
         let inf = f64::INFINITY;
         check_range("omega0", omega0, 0.0, false, inf, true)?;
@@ -49,7 +49,7 @@ impl Seed003 {
                 "1 <= n <= 1024",
             ));
         }
-        Ok(Seed003 {
+        Ok(DiskUnits {
             omega0,
             m0,
             e,
@@ -63,27 +63,27 @@ impl Seed003 {
         [self.omega0, self.m0, self.e, self.c0, self.d0]
     }
 
-    /// The value of the seed parameter `name` (one of [`SEED003_PARAMS`]).
+    /// The value of the parameter `name` (one of [`DISK_UNITS_PARAMS`]).
     pub fn param_value(&self, name: &str) -> Result<f64> {
-        match SEED003_PARAMS.iter().position(|p| *p == name) {
+        match DISK_UNITS_PARAMS.iter().position(|p| *p == name) {
             Some(i) => Ok(self.values()[i]),
             None => Err(unknown(name)),
         }
     }
 
-    /// A copy with the seed parameter `name` set to `value`, validated.
+    /// A copy with the parameter `name` set to `value`, validated.
     pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
         let mut v = self.values();
-        let i = SEED003_PARAMS
+        let i = DISK_UNITS_PARAMS
             .iter()
             .position(|p| *p == name)
             .ok_or_else(|| unknown(name))?;
         v[i] = value;
-        Seed003::new(v[0], v[1], v[2], v[3], v[4], self.n)
+        DiskUnits::new(v[0], v[1], v[2], v[3], v[4], self.n)
     }
 
-    /// `S = sqrt(1 + n m0)`: the seed's time over the model's, the model's speed over
-    /// the seed's.
+    /// `S = sqrt(1 + n m0)`: the disk's time unit over the model's, the model's speed
+    /// over `omega0`.
     pub fn scale(&self) -> f64 {
         (1.0 + self.n as f64 * self.m0).sqrt()
     }
@@ -115,8 +115,8 @@ impl Seed003 {
 fn unknown(name: &str) -> Error {
     Error::param_range(
         name,
-        format!("is not a parameter of seed 003's units (there: {name:?})"),
-        SEED003_PARAMS.join(", "),
+        format!("is not a parameter of the disk's units (there: {name:?})"),
+        DISK_UNITS_PARAMS.join(", "),
     )
 }
 
@@ -127,7 +127,7 @@ mod tests {
     #[test]
     fn the_codimension_two_point_is_the_models_double_zero() {
         // (omega0, m0) = (1/sqrt(1 + 2 m0), e/2) at e = 2 is (Omega, eta) = (1, 1/2).
-        let s = Seed003::new(1.0 / 3f64.sqrt(), 1.0, 2.0, 0.35, 0.35, 2).unwrap();
+        let s = DiskUnits::new(1.0 / 3f64.sqrt(), 1.0, 2.0, 0.35, 0.35, 2).unwrap();
         let p = s.planar().unwrap();
         assert!((p.omega_s - 1.0).abs() < 1e-15 && (p.eta[0] - 0.5).abs() < 1e-15);
         assert!((p.mu - 1.0 / 3.0).abs() < 1e-15 && (p.delta - 0.5).abs() < 1e-15);
