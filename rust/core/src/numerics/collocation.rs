@@ -1384,23 +1384,437 @@ mod tests {
         assert!(worst < 1e-6, "Jacobian vs differences: {worst:e}");
     }
 
+    /// Times at which the ball angle `b` (state index `ib`, decreasing one turn per
+    /// period) passes `b(0) - 2 pi m`, m = 1..=turns, integrating from `y0` at `rtol`:
+    /// the Poincaré section's return times, found on the integrator's dense output by
+    /// bisection.
+    fn section_times(
+        p: &Planar,
+        y0: &[f64],
+        ib: usize,
+        turns: usize,
+        t_end: f64,
+        rtol: f64,
+    ) -> Vec<f64> {
+        let f = |t: f64, y: &[f64], dy: &mut [f64]| crate::model::first_order_rhs(p, t, y, dy);
+        let start = y0[ib];
+        let mut times = Vec::new();
+        let mut buf = vec![0.0; y0.len()];
+        let mut solver = Dopri5::new(y0.len());
+        let mut prev = start;
+        let _ = solver.integrate(
+            f,
+            0.0,
+            y0,
+            t_end,
+            &Options::new(rtol, rtol * 1e-2),
+            |ta, tb, dense| {
+                let now = dense.end()[ib];
+                let level = start - 2.0 * PI * (times.len() + 1) as f64;
+                if prev > level && now <= level {
+                    let (mut lo, mut hi) = (ta, tb);
+                    for _ in 0..80 {
+                        let mid = 0.5 * (lo + hi);
+                        dense.eval(mid, &mut buf);
+                        if buf[ib] > level {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                    }
+                    times.push(0.5 * (lo + hi));
+                }
+                prev = now;
+                times.len() < turns
+            },
+        );
+        times
+    }
+
+    /// Leading non-trivial modulus (the multiplier closest to 1 is the trivial one).
+    fn leading(ev: &[(f64, f64)]) -> f64 {
+        judge(ev, 0.0, 1.0).max_modulus
+    }
+
+    /// (a) Omega 1.2: the collocation orbit, started from a simulated orbit (not from
+    /// harmonic balance), against harmonic balance at N = 24 (an independent method,
+    /// resolved there): period and multipliers to ~1e-8; and the period against the
+    /// simulation's own section return time.
     #[test]
-    #[ignore]
-    fn colloc_explore() {
+    fn colloc_smooth_orbit_agrees_with_harmonic_balance_and_simulation() {
         let p = balancer(1.2);
         let r24 = hb(&p, 24, None);
-        let f = r24.floquet.as_ref().unwrap();
-        println!("HB24 T {} mult {:?}", r24.sol.period(), &f.multipliers[..4]);
+        let f24 = r24.floquet.as_ref().unwrap();
+        // A rough start (N = 3), then 30 turns of simulation onto the attractor: the
+        // section crossing after them is the orbit's start, the last return time its
+        // period.
+        let r3 = hb(&p, 3, None);
+        let times = section_times(
+            &p,
+            &r3.sol.state(0.0),
+            2,
+            30,
+            40.0 * r24.sol.period(),
+            1e-12,
+        );
+        assert_eq!(times.len(), 30);
+        let t_return = times[29] - times[28];
+        let f = |t: f64, y: &[f64], dy: &mut [f64]| crate::model::first_order_rhs(&p, t, y, dy);
+        let (ys, _) = crate::ode::solve_at(
+            f,
+            0.0,
+            &r3.sol.state(0.0),
+            &[times[28]],
+            &Options::new(1e-12, 1e-14),
+        )
+        .unwrap();
+        assert!((t_return / r24.sol.period() - 1.0).abs() < 1e-8);
         for ntst in [20, 50] {
-            let t = std::time::Instant::now();
-            let s = solve(&p, &CollocOrbit::from_hb(&r24.sol, ntst, 4), &opts(ntst)).unwrap();
-            let el = t.elapsed().as_secs_f64();
+            let guess =
+                CollocOrbit::from_simulation(&p, &ys[0], t_return, &r24.sol.winding, ntst, 4)
+                    .unwrap();
+            let s = solve(&p, &guess, &opts(ntst)).unwrap();
+            assert_eq!(s.status, CollocStatus::Converged);
+            let rel = (s.orbit.period / r24.sol.period() - 1.0).abs();
+            assert!(rel < 1e-8, "NTST {ntst}: period off HB by {rel:e}");
             let m = multipliers_checked(&p, &s, 1e-12).unwrap();
+            let (lc, lh) = (leading(&m.multipliers), f24.max_modulus);
+            assert!((lc - lh).abs() < 1e-8, "NTST {ntst}: {lc} vs HB {lh}");
+            assert!(
+                m.modulus_error < 1e-8,
+                "NTST {ntst}: bound {:e}",
+                m.modulus_error
+            );
+            // The bound covers the actual error against harmonic balance.
+            assert!((lc - lh).abs() <= m.modulus_error.max(1e-10));
+            assert!(m.trivial_error < 1e-8);
+            // Every integrated multiplier matches one of harmonic balance's.
+            let d = crate::floquet::multiplier_distance(&f24.multipliers, &m.integrated);
+            assert!(
+                d < 1e-7,
+                "NTST {ntst}: integrated multipliers off HB by {d:e}"
+            );
+            // The orbit itself: the series at the time where its first ball has the
+            // collocation start's angle (modulo turns; Newton on b1(t)), every state
+            // against the collocation start's (angles modulo turns).
+            let yc = s.orbit.state(0.0);
+            let wrap = |a: f64| a - 2.0 * PI * (a / (2.0 * PI)).round();
+            let mut t = (0..400)
+                .map(|k| r24.sol.period() * k as f64 / 400.0)
+                .min_by(|a, b| {
+                    let da = wrap(r24.sol.state(*a)[2] - yc[2]).abs();
+                    let db = wrap(r24.sol.state(*b)[2] - yc[2]).abs();
+                    da.total_cmp(&db)
+                })
+                .unwrap();
+            for _ in 0..20 {
+                let y = r24.sol.state(t);
+                t -= wrap(y[2] - yc[2]) / y[6];
+            }
+            let yh = r24.sol.state(t);
+            let off = (0..8)
+                .map(|c| {
+                    if c == 2 || c == 3 {
+                        wrap(yh[c] - yc[c])
+                    } else {
+                        yh[c] - yc[c]
+                    }
+                })
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(off < 1e-8, "NTST {ntst}: state off the series by {off:e}");
+        }
+    }
+
+    /// (b) Omega 0.93, slow orbit (period ~370): the branch followed down from 1.2 by
+    /// collocation, its period against the return time of a long integration at tight
+    /// tolerance (the last of 8 turns: the start's error has decayed by the leading
+    /// multiplier, ~1e-8, per turn, so only the integration's own error remains).
+    #[test]
+    fn colloc_slow_orbit_period_agrees_with_a_long_integration() {
+        let p = balancer(1.2);
+        let r = hb(&p, 24, None);
+        let q = balancer(0.93);
+        for ntst in [20, 50] {
+            let o = opts(ntst);
+            let s = solve(&p, &CollocOrbit::from_hb(&r.sol, ntst, 4), &o).unwrap();
+            let br = follow(&p, "Omega", &s, 0.93, 0.05, 1e-6, &o).unwrap();
+            let last = br.last().unwrap();
+            assert!((last.param - 0.93).abs() < 1e-15);
+            let times = section_times(
+                &q,
+                &last.solution.orbit.state(0.0),
+                2,
+                8,
+                10.0 * last.solution.orbit.period,
+                1e-12,
+            );
+            assert_eq!(times.len(), 8);
+            let t_int = times[7] - times[6];
+            assert!(t_int > 300.0);
+            let rel = (last.solution.orbit.period / t_int - 1.0).abs();
+            assert!(
+                rel < 1e-7,
+                "NTST {ntst}: period {} vs {t_int}: {rel:e}",
+                last.solution.orbit.period
+            );
+            // The multipliers: the orbit is strongly attracting (integrated along the
+            // collocation orbit, the leading non-trivial modulus is ~1e-8). The
+            // discretised monodromy's (AUTO's way) is off, as AUTO's are near this end:
+            // 0.40 at NTST 20, 0.009 at NTST 50. The bound (twice the difference) always
+            // covers that; at NTST 50 it is small enough for a verdict, at NTST 20 not.
+            let m = multipliers_checked(&q, &last.solution, 1e-11).unwrap();
+            assert!(m.max_modulus_integrated < 1e-6, "NTST {ntst}: {m:?}");
+            assert!((m.integrated[0].0 - 1.0).abs() < 1e-6, "NTST {ntst}: {m:?}");
+            if ntst == 50 {
+                assert!(m.max_modulus + m.modulus_error < 0.1, "{m:?}");
+            }
+        }
+    }
+
+    /// (c) Towards the infinite-period end (the saddle-node on the invariant circle at
+    /// Omega* = 0.917140455, AUTO-07p's value): at NTST 50 the branch gets within 1e-7
+    /// of it, and the last points follow T ~ |Omega - Omega*|^(-1/2): `T^-2` is linear
+    /// in Omega, and its zero (from the orbits alone) is AUTO's Omega* to 1e-8.
+    #[test]
+    fn colloc_branch_reaches_the_infinite_period_end() {
+        let p = balancer(0.93);
+        let ntst = 50;
+        let o = opts(ntst);
+        let r = hb(&balancer(1.2), 24, None);
+        let s = solve(&balancer(1.2), &CollocOrbit::from_hb(&r.sol, ntst, 4), &o).unwrap();
+        let down = follow(&balancer(1.2), "Omega", &s, 0.93, 0.05, 1e-6, &o).unwrap();
+        let br = follow(
+            &p,
+            "Omega",
+            &down.last().unwrap().solution,
+            0.9,
+            0.005,
+            1e-13,
+            &o,
+        )
+        .unwrap();
+        let omega_star = 0.917140455;
+        let last = br.last().unwrap();
+        assert!(last.param - omega_star < 1e-7, "stopped at {}", last.param);
+        assert!(last.solution.orbit.period > 1e5);
+        // T = C (Omega - Omega*)^(-1/2) + T0 through three points with 1e4 < T < 1.5e5
+        // (long, and resolved: mesh indicator below 0.15): the Omega* that puts the
+        // middle one on the line through the outer two, by bisection.
+        let long: Vec<(f64, f64)> = br
+            .iter()
+            .filter(|b| (1e4..1.5e5).contains(&b.solution.orbit.period))
+            .map(|b| (b.param, b.solution.orbit.period))
+            .collect();
+        assert!(long.len() >= 3, "{long:?}");
+        let three = [long[0], long[long.len() / 2], long[long.len() - 1]];
+        let miss = |star: f64| {
+            let z = |w: f64| (w - star).powf(-0.5);
+            let (a, b, c) = (three[0], three[1], three[2]);
+            let slope = (c.1 - a.1) / (z(c.0) - z(a.0));
+            a.1 + slope * (z(b.0) - z(a.0)) - b.1
+        };
+        let (mut lo, mut hi) = (three[2].0 - 1e-4, three[2].0 - 1e-12);
+        assert!(miss(lo).signum() != miss(hi).signum(), "{long:?}");
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if miss(mid).signum() == miss(lo).signum() {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let fitted = 0.5 * (lo + hi);
+        assert!((fitted - omega_star).abs() < 5e-9, "fitted end {fitted}");
+    }
+
+    /// The collocation system through the generic [`Problem`] interface: its
+    /// implicit-function tangent's `dT/dOmega` against the difference of two solves.
+    #[test]
+    fn colloc_problem_tangent_matches_solves() {
+        let p = balancer(1.2);
+        let r = hb(&p, 24, None);
+        let o = CollocOptions {
+            ntst: 10,
+            ..Default::default()
+        };
+        let s = solve(&p, &CollocOrbit::from_hb(&r.sol, 10, 4), &o).unwrap();
+        let mut prob = CollocProblem::new(ModelAt::family_of(&p, "Omega").unwrap(), &s.orbit);
+        let x = s.orbit.unknowns();
+        let mut res = vec![0.0; prob.size()];
+        prob.residual(&x, 1.2, &mut res).unwrap();
+        assert!(res.iter().all(|v| v.abs() < 1e-8));
+        let tan = crate::numerics::problem::tangent(&mut prob, &x, 1.2)
+            .unwrap()
+            .unwrap();
+        let dt_tangent = tan[tan.len() - 1];
+        // Fixed mesh (no adaptation), so that both solves discretise alike.
+        let fixed = CollocOptions { adapt: 0, ..o };
+        let h = 1e-4;
+        let period = |w: f64| solve(&balancer(w), &s.orbit, &fixed).unwrap().orbit.period;
+        let fd = (period(1.2 + h) - period(1.2 - h)) / (2.0 * h);
+        assert!(
+            (dt_tangent - fd).abs() < 1e-5 * fd.abs(),
+            "{dt_tangent} vs {fd}"
+        );
+    }
+
+    /// Bad options are refused by name.
+    #[test]
+    fn colloc_options_out_of_range_are_refused() {
+        let name = |o: CollocOptions| match o.validate() {
+            Err(Error::InvalidParameter { name, .. }) => name,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(
+            name(CollocOptions {
+                ntst: 1,
+                ..Default::default()
+            }),
+            "ntst"
+        );
+        assert_eq!(
+            name(CollocOptions {
+                ntst: NTST_MAX + 1,
+                ..Default::default()
+            }),
+            "ntst"
+        );
+        assert_eq!(
+            name(CollocOptions {
+                ncol: 0,
+                ..Default::default()
+            }),
+            "ncol"
+        );
+        assert_eq!(
+            name(CollocOptions {
+                ncol: 8,
+                ..Default::default()
+            }),
+            "ncol"
+        );
+        assert_eq!(
+            name(CollocOptions {
+                tol: f64::NAN,
+                ..Default::default()
+            }),
+            "tol"
+        );
+        assert_eq!(
+            name(CollocOptions {
+                max_iter: 0,
+                ..Default::default()
+            }),
+            "max_iter"
+        );
+    }
+
+    /// Timings and reach (a measurement, not a test): `cargo test --release -j1 -p
+    /// ballbal-core colloc_measure -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn colloc_measure() {
+        let time = |f: &mut dyn FnMut()| {
+            let mut v: Vec<f64> = (0..5)
+                .map(|_| {
+                    let t = std::time::Instant::now();
+                    f();
+                    t.elapsed().as_secs_f64()
+                })
+                .collect();
+            v.sort_by(f64::total_cmp);
+            v[2]
+        };
+        let p12 = balancer(1.2);
+        let r24 = hb(&p12, 24, None);
+        let s50 = solve(&p12, &CollocOrbit::from_hb(&r24.sol, 50, 4), &opts(50)).unwrap();
+        let br = follow(&p12, "Omega", &s50, 0.93, 0.05, 1e-6, &opts(50)).unwrap();
+        let at093 = br.last().unwrap().solution.orbit.clone();
+        for (w, orbit) in [(1.2, None), (0.93, Some(&at093))] {
+            let p = balancer(w);
+            // Starts: the neighbouring solution at Omega + 1e-3 (a continuation step).
+            let q = balancer(w + 1e-3);
+            let base = match orbit {
+                None => CollocOrbit::from_hb(&r24.sol, 50, 4),
+                Some(o) => o.clone(),
+            };
+            let near = solve(&q, &base, &opts(50)).unwrap().orbit;
+            for ntst in [20, 50] {
+                let s = solve(&p, &near, &opts(ntst)).unwrap();
+                let t = time(&mut || {
+                    let _ = solve(&p, &near, &opts(ntst)).unwrap();
+                });
+                let t1 = time(&mut || {
+                    let _ = solve(
+                        &p,
+                        &near,
+                        &CollocOptions {
+                            adapt: 0,
+                            ..opts(ntst)
+                        },
+                    )
+                    .unwrap();
+                });
+                let tm = time(&mut || {
+                    let _ = multipliers_checked(&p, &s, 1e-10).unwrap();
+                });
+                println!(
+                    "Omega {w} colloc NTST {ntst}: solve {:.2} ms (3 adaptations), {:.2} ms \
+                     (fixed mesh), multipliers checked {:.2} ms; T {:.12}",
+                    t * 1e3,
+                    t1 * 1e3,
+                    tm * 1e3,
+                    s.orbit.period
+                );
+            }
+            // Harmonic balance from the same neighbour (its series fitted to the orbit).
+            let d = 4;
+            let winding = vec![0.0, 0.0, -1.0, -1.0];
+            for n_harm in [8, 24] {
+                let samples = 4 * n_harm + 8;
+                let mut flat = Vec::with_capacity(samples * d);
+                for i in 0..samples {
+                    let y = near.state(near.period * i as f64 / samples as f64);
+                    flat.extend_from_slice(&y[..d]);
+                }
+                let coeffs = crate::hb::fit_coefficients(&flat, d, &winding, n_harm);
+                let g = HbSolution::start(
+                    2.0 * PI / near.period,
+                    coeffs,
+                    winding.clone(),
+                    n_harm,
+                    Status::Converged,
+                );
+                let ho = HbOptions {
+                    n_harm,
+                    ..Default::default()
+                };
+                let sol = crate::hb::solve(&p, &g, &ho);
+                let t = time(&mut || {
+                    let _ = crate::hb::solve(&p, &g, &ho);
+                });
+                println!(
+                    "Omega {w} HB N {n_harm}: solve {:.2} ms, {:?}, T {:.12}",
+                    t * 1e3,
+                    sol.status,
+                    sol.period()
+                );
+            }
+        }
+        // Reach towards Omega* = 0.917140455 (AUTO: NTST 20 3.1e-6, 50 8.8e-8, 100 6e-11).
+        for ntst in [20, 50, 100] {
+            let o = opts(ntst);
+            let s = solve(&balancer(0.93), &at093, &o).unwrap();
+            let t = std::time::Instant::now();
+            let br = follow(&balancer(0.93), "Omega", &s, 0.9, 0.005, 1e-13, &o).unwrap();
+            let last = br.last().unwrap();
             println!(
-                "NTST {ntst}: {:?} it {} res {:e} T {} dT {:e} time {el:.4} mesh_err {:e}\n mult {:?}\n int {:?}\n err {:e}",
-                s.status, s.iterations, s.residual, s.orbit.period,
-                s.orbit.period / r24.sol.period() - 1.0, s.mesh_error,
-                &m.multipliers[..4], &m.integrated[..4], m.modulus_error
+                "NTST {ntst}: 0.93 -> Omega* + {:.2e} (T {:.3e}, mesh indicator {:.1e}), {} points, {:.2} s",
+                last.param - 0.917140455,
+                last.solution.orbit.period,
+                last.solution.mesh_error,
+                br.len(),
+                t.elapsed().as_secs_f64()
             );
         }
     }
