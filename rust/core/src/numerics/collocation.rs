@@ -169,8 +169,8 @@ impl CollocOrbit {
                 dy[i] += dl[k] * p[i] / h;
             }
         }
-        for i in 0..self.n {
-            y[i] += turns * self.jump[i];
+        for (yi, ji) in y.iter_mut().zip(&self.jump) {
+            *yi += turns * ji;
         }
     }
 
@@ -1052,12 +1052,12 @@ pub fn solve<D: Dynamics + ?Sized>(
         ));
     }
     crate::periodic::require_autonomous(model)?;
+    // Another NTST: a mesh of that many intervals adapted to the guess (a uniform one
+    // would lose the fast jump of a long-period orbit).
     let mut start = if guess.ntst() == opts.ntst {
         guess.clone()
     } else {
-        let mesh: Vec<f64> = (0..=opts.ntst)
-            .map(|j| j as f64 / opts.ntst as f64)
-            .collect();
+        let mesh = CollocSystem::new(guess).adapted_mesh(guess, opts.ntst).0;
         guess.remeshed(&mesh)
     };
     let mut sol = newton(model, &start, &start, opts);
@@ -1067,6 +1067,15 @@ pub fn solve<D: Dynamics + ?Sized>(
         }
         let sys = CollocSystem::new(&sol.orbit);
         let (mesh, _) = sys.adapted_mesh(&sol.orbit, opts.ntst);
+        // A mesh that would move no point by a hundredth of an average interval is the
+        // one we have: another Newton run would only re-interpolate.
+        let moved = mesh
+            .iter()
+            .zip(&sol.orbit.mesh)
+            .fold(0.0f64, |a, (u, v)| a.max((u - v).abs()));
+        if mesh.len() == sol.orbit.mesh.len() && moved < 0.01 / opts.ntst as f64 {
+            break;
+        }
         start = sol.orbit.remeshed(&mesh);
         sol = newton(model, &start, &start, opts);
     }
@@ -1235,7 +1244,7 @@ pub fn follow<D: Parametric>(
     opts: &CollocOptions,
 ) -> Result<Vec<BranchPoint>> {
     opts.validate()?;
-    if !(step > 0.0 && step.is_finite()) || !(min_step > 0.0 && min_step <= step) {
+    if !(step > 0.0 && step.is_finite() && min_step > 0.0 && min_step <= step) {
         return Err(Error::param(
             "step",
             format!("needs 0 < min_step <= step, got step {step}, min_step {min_step}"),
@@ -1741,6 +1750,19 @@ mod tests {
             let near = solve(&q, &base, &opts(50)).unwrap().orbit;
             for ntst in [20, 50] {
                 let s = solve(&p, &near, &opts(ntst)).unwrap();
+                let s1 = solve(
+                    &p,
+                    &near,
+                    &CollocOptions {
+                        adapt: 0,
+                        ..opts(ntst)
+                    },
+                )
+                .unwrap();
+                println!(
+                    "  Newton iterations: last run {} (adapted), {} (fixed mesh)",
+                    s.iterations, s1.iterations
+                );
                 let t = time(&mut || {
                     let _ = solve(&p, &near, &opts(ntst)).unwrap();
                 });
@@ -1801,6 +1823,16 @@ mod tests {
                 );
             }
         }
+        // One condensed Newton step against NTST: linear work expected.
+        for ntst in [20, 50, 100, 200] {
+            let o = CollocOrbit::from_hb(&r24.sol, ntst, 4);
+            let sys = CollocSystem::new(&o);
+            let x = o.unknowns();
+            let t = time(&mut || {
+                let _ = sys.newton_step(&p12, &x).unwrap();
+            });
+            println!("one Newton step at NTST {ntst}: {:.3} ms", t * 1e3);
+        }
         // Reach towards Omega* = 0.917140455 (AUTO: NTST 20 3.1e-6, 50 8.8e-8, 100 6e-11).
         for ntst in [20, 50, 100] {
             let o = opts(ntst);
@@ -1808,6 +1840,29 @@ mod tests {
             let t = std::time::Instant::now();
             let br = follow(&balancer(0.93), "Omega", &s, 0.9, 0.005, 1e-13, &o).unwrap();
             let last = br.last().unwrap();
+            // The period there on finer meshes (from this orbit, at the same Omega).
+            let here = balancer(last.param);
+            for finer in [2 * ntst, 4 * ntst] {
+                let f = solve(&here, &last.solution.orbit, &opts(finer)).unwrap();
+                println!(
+                    "  same Omega at NTST {finer}: {:?}, T {:.6e} (relative difference {:.1e})",
+                    f.status,
+                    f.orbit.period,
+                    f.orbit.period / last.solution.orbit.period - 1.0
+                );
+            }
+            // And a point with T ~ 3e4 (AUTO NTST 20's reach).
+            if let Some(b) = br.iter().find(|b| b.solution.orbit.period > 2.5e4) {
+                let f = solve(&balancer(b.param), &b.solution.orbit, &opts(4 * ntst)).unwrap();
+                println!(
+                    "  Omega* + {:.2e}: T {:.6e}, at NTST {}: {:.6e} (relative {:.1e})",
+                    b.param - 0.917140455,
+                    b.solution.orbit.period,
+                    4 * ntst,
+                    f.orbit.period,
+                    b.solution.orbit.period / f.orbit.period - 1.0
+                );
+            }
             println!(
                 "NTST {ntst}: 0.93 -> Omega* + {:.2e} (T {:.3e}, mesh indicator {:.1e}), {} points, {:.2} s",
                 last.param - 0.917140455,
