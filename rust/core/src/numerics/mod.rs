@@ -3,6 +3,7 @@
 //! a concrete model.
 
 pub mod blocked_lu;
+pub mod collocation;
 pub mod floquet;
 pub mod hb;
 pub mod linalg;
