@@ -1719,7 +1719,8 @@ mod tests {
     }
 
     /// Timings and reach (a measurement, not a test): `cargo test --release -j1 -p
-    /// ballbal-core colloc_measure -- --ignored --nocapture`.
+    /// ballbal-core --features studies colloc_measure -- --ignored --nocapture`.
+    #[cfg(feature = "studies")]
     #[test]
     #[ignore]
     fn colloc_measure() {
