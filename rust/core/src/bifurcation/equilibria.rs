@@ -26,9 +26,9 @@
 //! the point where it meets the pitchfork.
 
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
+use crate::bifurcation::event::Event;
 use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::continuation::curves::{join_halves, Extended, TwoParameter};
-use crate::continuation::event::Event;
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::seed003::Seed003;

@@ -20,7 +20,8 @@
 //! finds by itself.
 
 use crate::analysis::periodic::{finish_on_branch, Periodic, PeriodicOptions};
-use crate::continuation::{point_at, ArcOptions, ArcPoint, Event};
+use crate::bifurcation::event::Event;
+use crate::continuation::{point_at, ArcOptions, ArcPoint};
 use crate::error::{Error, Result};
 use crate::floquet::{merged_pair, monodromy, FloquetOptions};
 use crate::hb::{default_samples, fit_coefficients, HbProblem, HbSolution, Status};

@@ -45,9 +45,10 @@
 //! branch-point curve) and `LPPD` (fold–flip); on a `BP` curve `LP` and `PD`; on a `PD`
 //! curve `LPPD` and `BP`.
 
-use crate::analysis::po_branch::{branch_options, check_start};
+use crate::bifurcation::event::Event;
+use crate::bifurcation::po_branch::{branch_options, check_start};
 use crate::continuation::curves::join_halves;
-use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength, Event};
+use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::error::{Error, Result};
 use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
 use crate::numerics::problem::{Parametric, Problem};
@@ -2021,7 +2022,7 @@ fn certify_at<D: Parametric>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::po_branch::{periodic_branch, PoBranchOptions, PoEventKind};
+    use crate::bifurcation::po_branch::{periodic_branch, PoBranchOptions, PoEventKind};
     use crate::floquet::FloquetOptions;
     use crate::hb::HbOptions;
     use crate::periodic::periodic;
@@ -2182,7 +2183,7 @@ mod tests {
     }
 
     /// The whirl branch in zeta from 0.3 down to `lo` at rho 0.5 (N harmonics).
-    fn whirl_branch(n: usize, lo: f64) -> (crate::Scene, crate::analysis::po_branch::PoBranch) {
+    fn whirl_branch(n: usize, lo: f64) -> (crate::Scene, crate::bifurcation::po_branch::PoBranch) {
         let sc = whirl_scene(0.3, 0.5);
         let mut o = branch_opts(n, lo, 0.3);
         o.arc.forward = false;
@@ -2199,7 +2200,7 @@ mod tests {
     /// in `names[0]`.
     fn curve_at_event<D: Parametric>(
         p: &D,
-        b: &crate::analysis::po_branch::PoBranch,
+        b: &crate::bifurcation::po_branch::PoBranch,
         event: PoEventKind,
         names: [&str; 2],
         kind: PoCurveKind,

@@ -30,8 +30,9 @@
 //! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
 //! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
 
+use crate::bifurcation::event::Event;
 use crate::continuation::curves::join_halves;
-use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength, Event};
+use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
 use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
