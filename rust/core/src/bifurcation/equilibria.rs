@@ -28,7 +28,9 @@
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
 use crate::bifurcation::event::Event;
 use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
-use crate::continuation::curves::{join_halves, Extended, TwoParameter};
+use crate::continuation::curves::{
+    both_halves, curve_half, join_halves, CurveHook, Extended, TwoParameter,
+};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::seed003::Seed003;
@@ -1057,41 +1059,13 @@ fn codim_tests<D: Dynamics + Clone>(
 /// from the start: the rows run from the end reached towards decreasing `p2` to the
 /// end reached towards increasing `p2`.
 pub fn curve<D: Dynamics + Clone>(
-    mut sys: EqSystem<'_, D>,
+    sys: EqSystem<'_, D>,
     kind: CurveKind,
     q: &[f64],
     p1: f64,
     p2: f64,
     opts: &EqOptions,
 ) -> Result<EqCurve> {
-    let mut o = opts.clone();
-    o.arc.forward = false;
-    let back;
-    (back, sys) = curve_half(sys, kind, q, p1, p2, &o)?;
-    o.arc.forward = true;
-    let (fwd, _) = curve_half(sys, kind, q, p1, p2, &o)?;
-    let stop = [back.stop[1].clone(), fwd.stop[1].clone()];
-    let (points, special) = join_halves(
-        (back.points, back.special),
-        (fwd.points, fwd.special),
-        |c: &mut Codim2| &mut c.row,
-    );
-    Ok(EqCurve {
-        kind,
-        points,
-        special,
-        stop,
-    })
-}
-
-fn curve_half<'a, D: Dynamics + Clone>(
-    sys: EqSystem<'a, D>,
-    kind: CurveKind,
-    q: &[f64],
-    p1: f64,
-    p2: f64,
-    opts: &EqOptions,
-) -> Result<(EqCurve, EqSystem<'a, D>)> {
     if kind == CurveKind::Pitchfork && !sys.reduced {
         return Err(Error::param(
             "event",
@@ -1137,113 +1111,115 @@ fn curve_half<'a, D: Dynamics + Clone>(
         ));
     }
     ext.test.scale = 1.0 / grad2.sqrt();
-    let arc_opts = opts.arc.clone();
-    let mut arc = Arclength::new(&mut ext, &y0, p2, None, arc_opts.clone())?;
-    let mut points: Vec<CurvePoint> = vec![];
-    let mut special: Vec<Codim2> = vec![];
-    let mut prev: Option<(ArcPoint, Vec<(&'static str, f64)>)> = None;
-    while let Some(pt) = arc.next() {
-        let s = &mut arc.problem().system;
+    let mut hook = EqCurveHook {
+        kind,
+        n,
+        family: opts.family,
+    };
+    let whole = both_halves(
+        &opts.arc,
+        |arc| curve_half(&mut ext, &y0, p2, arc, opts.locate_tol, &mut hook),
+        |c: &mut Codim2| &mut c.row,
+    )?;
+    Ok(EqCurve {
+        kind,
+        points: whole.points,
+        special: whole.special,
+        stop: whole.stop,
+    })
+}
+
+/// The equilibrium side of the curve loop: codimension-two tests, their located points
+/// (a Hopf test's zero told apart into Bogdanov–Takens, zero-Hopf or neither), and each
+/// point's equilibrium with its stability.
+struct EqCurveHook {
+    kind: CurveKind,
+    n: usize,
+    family: bool,
+}
+
+type EqExtended<'a, D> = Extended<EqSystem<'a, D>, CurveTest>;
+
+impl<'a, D: Dynamics + Clone> CurveHook<EqExtended<'a, D>> for EqCurveHook {
+    type Point = CurvePoint;
+    type Special = Codim2;
+
+    fn n(&self) -> usize {
+        self.n
+    }
+
+    fn tests(
+        &mut self,
+        e: &mut EqExtended<'a, D>,
+        pt: &ArcPoint,
+    ) -> Result<Vec<(&'static str, f64)>> {
+        let n = self.n;
+        codim_tests(self.kind, &mut e.system, &pt.x[..n], [pt.x[n], pt.p])
+    }
+
+    fn cusp(&self) -> Option<&'static str> {
+        Some("cusp")
+    }
+
+    fn special(
+        &mut self,
+        e: &mut EqExtended<'a, D>,
+        label: &'static str,
+        at: &ArcPoint,
+        row: usize,
+    ) -> Result<Option<Codim2>> {
+        let n = self.n;
+        let s = &mut e.system;
+        let q = s.full(&at.x[..n]);
+        let p = [at.x[n], at.p];
+        let label = match label {
+            "hopf_test" => {
+                // the located zero of the Hopf test on a fold / pitchfork curve:
+                // a double zero, a zero-Hopf point, or a neutral saddle (none)
+                let (kappa, _) = s.critical_pair(&q, &p)?;
+                let a = s.state(&q, &p)?;
+                let ev = eigenvalues(&a, 2 * s.d).unwrap_or_default();
+                let scale = ev.iter().map(|z| z.0.hypot(z.1)).fold(1.0, f64::max);
+                let zeros = ev.iter().filter(|z| z.0.hypot(z.1) < 1e-5 * scale).count();
+                if zeros >= 2 {
+                    // Two zero eigenvalues with a two-dimensional kernel of K are two
+                    // simultaneous zero-eigenvalue bifurcations, not a Bogdanov–Takens
+                    // point (a Jordan block, a one-dimensional kernel): where the
+                    // together branch's fold meets its pitchfork the second zero belongs
+                    // to the antisymmetric ball mode, and the curve's other test flags
+                    // the point.
+                    let (k, _, _) = s.kcm(&q, &p)?;
+                    if kernel_dim(&k, s.d) >= 2 {
+                        return Ok(None);
+                    }
+                    "BT"
+                } else if kappa > 0.0 {
+                    "ZH"
+                } else {
+                    return Ok(None);
+                }
+            }
+            other => other,
+        };
+        Ok(Some(Codim2 {
+            kind: label,
+            p,
+            q,
+            row,
+        }))
+    }
+
+    fn point(
+        &mut self,
+        e: &mut EqExtended<'a, D>,
+        pt: &ArcPoint,
+        _tests: &[(&'static str, f64)],
+    ) -> Result<CurvePoint> {
+        let n = self.n;
         let p = [pt.x[n], pt.p];
-        let tt = codim_tests(kind, s, &pt.x[..n], p)?;
-        let row = points.len();
-        if let Some((a, ta)) = &prev {
-            let mut found: Vec<(usize, f64, f64)> = vec![];
-            for (i, ((_, ga), (_, gb))) in ta.iter().zip(&tt).enumerate() {
-                if ga * gb < 0.0 {
-                    found.push((i, *ga, *gb));
-                }
-            }
-            for (i, ga, gb) in found {
-                let label = tt[i].0;
-                let g = |e: &mut Extended<EqSystem<'_, D>, CurveTest>, pt: &ArcPoint| {
-                    codim_tests(kind, &mut e.system, &pt.x[..n], [pt.x[n], pt.p]).map(|v| v[i].1)
-                };
-                if let Some((e, _)) = locate(
-                    arc.problem(),
-                    a,
-                    &pt,
-                    ga,
-                    gb,
-                    g,
-                    opts.locate_tol,
-                    0.0,
-                    &arc_opts,
-                )? {
-                    let s = &mut arc.problem().system;
-                    let q = s.full(&e.x[..n]);
-                    let label = match label {
-                        "hopf_test" => {
-                            // the located zero of the Hopf test on a fold / pitchfork curve:
-                            // a double zero, a zero-Hopf point, or a neutral saddle (none)
-                            let (kappa, _) = s.critical_pair(&q, &[e.x[n], e.p])?;
-                            let a = s.state(&q, &[e.x[n], e.p])?;
-                            let ev = eigenvalues(&a, 2 * s.d).unwrap_or_default();
-                            let scale = ev.iter().map(|z| z.0.hypot(z.1)).fold(1.0, f64::max);
-                            let zeros = ev.iter().filter(|z| z.0.hypot(z.1) < 1e-5 * scale).count();
-                            if zeros >= 2 {
-                                // Two zero eigenvalues with a two-dimensional kernel of K
-                                // are two simultaneous zero-eigenvalue bifurcations, not a
-                                // Bogdanov–Takens point (a Jordan block, a one-dimensional
-                                // kernel): where the together branch's fold meets its
-                                // pitchfork the second zero belongs to the antisymmetric
-                                // ball mode, and the curve's other test flags the point.
-                                let (k, _, _) = s.kcm(&q, &[e.x[n], e.p])?;
-                                if kernel_dim(&k, s.d) >= 2 {
-                                    continue;
-                                }
-                                "BT"
-                            } else if kappa > 0.0 {
-                                "ZH"
-                            } else {
-                                continue;
-                            }
-                        }
-                        other => other,
-                    };
-                    special.push(Codim2 {
-                        kind: label,
-                        p: [e.x[n], e.p],
-                        q,
-                        row,
-                    });
-                }
-            }
-            // A cusp: the curve's direction in the parameter plane reverses.
-            let (ua, ub) = (
-                [a.tangent[n], a.tangent[n + 1]],
-                [pt.tangent[n], pt.tangent[n + 1]],
-            );
-            if ua[0] * ub[0] + ua[1] * ub[1] < 0.0 {
-                let g = |_: &mut Extended<EqSystem<'_, D>, CurveTest>, pt: &ArcPoint| {
-                    Ok(pt.tangent[n] * ua[0] + pt.tangent[n + 1] * ua[1])
-                };
-                let gb = ub[0] * ua[0] + ub[1] * ua[1];
-                let ga = ua[0] * ua[0] + ua[1] * ua[1];
-                if let Some((e, _)) = locate(
-                    arc.problem(),
-                    a,
-                    &pt,
-                    ga,
-                    gb,
-                    g,
-                    opts.locate_tol,
-                    0.0,
-                    &arc_opts,
-                )? {
-                    let q = arc.problem().system.full(&e.x[..n]);
-                    special.push(Codim2 {
-                        kind: "cusp",
-                        p: [e.x[n], e.p],
-                        q,
-                        row,
-                    });
-                }
-            }
-        }
-        let s = &mut arc.problem().system;
+        let s = &mut e.system;
         let q = s.full(&pt.x[..n]);
-        let omega = if kind == CurveKind::Hopf {
+        let omega = if self.kind == CurveKind::Hopf {
             s.critical_pair(&q, &p)?.1
         } else {
             f64::NAN
@@ -1254,31 +1230,10 @@ fn curve_half<'a, D: Dynamics + Clone>(
             kind_of(&q, s.o, EquilibriumKind::Unbalanced)
         };
         let k = kind_of(&q, s.o, start_kind);
-        let eq = analyse_model(s.model(&p)?, &q, k, opts.family);
-        let g = raw_curve_test(kind, s, &pt.x[..n], &p)? * arc.problem().test.scale;
-        points.push(CurvePoint { p, q, eq, omega, g });
-        prev = Some((pt, tt));
+        let eq = analyse_model(s.model(&p)?, &q, k, self.family);
+        let g = raw_curve_test(self.kind, s, &pt.x[..n], &p)? * e.test.scale;
+        Ok(CurvePoint { p, q, eq, omega, g })
     }
-    let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
-    if crate::cancel::cancelled() {
-        return Err(Error::Cancelled);
-    }
-    if points.is_empty() {
-        return Err(Error::param(
-            "event",
-            format!("the curve's start does not converge: {stop:?}"),
-        ));
-    }
-    drop(arc);
-    Ok((
-        EqCurve {
-            kind,
-            points,
-            special,
-            stop: [stop.clone(), stop],
-        },
-        ext.system,
-    ))
 }
 
 #[cfg(test)]

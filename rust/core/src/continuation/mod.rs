@@ -22,7 +22,9 @@ pub mod lattice;
 pub mod natural;
 
 pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
-pub use curves::{Extended, TestFunction, TwoParameter};
+pub use curves::{
+    both_halves, curve_half, CurveHalf, CurveHook, Extended, TestFunction, TwoParameter,
+};
 pub use lattice::{waves, Lattice, Tally, Waves};
 pub use natural::{natural_step, Natural, Step};
 

@@ -47,8 +47,8 @@
 
 use crate::bifurcation::event::Event;
 use crate::bifurcation::po_branch::{branch_options, check_start};
-use crate::continuation::curves::join_halves;
-use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::continuation::curves::{both_halves, curve_half, CurveHook};
+use crate::continuation::{ArcOptions, ArcPoint, ArcStop};
 use crate::error::{Error, Result};
 use crate::hb::HbSolution;
 use crate::numerics::problem::Parametric;
@@ -269,49 +269,10 @@ pub fn periodic_curve<D: Parametric>(
         let h0 = sys.test_matrix(kind, &x0, p0)?;
         Borders::Real(Border::from_svd(&h0)?)
     };
-    let mut o = opts.clone();
-    o.arc.forward = false;
-    let (back, sys) = half(sys, kind, &x0, p0, border.clone(), &o, &popts)?;
-    o.arc.forward = true;
-    let (fwd, _) = half(sys, kind, &x0, p0, border, &o, &popts)?;
-    let stop = [back.stop[1].clone(), fwd.stop[1].clone()];
-    let (points, special) = join_halves(
-        (back.points, back.special),
-        (fwd.points, fwd.special),
-        |c: &mut PoCodim2| &mut c.row,
-    );
-    Ok(PoCurve {
-        kind,
-        points,
-        special,
-        together,
-        stop,
-    })
-}
-
-type Half<'a, D> = (PoCurve, PoSystem<'a, D>);
-
-/// The start's borders: real, or complex for `NS`.
-#[derive(Debug, Clone)]
-enum Borders {
-    Real(Border<f64>),
-    Complex(CBorder),
-}
-
-/// On an `NS` curve closer than this to 0 or pi, the pair meets the real axis (strong
-/// resonance 1:1 or 1:2) and the curve ends.
-const THETA_END: f64 = 1e-3;
-
-fn half<'a, D: Parametric>(
-    sys: PoSystem<'a, D>,
-    kind: PoCurveKind,
-    x0: &[f64],
-    p0: [f64; 2],
-    border: Borders,
-    opts: &PoCurveOptions,
-    popts: &PeriodicOptions,
-) -> Result<Half<'a, D>> {
     let n = sys.n();
+    let mut y0 = x0[..n].to_vec();
+    y0.push(p0[0]);
+    y0.extend_from_slice(&x0[n..]);
     let (border, cborder) = match border {
         Borders::Real(b) => (b, None),
         Borders::Complex(c) => (
@@ -326,177 +287,163 @@ fn half<'a, D: Parametric>(
     let mut ext = Augmented {
         sys,
         kind,
-        border,
-        cborder,
+        border: border.clone(),
+        cborder: cborder.clone(),
         scale: 1.0,
         p2: p0[1],
         grad: None,
     };
-    let mut y0 = x0[..n].to_vec();
-    y0.push(p0[0]);
-    y0.extend_from_slice(&x0[n..]);
-    let norm = ext.gradient_norm(&y0, p0[1])?;
-    if !(norm > 0.0 && norm.is_finite()) {
-        return Err(Error::param(
-            "event",
-            "the test function is flat at the start: not a regular bifurcation point",
-        ));
-    }
-    ext.scale = 1.0 / norm;
-    ext.grad = None;
-    let arc_opts = opts.arc.clone();
-    let (lo, hi) = opts.p1_range;
-    let mut arc = Arclength::new(&mut ext, &y0, p0[1], None, arc_opts.clone())?;
-    let mut points: Vec<PoCurvePoint> = vec![];
-    let mut special: Vec<PoCodim2> = vec![];
-    let mut prev: Option<(ArcPoint, Vec<(&'static str, f64)>)> = None;
-    while let Some(pt) = arc.next() {
-        let p = [pt.x[n], pt.p];
-        if !(lo..=hi).contains(&p[0]) {
-            arc.finish("boundary");
-            break;
+    let mut hook = PoCurveHook {
+        kind,
+        n,
+        ns,
+        p1_range: opts.p1_range,
+        popts,
+    };
+    let half = |arc: &ArcOptions| {
+        // Each half starts from the start's borders (the other half rebased them).
+        ext.border = border.clone();
+        ext.cborder = cborder.clone();
+        ext.scale = 1.0;
+        ext.grad = None;
+        let norm = ext.gradient_norm(&y0, p0[1])?;
+        if !(norm > 0.0 && norm.is_finite()) {
+            return Err(Error::param(
+                "event",
+                "the test function is flat at the start: not a regular bifurcation point",
+            ));
         }
-        let omega = arc
-            .problem()
-            .sys
-            .full(&pt.x[..n])
+        ext.scale = 1.0 / norm;
+        ext.grad = None;
+        curve_half(&mut ext, &y0, p0[1], arc, opts.locate_tol, &mut hook)
+    };
+    let whole = both_halves(&opts.arc, half, |c: &mut PoCodim2| &mut c.row)?;
+    Ok(PoCurve {
+        kind,
+        points: whole.points,
+        special: whole.special,
+        together,
+        stop: whole.stop.map(|s| ArcStop::text(Some(&s))),
+    })
+}
+
+/// The start's borders: real, or complex for `NS`.
+#[derive(Debug, Clone)]
+enum Borders {
+    Real(Border<f64>),
+    Complex(CBorder),
+}
+
+/// On an `NS` curve closer than this to 0 or pi, the pair meets the real axis (strong
+/// resonance 1:1 or 1:2) and the curve ends.
+const THETA_END: f64 = 1e-3;
+
+/// The periodic side of the curve loop: the ends the arclength window does not know
+/// (the first parameter's window, omega vanishing, a Neimark–Sacker angle at a strong
+/// resonance), the other kinds' determinants as codimension-two tests with each located
+/// point's multiplier certificate, and each point's series certified and judged.
+struct PoCurveHook {
+    kind: PoCurveKind,
+    n: usize,
+    /// A Neimark–Sacker curve: `theta` is the unknown after `p1`.
+    ns: bool,
+    p1_range: (f64, f64),
+    popts: PeriodicOptions,
+}
+
+impl PoCurveHook {
+    fn theta(&self, pt: &ArcPoint) -> Option<f64> {
+        self.ns.then(|| pt.x[self.n + 1])
+    }
+
+    fn omega<D: Parametric>(&self, e: &Augmented<'_, D>, pt: &ArcPoint) -> f64 {
+        e.sys
+            .full(&pt.x[..self.n])
             .last()
             .copied()
-            .unwrap_or(f64::NAN);
-        if !(omega > 1e-3) {
-            arc.finish("omega_vanishes");
-            break;
+            .unwrap_or(f64::NAN)
+    }
+}
+
+impl<'a, D: Parametric> CurveHook<Augmented<'a, D>> for PoCurveHook {
+    type Point = PoCurvePoint;
+    type Special = PoCodim2;
+
+    fn n(&self) -> usize {
+        self.n
+    }
+
+    fn end(&mut self, e: &mut Augmented<'a, D>, pt: &ArcPoint) -> Result<Option<&'static str>> {
+        let (lo, hi) = self.p1_range;
+        if !(lo..=hi).contains(&pt.x[self.n]) {
+            return Ok(Some("boundary"));
         }
-        let theta = ns.then(|| pt.x[n + 1]);
-        if let Some(t) = theta {
-            if t < THETA_END {
-                arc.finish("resonance_1:1");
-                break;
-            }
-            if t > PI - THETA_END {
-                arc.finish("resonance_1:2");
-                break;
-            }
+        if !(self.omega(e, pt) > 1e-3) {
+            return Ok(Some("omega_vanishes"));
         }
-        let tt = arc.problem().sys.secondary(kind, &pt.x[..n], p, theta)?;
-        let row = points.len();
-        if let Some((a, ta)) = &prev {
-            for (i, ((label, ga), (_, gb))) in ta.iter().zip(&tt).enumerate() {
-                if ga * gb >= 0.0 {
-                    continue;
-                }
-                let g = |e: &mut Augmented<'_, D>, pt: &ArcPoint| {
-                    e.sys
-                        .secondary(kind, &pt.x[..n], [pt.x[n], pt.p], ns.then(|| pt.x[n + 1]))
-                        .map(|v| v[i].1)
-                };
-                if let Some((e, _)) = locate(
-                    arc.problem(),
-                    a,
-                    &pt,
-                    *ga,
-                    *gb,
-                    g,
-                    opts.locate_tol,
-                    0.0,
-                    &arc_opts,
-                )? {
-                    let om = arc
-                        .problem()
-                        .sys
-                        .full(&e.x[..n])
-                        .last()
-                        .copied()
-                        .unwrap_or(f64::NAN);
-                    let certificate = certify_at(arc.problem(), kind, label, &e, n, ns)?;
-                    special.push(PoCodim2 {
-                        kind: label,
-                        p: [e.x[n], e.p],
-                        omega: om,
-                        row,
-                        certificate,
-                    });
-                }
-            }
-            if kind == PoCurveKind::Fold {
-                // A cusp: the curve's direction in the parameter plane reverses.
-                let ua = [a.tangent[n], a.tangent[n + 1]];
-                let ub = [pt.tangent[n], pt.tangent[n + 1]];
-                let gb = ub[0] * ua[0] + ub[1] * ua[1];
-                if gb < 0.0 {
-                    let ga = ua[0] * ua[0] + ua[1] * ua[1];
-                    let g = |_: &mut Augmented<'_, D>, pt: &ArcPoint| {
-                        Ok(pt.tangent[n] * ua[0] + pt.tangent[n + 1] * ua[1])
-                    };
-                    if let Some((e, _)) = locate(
-                        arc.problem(),
-                        a,
-                        &pt,
-                        ga,
-                        gb,
-                        g,
-                        opts.locate_tol,
-                        0.0,
-                        &arc_opts,
-                    )? {
-                        let om = arc
-                            .problem()
-                            .sys
-                            .full(&e.x[..n])
-                            .last()
-                            .copied()
-                            .unwrap_or(f64::NAN);
-                        let certificate = certify_at(arc.problem(), kind, "CP", &e, n, ns)?;
-                        special.push(PoCodim2 {
-                            kind: "CP",
-                            p: [e.x[n], e.p],
-                            omega: om,
-                            row,
-                            certificate,
-                        });
-                    }
-                }
-            }
-        }
-        let prob = arc.problem();
-        let sol = prob.sys.series(&pt.x[..n], pt.residual);
-        let model = prob.sys.model(p)?.clone();
-        let result = finish_on_branch(&model, sol, popts);
-        let g = prob.g(&pt.x, pt.p)?;
-        let g = if ns { g[0].hypot(g[1]) } else { g[0] };
+        Ok(match self.theta(pt) {
+            Some(t) if t < THETA_END => Some("resonance_1:1"),
+            Some(t) if t > PI - THETA_END => Some("resonance_1:2"),
+            _ => None,
+        })
+    }
+
+    fn tests(
+        &mut self,
+        e: &mut Augmented<'a, D>,
+        pt: &ArcPoint,
+    ) -> Result<Vec<(&'static str, f64)>> {
+        let p = [pt.x[self.n], pt.p];
+        e.sys
+            .secondary(self.kind, &pt.x[..self.n], p, self.theta(pt))
+    }
+
+    fn cusp(&self) -> Option<&'static str> {
+        (self.kind == PoCurveKind::Fold).then_some("CP")
+    }
+
+    fn special(
+        &mut self,
+        e: &mut Augmented<'a, D>,
+        label: &'static str,
+        at: &ArcPoint,
+        row: usize,
+    ) -> Result<Option<PoCodim2>> {
+        let omega = self.omega(e, at);
+        let certificate = certify_at(e, self.kind, label, at, self.n, self.ns)?;
+        Ok(Some(PoCodim2 {
+            kind: label,
+            p: [at.x[self.n], at.p],
+            omega,
+            row,
+            certificate,
+        }))
+    }
+
+    fn point(
+        &mut self,
+        e: &mut Augmented<'a, D>,
+        pt: &ArcPoint,
+        tests: &[(&'static str, f64)],
+    ) -> Result<PoCurvePoint> {
+        let n = self.n;
+        let p = [pt.x[n], pt.p];
+        let sol = e.sys.series(&pt.x[..n], pt.residual);
+        let model = e.sys.model(p)?.clone();
+        let result = finish_on_branch(&model, sol, &self.popts);
+        let g = e.g(&pt.x, pt.p)?;
+        let g = if self.ns { g[0].hypot(g[1]) } else { g[0] };
         // New borders for the next step (the curve is the same set: g = 0 iff H is
         // singular, whatever the borders).
-        prob.rebase(&pt.x, pt.p)?;
-        points.push(PoCurvePoint {
+        e.rebase(&pt.x, pt.p)?;
+        Ok(PoCurvePoint {
             p,
             result,
             g,
-            theta,
-            tests: tt.clone(),
-        });
-        prev = Some((pt, tt));
+            theta: self.theta(pt),
+            tests: tests.to_vec(),
+        })
     }
-    let stop = ArcStop::text(arc.stop());
-    if crate::cancel::cancelled() {
-        return Err(Error::Cancelled);
-    }
-    if points.is_empty() {
-        return Err(Error::param(
-            "event",
-            format!("the curve's start does not converge: {stop}"),
-        ));
-    }
-    drop(arc);
-    Ok((
-        PoCurve {
-            kind,
-            points,
-            special,
-            together: ext.sys.reduced,
-            stop: [stop.clone(), stop],
-        },
-        ext.sys,
-    ))
 }
 
 /// [`certify_codim2`] at a located arclength point `e` of the augmented system.
