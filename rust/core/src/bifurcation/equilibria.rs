@@ -27,10 +27,11 @@
 
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
 use crate::bifurcation::event::Event;
-use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::continuation::arclength::{point_at, ArcOptions, ArcPoint, ArcStop};
 use crate::continuation::curves::{
     both_halves, curve_half, join_halves, CurveHook, Extended, TwoParameter,
 };
+use crate::continuation::{self, Declared, Spectrum};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::seed003::Seed003;
@@ -489,131 +490,31 @@ pub struct EqBranch {
     pub stop_back: Option<ArcStop>,
 }
 
-struct Tests {
-    fold: f64,
-    bp: f64,
-    hopf: f64,
-}
-
-fn tests<D: Dynamics + Clone>(
-    sys: &mut EqSystem<'_, D>,
-    pt: &ArcPoint,
-    together: bool,
-) -> Result<Tests> {
-    let q = sys.full(&pt.x);
-    let bp = if together {
-        sys.transverse(&q, &[pt.p])?
-    } else {
-        sys.bordered_det(&pt.x, pt.p, &pt.tangent)?
-    };
-    Ok(Tests {
-        fold: pt.dp_ds(),
-        bp,
-        hopf: sys.hopf_test(&q, &[pt.p])?,
-    })
-}
-
-/// At most this many halvings of one step by [`branch`]'s checks for events hidden
-/// inside it (the step then stands: a check that keeps failing, e.g. on an eigenvalue
-/// that sits on the axis, must not stall the branch).
-const MAX_SPLITS: usize = 6;
-
-/// What [`branch`]'s step control reads of a point's eigenvalues.
-struct Spectrum {
-    /// Eigenvalues with a positive real part (above [`UNSTABLE_TOL`]).
-    unstable: usize,
-    /// The real part of the complex eigenvalue nearest the imaginary axis (NaN without
-    /// one).
-    pair_re: f64,
-}
-
 /// Real parts below this count as on the axis, not unstable: neutral directions of a
 /// family sit at round-off from zero and must not look like crossings.
 const UNSTABLE_TOL: f64 = 1e-7;
 
-impl Spectrum {
-    fn of(eq: &Equilibrium) -> Spectrum {
-        let unstable = eq
-            .eigenvalues
-            .iter()
-            .filter(|(re, _)| *re > UNSTABLE_TOL)
-            .count();
-        let pair_re = eq
-            .eigenvalues
-            .iter()
-            .filter(|(_, im)| im.abs() > UNSTABLE_TOL)
-            .map(|(re, _)| *re)
-            .fold(f64::NAN, |m, re| {
-                if re.abs() < m.abs() || m.is_nan() {
-                    re
-                } else {
-                    m
-                }
-            });
-        Spectrum { unstable, pair_re }
-    }
-
-    fn pair_distance(&self) -> f64 {
-        if self.pair_re.is_nan() {
-            f64::INFINITY
-        } else {
-            self.pair_re.abs()
-        }
-    }
-}
-
-/// Whether the complex pair nearest the axis could cross it and come back inside a step
-/// of arclength `ds` from `a` to `b`. Near its largest value inside the step the real
-/// part is `m - k (s - s*)^2`: an end a distance `d <= ds` from `s*` that is still off
-/// the axis has `|Re| <= k d^2` and slope `2 k d`, so `|Re| <= slope ds / 2`. `rate` is
-/// that slope at `a` from the step before it (the secant); twice `rate ds`, four times
-/// the parabola's bound, allows for the secant's error. Without a step before `a`, the
-/// slope is taken as one (unknowns and parameters are O(1)).
-fn pair_may_return(a: &Spectrum, b: &Spectrum, rate: Option<f64>, ds: f64) -> bool {
-    let reach = rate.map_or(ds.abs(), |r| 2.0 * r * ds.abs());
-    a.pair_distance().max(b.pair_distance()) < reach
-}
-
-/// The rate at which the pair nearest the axis moves over a step of arclength `ds`.
-fn pair_rate(a: &Spectrum, b: &Spectrum, ds: f64) -> Option<f64> {
-    let r = (b.pair_re - a.pair_re).abs() / ds.abs();
-    // a pair appearing or vanishing (NaN) or a zero step: no rate, the O(1) default
-    r.is_finite().then_some(r)
-}
-
-/// Whether the test functions change sign at the step's midpoint though not between
-/// its ends: two zeros (a Hopf point and its return, two folds) inside one step.
-#[allow(clippy::too_many_arguments)]
-fn crossed_twice<D: Dynamics + Clone>(
-    sys: &mut EqSystem<'_, D>,
-    a: &ArcPoint,
-    b: &ArcPoint,
-    ta: &Tests,
-    tb: &Tests,
-    together: bool,
-    opts: &ArcOptions,
-) -> Result<bool> {
-    let Some(m) = point_at(sys, a, 0.5 * b.ds, opts)? else {
-        return Ok(false);
-    };
-    let tm = tests(sys, &m, together)?;
-    let twice = |ga: f64, gm: f64, gb: f64| ga * gb > 0.0 && ga * gm < 0.0;
-    Ok(twice(ta.hopf, tm.hopf, tb.hopf)
-        || twice(ta.fold, tm.fold, tb.fold)
-        || twice(ta.bp, tm.bp, tb.bp))
-}
-
-/// Whether the located events account for the change in the count of unstable
-/// eigenvalues over a step: a Hopf point moves two, a fold or branch point one.
-fn explained(a: &Spectrum, b: &Spectrum, events: &[EqEvent]) -> bool {
-    let moved: usize = events
+/// What the step control reads of an equilibrium's eigenvalues: those with a positive
+/// real part, and the real part of the complex eigenvalue nearest the imaginary axis.
+fn spectrum_of(eq: &Equilibrium) -> Spectrum {
+    let unstable = eq
+        .eigenvalues
         .iter()
-        .map(|e| match e.kind {
-            EventKind::Hopf => 2,
-            EventKind::Fold | EventKind::BranchPoint => 1,
-        })
-        .sum();
-    a.unstable.abs_diff(b.unstable) <= moved
+        .filter(|(re, _)| *re > UNSTABLE_TOL)
+        .count();
+    let pair = eq
+        .eigenvalues
+        .iter()
+        .filter(|(_, im)| im.abs() > UNSTABLE_TOL)
+        .map(|(re, _)| *re)
+        .fold(f64::NAN, |m, re| {
+            if re.abs() < m.abs() || m.is_nan() {
+                re
+            } else {
+                m
+            }
+        });
+    Spectrum { unstable, pair }
 }
 
 fn analyse_at<D: Dynamics + Clone>(
@@ -629,9 +530,170 @@ fn analyse_at<D: Dynamics + Clone>(
     Ok(analyse_model(sys.model(&[p])?, &q, kind, family))
 }
 
+/// The declared tests of an equilibrium branch, in [`EqTests::NAMES`]' order: `dp/ds`
+/// (fold), the branch point's (the bordered determinant, or on the together subspace
+/// the transverse stiffness), the bialternate Hopf test.
+struct EqTests {
+    start: EquilibriumKind,
+    family: bool,
+}
+
+/// A row of an equilibrium branch as the loop keeps it.
+struct EqRow {
+    arc: ArcPoint,
+    /// Whether the point is balls-together (its branch-point test is the transverse
+    /// stiffness).
+    together: bool,
+    point: EqPoint,
+    spectrum: Spectrum,
+}
+
+impl EqTests {
+    const NAMES: [&'static str; 3] = ["fold", "branch_point", "hopf"];
+    const KINDS: [EventKind; 3] = [EventKind::Fold, EventKind::BranchPoint, EventKind::Hopf];
+
+    fn together<D: Dynamics + Clone>(&self, sys: &EqSystem<'_, D>, pt: &ArcPoint) -> bool {
+        kind_of(&sys.full(&pt.x), sys.o, self.start) == EquilibriumKind::Together
+    }
+
+    fn all<D: Dynamics + Clone>(
+        sys: &mut EqSystem<'_, D>,
+        pt: &ArcPoint,
+        together: bool,
+    ) -> Result<[f64; 3]> {
+        let q = sys.full(&pt.x);
+        let bp = if together {
+            sys.transverse(&q, &[pt.p])?
+        } else {
+            sys.bordered_det(&pt.x, pt.p, &pt.tangent)?
+        };
+        Ok([pt.dp_ds(), bp, sys.hopf_test(&q, &[pt.p])?])
+    }
+}
+
+impl<'a, D: Dynamics + Clone> Declared<EqSystem<'a, D>> for EqTests {
+    type Point = EqRow;
+    type Event = EqEvent;
+
+    fn names(&self) -> &'static [&'static str] {
+        &Self::NAMES
+    }
+
+    fn point(&mut self, sys: &mut EqSystem<'a, D>, pt: &ArcPoint) -> Result<EqRow> {
+        let together = self.together(sys, pt);
+        let [fold, bp, hopf] = Self::all(sys, pt, together)?;
+        let eq = analyse_at(sys, &pt.x, pt.p, self.start, self.family)?;
+        let spectrum = spectrum_of(&eq);
+        Ok(EqRow {
+            arc: pt.clone(),
+            together,
+            point: EqPoint {
+                p: pt.p,
+                x: pt.x.clone(),
+                tangent: pt.tangent.clone(),
+                eq,
+                fold,
+                bp,
+                hopf,
+            },
+            spectrum,
+        })
+    }
+
+    fn arc<'p>(&self, row: &'p EqRow) -> &'p ArcPoint {
+        &row.arc
+    }
+
+    fn values(&self, row: &EqRow) -> Vec<Option<f64>> {
+        let p = &row.point;
+        vec![Some(p.fold), Some(p.bp), Some(p.hopf)]
+    }
+
+    fn spectrum(&self, row: &EqRow) -> Option<Spectrum> {
+        Some(row.spectrum)
+    }
+
+    fn value_at(
+        &mut self,
+        sys: &mut EqSystem<'a, D>,
+        a: &EqRow,
+        pt: &ArcPoint,
+        i: usize,
+    ) -> Result<f64> {
+        Ok(Self::all(sys, pt, a.together)?[i])
+    }
+
+    fn values_at(
+        &mut self,
+        sys: &mut EqSystem<'a, D>,
+        b: &EqRow,
+        pt: &ArcPoint,
+    ) -> Result<Vec<Option<f64>>> {
+        Ok(Self::all(sys, pt, b.together)?.map(Some).to_vec())
+    }
+
+    fn comparable(&self, a: &EqRow, b: &EqRow) -> bool {
+        a.together == b.together
+    }
+
+    fn watched(&self, a: &EqRow, b: &EqRow) -> Vec<usize> {
+        let (va, vb) = (
+            <Self as Declared<EqSystem<'a, D>>>::values(self, a),
+            <Self as Declared<EqSystem<'a, D>>>::values(self, b),
+        );
+        // The branch-point function changes with the kind on a switched branch.
+        (0..3)
+            .filter(|&i| i != 1 || a.together == b.together)
+            .filter(|&i| matches!((va[i], vb[i]), (Some(x), Some(y)) if x * y < 0.0))
+            .collect()
+    }
+
+    fn event(
+        &mut self,
+        s: &mut EqSystem<'a, D>,
+        i: usize,
+        e: &ArcPoint,
+        g: f64,
+        row: usize,
+    ) -> Result<Option<EqEvent>> {
+        let kind = Self::KINDS[i];
+        let q = s.full(&e.x);
+        let omega = if kind == EventKind::Hopf {
+            let (kappa, om) = s.critical_pair(&q, &[e.p])?;
+            if kappa <= 0.0 {
+                // a neutral saddle: not a bifurcation
+                return Ok(None);
+            }
+            om
+        } else {
+            f64::NAN
+        };
+        let eq = analyse_at(s, &e.x, e.p, self.start, self.family)?;
+        Ok(Some(EqEvent {
+            kind,
+            row,
+            p: e.p,
+            x: e.x.clone(),
+            tangent: e.tangent.clone(),
+            eq,
+            test: g,
+            omega,
+        }))
+    }
+
+    /// A Hopf point moves two eigenvalues across the axis, a fold or branch point one.
+    fn moves(&self, e: &EqEvent) -> usize {
+        match e.kind {
+            EventKind::Hopf => 2,
+            EventKind::Fold | EventKind::BranchPoint => 1,
+        }
+    }
+}
+
 /// Continues the equilibrium `x0` (full coordinates) at `p0` of the one-parameter
-/// family `sys`, locating folds, Hopf points and branch points between points.
-/// `start` is the start's kind (kinds along the branch are judged by shape, see
+/// family `sys`, locating folds, Hopf points and branch points between points
+/// ([`crate::continuation::branch`], with its step control against events hidden in a
+/// step). `start` is the start's kind (kinds along the branch are judged by shape, see
 /// [`kind_of`]); `direction` (in `(x, p)`) orients the first tangent, as at a switch.
 pub fn branch<D: Dynamics + Clone>(
     sys: &mut EqSystem<'_, D>,
@@ -659,123 +721,21 @@ pub fn branch<D: Dynamics + Clone>(
             ),
         ));
     }
-    let o = sys.o;
-    let arc_opts = opts.arc.clone();
-    let mut arc = Arclength::new(sys, x0, p0, direction, arc_opts.clone())?;
-    let mut points: Vec<EqPoint> = vec![];
-    let mut events: Vec<EqEvent> = vec![];
-    let mut prev: Option<(ArcPoint, Tests, bool, Spectrum, Option<f64>)> = None;
-    let mut splits = 0;
-    while let Some(pt) = arc.next() {
-        let q = arc.problem().full(&pt.x);
-        let together = kind_of(&q, o, start) == EquilibriumKind::Together;
-        let t = tests(arc.problem(), &pt, together)?;
-        let eq = analyse_at(arc.problem(), &pt.x, pt.p, start, opts.family)?;
-        let spectrum = Spectrum::of(&eq);
-        let row = points.len();
-        let mut found_events = vec![];
-        let mut rate = None;
-        if let Some((a, ta, tog_a, sa, rate_a)) = &prev {
-            rate = pair_rate(sa, &spectrum, pt.ds);
-            let may_hide = splits < MAX_SPLITS && *tog_a == together;
-            if may_hide
-                && pair_may_return(sa, &spectrum, *rate_a, pt.ds)
-                && crossed_twice(arc.problem(), a, &pt, ta, &t, together, &arc_opts)?
-                && arc.subdivide()
-            {
-                splits += 1;
-                continue;
-            }
-            let mut found = vec![];
-            if ta.fold * t.fold < 0.0 {
-                found.push(EventKind::Fold);
-            }
-            // The branch-point function changes with the kind on a switched branch.
-            if *tog_a == together && ta.bp * t.bp < 0.0 {
-                found.push(EventKind::BranchPoint);
-            }
-            if ta.hopf * t.hopf < 0.0 {
-                found.push(EventKind::Hopf);
-            }
-            for kind in found {
-                let (ga, gb) = match kind {
-                    EventKind::Fold => (ta.fold, t.fold),
-                    EventKind::BranchPoint => (ta.bp, t.bp),
-                    EventKind::Hopf => (ta.hopf, t.hopf),
-                };
-                let tog = *tog_a;
-                let g = |s: &mut EqSystem<'_, D>, pt: &ArcPoint| -> Result<f64> {
-                    let tt = tests(s, pt, tog)?;
-                    Ok(match kind {
-                        EventKind::Fold => tt.fold,
-                        EventKind::BranchPoint => tt.bp,
-                        EventKind::Hopf => tt.hopf,
-                    })
-                };
-                let Some((e, ge)) = locate(
-                    arc.problem(),
-                    a,
-                    &pt,
-                    ga,
-                    gb,
-                    g,
-                    opts.locate_tol,
-                    0.0,
-                    &arc_opts,
-                )?
-                else {
-                    continue;
-                };
-                let s = arc.problem();
-                let q = s.full(&e.x);
-                let omega = if kind == EventKind::Hopf {
-                    let (kappa, om) = s.critical_pair(&q, &[e.p])?;
-                    if kappa <= 0.0 {
-                        // a neutral saddle: not a bifurcation
-                        continue;
-                    }
-                    om
-                } else {
-                    f64::NAN
-                };
-                let eq = analyse_at(s, &e.x, e.p, start, opts.family)?;
-                found_events.push(EqEvent {
-                    kind,
-                    row,
-                    p: e.p,
-                    x: e.x.clone(),
-                    tangent: e.tangent.clone(),
-                    eq,
-                    test: ge,
-                    omega,
-                });
-            }
-            // Unstable eigenvalues that appear or vanish with no located event to
-            // account for them crossed inside the step (a Hopf pair and its return, or
-            // two pairs at once): the step is taken again in halves.
-            if may_hide && !explained(sa, &spectrum, &found_events) && arc.subdivide() {
-                splits += 1;
-                continue;
-            }
-        }
-        splits = 0;
-        events.extend(found_events);
-        points.push(EqPoint {
-            p: pt.p,
-            x: pt.x.clone(),
-            tangent: pt.tangent.clone(),
-            eq,
-            fold: t.fold,
-            bp: t.bp,
-            hopf: t.hopf,
-        });
-        prev = Some((pt, t, together, spectrum, rate));
-    }
-    let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
-    if crate::cancel::cancelled() {
-        return Err(Error::Cancelled);
-    }
-    if points.is_empty() {
+    let mut tests = EqTests {
+        start,
+        family: opts.family,
+    };
+    let run = continuation::branch(
+        sys,
+        x0,
+        p0,
+        direction,
+        &opts.arc,
+        opts.locate_tol,
+        &mut tests,
+    )?;
+    let stop = run.stop;
+    if run.points.is_empty() {
         return Err(Error::param(
             "start",
             match &stop {
@@ -787,8 +747,8 @@ pub fn branch<D: Dynamics + Clone>(
         ));
     }
     Ok(EqBranch {
-        points,
-        events,
+        points: run.points.into_iter().map(|r| r.point).collect(),
+        events: run.events,
         stop,
         stop_back: None,
     })

@@ -17,11 +17,13 @@
 //! and the scans build on it, never the other way.
 
 pub mod arclength;
+pub mod branch;
 pub mod curves;
 pub mod lattice;
 pub mod natural;
 
 pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
+pub use branch::{branch, Branch, Declared, Spectrum};
 pub use curves::{
     both_halves, curve_half, CurveHalf, CurveHook, Extended, TestFunction, TwoParameter,
 };
@@ -63,12 +65,13 @@ pub struct BranchPoint<A, P> {
 mod tests {
     /// The engine's sources, read at compile time so that the layer rule is checked on
     /// what is built.
-    const SOURCES: [(&str, &str); 5] = [
+    const SOURCES: [(&str, &str); 6] = [
         ("mod.rs", include_str!("mod.rs")),
         ("arclength.rs", include_str!("arclength.rs")),
         ("curves.rs", include_str!("curves.rs")),
         ("lattice.rs", include_str!("lattice.rs")),
         ("natural.rs", include_str!("natural.rs")),
+        ("branch.rs", include_str!("branch.rs")),
     ];
 
     #[test]
