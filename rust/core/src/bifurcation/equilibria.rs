@@ -31,7 +31,7 @@ use crate::continuation::arclength::{point_at, ArcOptions, ArcPoint, ArcStop};
 use crate::continuation::curves::{
     both_halves, curve_half, join_halves, CurveHook, Extended, TwoParameter,
 };
-use crate::continuation::{self, Declared, Spectrum};
+use crate::continuation::{self, Declared, Spectrum, Start};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::seed003::Seed003;
@@ -725,15 +725,12 @@ pub fn branch<D: Dynamics + Clone>(
         start,
         family: opts.family,
     };
-    let run = continuation::branch(
-        sys,
-        x0,
-        p0,
+    let from = Start {
+        x: x0,
+        p: p0,
         direction,
-        &opts.arc,
-        opts.locate_tol,
-        &mut tests,
-    )?;
+    };
+    let run = continuation::branch(sys, from, &opts.arc, opts.locate_tol, &mut tests)?;
     let stop = run.stop;
     if run.points.is_empty() {
         return Err(Error::param(

@@ -15,4 +15,7 @@ pub mod po_branch;
 pub mod po_curves;
 pub mod switch;
 
+#[cfg(all(test, feature = "studies"))]
+mod studies;
+
 pub use event::Event;

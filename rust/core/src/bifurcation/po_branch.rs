@@ -22,9 +22,9 @@
 //!   harmonics cannot follow it: the branch ends when omega falls below `min_omega`, or
 //!   when a point fails its certificate while omega is falling. That point is not
 //!   kept; `p*` is fitted on the last three kept points as `T = C / sqrt|p - p*| + D`
-//!   (the constant `D`, the time spent away from the bottleneck, matters: without it,
-//!   `omega^2` linear in `p` through the last two points, `p*` at the standard point was
-//!   1.4e-3 short of the saddle-node's closed form, ten times the fit's error).
+//!   (the constant `D`, the time spent away from the bottleneck, matters: without it the
+//!   fitted `p*` falls short of the saddle-node's closed form by far more than the fit's
+//!   error; docs/measurements.md, "Continuation and bifurcation", has the numbers).
 //!
 //! Every test function is continuous along the branch and changes sign exactly at its
 //! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
@@ -32,7 +32,7 @@
 
 use crate::bifurcation::event::Event;
 use crate::continuation::curves::join_halves;
-use crate::continuation::{self, ArcOptions, ArcPoint, ArcStop, Declared, Spectrum};
+use crate::continuation::{self, ArcOptions, ArcPoint, ArcStop, Declared, Spectrum, Start};
 use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
@@ -436,15 +436,13 @@ pub fn periodic_branch<D: Parametric>(
         ctx,
         min_omega: opts.min_omega,
     };
-    let run = continuation::branch(
-        &mut prob,
-        &first.unknowns(),
-        p0,
-        None,
-        &opts.arc,
-        opts.event_tol,
-        &mut tests,
-    )?;
+    let x0 = first.unknowns();
+    let from = Start {
+        x: &x0,
+        p: p0,
+        direction: None,
+    };
+    let run = continuation::branch(&mut prob, from, &opts.arc, opts.event_tol, &mut tests)?;
     Ok(PoBranch {
         points: run.points,
         events: run.events,
@@ -734,14 +732,19 @@ pub(crate) fn branch_options(periodic: &PeriodicOptions) -> (PeriodicOptions, us
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::floquet::FloquetOptions;
     use crate::hb::HbOptions;
     use crate::periodic::periodic;
     use crate::Planar;
 
-    pub(super) fn opts(n: usize, lo: f64, hi: f64, forward: bool) -> PoBranchOptions {
+    pub(in crate::bifurcation) fn opts(
+        n: usize,
+        lo: f64,
+        hi: f64,
+        forward: bool,
+    ) -> PoBranchOptions {
         PoBranchOptions {
             arc: ArcOptions {
                 ds: 0.02,
@@ -859,81 +862,5 @@ mod tests {
             name(periodic_branch(&p, "Omega", &start.sol, &o2)),
             "min_omega"
         );
-    }
-}
-
-#[cfg(test)]
-mod explore {
-    use super::tests::opts;
-    use super::*;
-    use crate::periodic::periodic;
-    use crate::Planar;
-
-    /// Measurement: `cargo test --release -p ballbal-core explore_branch -- --ignored
-    /// --nocapture`.
-    #[test]
-    #[ignore]
-    fn explore_branch() {
-        let zb: f64 = std::env::var("ZB")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(0.05);
-        let eta: f64 = std::env::var("ETA")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(1.0);
-        let om: f64 = std::env::var("OM")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(1.2);
-        let fwd = std::env::var("FWD").as_deref() != Ok("0");
-        let n: usize = std::env::var("N")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(8);
-        let p = Planar::new(0.2, 0.05, &[zb], 50.0, om, &[eta, eta]).unwrap();
-        let mut o = opts(n, 0.5, 3.0, fwd);
-        o.arc.max_points = 400;
-        let start = periodic(&p, &[true, true], None, &o.periodic);
-        println!("start {:?} omega {}", start.sol.status, start.sol.omega);
-        let t = std::time::Instant::now();
-        let b = periodic_branch(&p, "Omega", &start.sol, &o).unwrap();
-        println!(
-            "{} points in {:?}, stop {}",
-            b.points.len(),
-            t.elapsed(),
-            b.stop
-        );
-        for pt in &b.points {
-            let m = pt.multipliers().map(|m| {
-                m.iter()
-                    .map(|z| format!("{:.3}{:+.3}i", z.0, z.1))
-                    .collect::<Vec<_>>()
-                    .join(" ")
-            });
-            println!(
-                "p={:.6} w={:.5} {} {} lp={:+.2e} bp={:+.2e} pd={:?} ns={:?} ev={:?} | {}",
-                pt.p,
-                pt.omega(),
-                pt.result.sol.status.as_str(),
-                pt.stability().as_str(),
-                pt.tests.lp,
-                pt.tests.bp,
-                pt.tests.pd.map(|v| (v * 1e3).round() / 1e3),
-                pt.tests.ns.map(|v| (v * 1e3).round() / 1e3),
-                pt.events,
-                m.unwrap_or_default()
-            );
-        }
-        for e in &b.events {
-            println!(
-                "EVENT {} p={:.9} test={:.3e} idx={} w={}",
-                e.kind.as_str(),
-                e.p,
-                e.test,
-                e.index,
-                e.point.omega()
-            );
-        }
     }
 }

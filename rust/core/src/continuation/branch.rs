@@ -14,7 +14,9 @@
 //!   evaluated at the step's midpoint: a test that changes sign there though not between
 //!   the ends has two zeros inside the step.
 
-use super::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
+use super::arclength::{
+    locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength, Bracket, Within,
+};
 use crate::error::{Error, Result};
 use crate::numerics::problem::Problem;
 
@@ -175,18 +177,23 @@ where
     }))
 }
 
-/// The one branch loop: continues `problem` from `x0` at `p0` (`direction` orienting the
-/// first tangent, as at a switch) by pseudo-arclength, keeps the row [`Declared::point`]
-/// makes at each corrected point, and locates the sign changes of the declared tests
-/// between rows to arclength `locate_tol`, subdividing a step that may hide events (see
-/// the module's notes). Errors when not even the start converges (`start_error` says
-/// what the branch would have started from).
-#[allow(clippy::too_many_arguments)]
+/// Where a branch starts: the solution `x` at the parameter `p`, and the direction (in
+/// `(x, p)`) that orients the first tangent, as at a switch (`None`: along `opts.forward`).
+#[derive(Debug, Clone)]
+pub struct Start<'a> {
+    pub x: &'a [f64],
+    pub p: f64,
+    pub direction: Option<Vec<f64>>,
+}
+
+/// The one branch loop: continues `problem` from `start` by pseudo-arclength, keeps the
+/// row [`Declared::point`] makes at each corrected point, and locates the sign changes
+/// of the declared tests between rows to arclength `locate_tol`, subdividing a step
+/// that may hide events (see the module's notes). The rows are empty when not even the
+/// start converges (the caller says what it would have started from).
 pub fn branch<P, T>(
     problem: &mut P,
-    x0: &[f64],
-    p0: f64,
-    direction: Option<Vec<f64>>,
+    start: Start<'_>,
     opts: &ArcOptions,
     locate_tol: f64,
     tests: &mut T,
@@ -195,7 +202,11 @@ where
     P: Problem + ?Sized,
     T: Declared<P>,
 {
-    let mut arc = Arclength::new(problem, x0, p0, direction, opts.clone())?;
+    let within = Within {
+        s: locate_tol,
+        g: 0.0,
+    };
+    let mut arc = Arclength::new(problem, start.x, start.p, start.direction, opts.clone())?;
     let mut points: Vec<T::Point> = vec![];
     let mut events: Vec<T::Event> = vec![];
     // The rate the pair nearest the boundary moved at over the last step kept.
@@ -231,11 +242,14 @@ where
                 let (Some(ga), Some(gb)) = (va[i], vb[i]) else {
                     continue;
                 };
-                let pa = tests.arc(a);
+                let bracket = Bracket {
+                    a: tests.arc(a),
+                    b: &pt,
+                    ga,
+                    gb,
+                };
                 let g = |pr: &mut P, t: &ArcPoint| tests.value_at(pr, a, t, i);
-                let Some((e, ge)) =
-                    locate(arc.problem(), pa, &pt, ga, gb, g, locate_tol, 0.0, opts)?
-                else {
+                let Some((e, ge)) = locate(arc.problem(), bracket, g, within, opts)? else {
                     continue;
                 };
                 found.extend(tests.event(arc.problem(), i, &e, ge, row)?);
@@ -369,7 +383,12 @@ mod tests {
             p_max: 1.0,
             ..ArcOptions::default()
         };
-        branch(&mut Diagonal, &[0.0], 0.0, None, &opts, 1e-12, pair).unwrap()
+        let start = Start {
+            x: &[0.0],
+            p: 0.0,
+            direction: None,
+        };
+        branch(&mut Diagonal, start, &opts, 1e-12, pair).unwrap()
     }
 
     #[test]

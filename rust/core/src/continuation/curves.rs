@@ -16,7 +16,9 @@
 //! taken by central differences (minimally augmented systems supply `g` by one bordered
 //! solve, which is what makes this cheap).
 
-use crate::continuation::arclength::{locate, ArcOptions, ArcPoint, ArcStop, Arclength};
+use crate::continuation::arclength::{
+    locate, ArcOptions, ArcPoint, ArcStop, Arclength, Bracket, Within,
+};
 use crate::error::{Error, Result};
 use crate::numerics::problem::Problem;
 
@@ -152,6 +154,10 @@ where
     H: CurveHook<P>,
 {
     let n = hook.n();
+    let within = Within {
+        s: locate_tol,
+        g: 0.0,
+    };
     let mut arc = Arclength::new(problem, y0, p2, None, opts.clone())?;
     let mut points = vec![];
     let mut special = vec![];
@@ -169,7 +175,13 @@ where
                     continue;
                 }
                 let g = |e: &mut P, pt: &ArcPoint| hook.tests(e, pt).map(|v| v[i].1);
-                let located = locate(arc.problem(), a, &pt, *ga, *gb, g, locate_tol, 0.0, opts)?;
+                let bracket = Bracket {
+                    a,
+                    b: &pt,
+                    ga: *ga,
+                    gb: *gb,
+                };
+                let located = locate(arc.problem(), bracket, g, within, opts)?;
                 if let Some((e, _)) = located {
                     special.extend(hook.special(arc.problem(), label, &e, row)?);
                 }
@@ -184,7 +196,8 @@ where
                     let g = |_: &mut P, pt: &ArcPoint| {
                         Ok(pt.tangent[n] * ua[0] + pt.tangent[n + 1] * ua[1])
                     };
-                    let located = locate(arc.problem(), a, &pt, ga, gb, g, locate_tol, 0.0, opts)?;
+                    let bracket = Bracket { a, b: &pt, ga, gb };
+                    let located = locate(arc.problem(), bracket, g, within, opts)?;
                     if let Some((e, _)) = located {
                         special.extend(hook.special(arc.problem(), label, &e, row)?);
                     }

@@ -22,8 +22,8 @@ pub mod curves;
 pub mod lattice;
 pub mod natural;
 
-pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
-pub use branch::{branch, Branch, Declared, Spectrum};
+pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength, Bracket, Within};
+pub use branch::{branch, Branch, Declared, Spectrum, Start};
 pub use curves::{
     both_halves, curve_half, CurveHalf, CurveHook, Extended, TestFunction, TwoParameter,
 };

@@ -467,7 +467,7 @@ fn certify_at<D: Parametric>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::certificate::{added_need, complement, smin, Need};
     use super::system::C64;
     use super::*;
@@ -506,7 +506,12 @@ mod tests {
         }
     }
 
-    fn curve_opts(n: usize, p1: (f64, f64), p2: (f64, f64), points: usize) -> PoCurveOptions {
+    pub(in crate::bifurcation) fn curve_opts(
+        n: usize,
+        p1: (f64, f64),
+        p2: (f64, f64),
+        points: usize,
+    ) -> PoCurveOptions {
         PoCurveOptions {
             arc: ArcOptions {
                 ds: 0.01,
@@ -634,7 +639,10 @@ mod tests {
     }
 
     /// The whirl branch in zeta from 0.3 down to `lo` at rho 0.5 (N harmonics).
-    fn whirl_branch(n: usize, lo: f64) -> (crate::Scene, crate::bifurcation::po_branch::PoBranch) {
+    pub(in crate::bifurcation) fn whirl_branch(
+        n: usize,
+        lo: f64,
+    ) -> (crate::Scene, crate::bifurcation::po_branch::PoBranch) {
         let sc = whirl_scene(0.3, 0.5);
         let mut o = branch_opts(n, lo, 0.3);
         o.arc.forward = false;
@@ -649,7 +657,7 @@ mod tests {
 
     /// The curve of `kind` in `names` through the first `event` of `b`, a branch of `p`
     /// in `names[0]`.
-    fn curve_at_event<D: Parametric>(
+    pub(in crate::bifurcation) fn curve_at_event<D: Parametric>(
         p: &D,
         b: &crate::bifurcation::po_branch::PoBranch,
         event: PoEventKind,
@@ -696,66 +704,6 @@ mod tests {
                 .expect("a complex pair");
             assert!((z.0.hypot(z.1) - 1.0).abs() < 1e-6, "{z:?} at {:?}", pt.p);
             assert!((z.1.atan2(z.0) - theta).abs() < 1e-5, "{z:?} {theta}");
-        }
-    }
-
-    /// Measurement: `cargo test --release -p ballbal-core explore_ns -- --ignored
-    /// --nocapture`.
-    #[test]
-    #[ignore]
-    fn explore_ns() {
-        let n: usize = std::env::var("N")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(6);
-        let t = std::time::Instant::now();
-        let (sc, b) = whirl_branch(n, 0.05);
-        println!(
-            "{} points {:?} stop {}",
-            b.points.len(),
-            t.elapsed(),
-            b.stop
-        );
-        for e in &b.events {
-            println!(
-                "EVENT {} p={:.9} w={}",
-                e.kind.as_str(),
-                e.p,
-                e.point.omega()
-            );
-        }
-        let mut co = curve_opts(n, (0.0, 1.0), (0.3, 1.0), 40);
-        (co.arc.ds, co.arc.ds_max) = (0.01, 0.05);
-        let c = curve_at_event(
-            &sc,
-            &b,
-            PoEventKind::NeimarkSacker,
-            ["zeta", "rho"],
-            PoCurveKind::NeimarkSacker,
-            &co,
-        );
-        println!("curve {:?} {:?}", c.stop, t.elapsed());
-        for pt in &c.points {
-            let m = &pt.result.floquet.as_ref().expect("multipliers").multipliers;
-            let ns = m
-                .iter()
-                .filter(|z| z.1 > 1e-9)
-                .map(|z| format!("{:.6}@{:.4}", z.0.hypot(z.1), z.1.atan2(z.0)))
-                .collect::<Vec<_>>()
-                .join(" ");
-            println!(
-                "zeta={:.6} rho={:.6} theta={:.5} g={:.1e} w={:.5} {:?} | {}",
-                pt.p[0],
-                pt.p[1],
-                pt.theta.unwrap(),
-                pt.g,
-                pt.result.sol.omega,
-                pt.tests,
-                ns
-            );
-        }
-        for s in &c.special {
-            println!("SPECIAL {} {:?} row {}", s.kind, s.p, s.row);
         }
     }
 

@@ -26,6 +26,29 @@ pub struct PoSystem<'a, D: Parametric> {
     pub(super) cache: Option<([u64; 2], D)>,
 }
 
+/// What a Galerkin matrix is projected on: rows the basis `rows` per coordinate,
+/// columns `cols` per coordinate and, with `omega_col`, the derivative in omega; sampled
+/// `periods` times over `[0, 2 pi)` (twice for a half-harmonic basis, whose period is
+/// two of the orbit's).
+#[derive(Clone, Copy)]
+pub(super) struct Projection<'t> {
+    rows: &'t Table,
+    cols: &'t Table,
+    omega_col: bool,
+    periods: usize,
+}
+
+impl<'t> Projection<'t> {
+    fn new(rows: &'t Table, cols: &'t Table, omega_col: bool, periods: usize) -> Self {
+        Projection {
+            rows,
+            cols,
+            omega_col,
+            periods,
+        }
+    }
+}
+
 /// Step of the directional differences along a unit null vector.
 pub(super) const DIR_STEP: f64 = 1e-5;
 
@@ -211,27 +234,27 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
             PoCurveKind::PeriodDoubling => {
                 let xf = self.full(x);
                 let half = Table::new(Basis::Half, self.n_harm, self.samples, 1);
-                self.galerkin(&xf, None, p, &half, &half, false, 1)
+                self.galerkin(&xf, None, p, Projection::new(&half, &half, false, 1))
             }
             PoCurveKind::NeimarkSacker => Err(complex_kind()),
         }
     }
 
     /// The Galerkin matrix of the linearisation about the series `xf` (plus `pert`, a
-    /// half-harmonic series, when given): rows the basis `rows` per coordinate, columns
-    /// `cols` per coordinate and, with `omega_col`, the derivative in omega; sampled
-    /// `periods` times over `[0, 2 pi)`.
-    #[allow(clippy::too_many_arguments)]
+    /// half-harmonic series, when given) on the projection `on`.
     pub(super) fn galerkin(
         &mut self,
         xf: &[f64],
         pert: Option<&[f64]>,
         p: [f64; 2],
-        rows: &Table,
-        cols: &Table,
-        omega_col: bool,
-        periods: usize,
+        on: Projection<'_>,
     ) -> Result<DMatrix<f64>> {
+        let Projection {
+            rows,
+            cols,
+            omega_col,
+            periods,
+        } = on;
         let (d, l, nh) = (self.d, self.l, self.n_harm);
         let s = self.samples * periods;
         let om = xf[d * l];
@@ -376,8 +399,10 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 let whole = Table::new(Basis::Whole, nh, s, 2);
                 let ep: Vec<f64> = v.iter().map(|b| h * b).collect();
                 let em: Vec<f64> = v.iter().map(|b| -h * b).collect();
-                let gp = self.galerkin(&xf, Some(&ep), p, &half, &whole, true, 2)?;
-                let gm = self.galerkin(&xf, Some(&em), p, &half, &whole, true, 2)?;
+                let gp =
+                    self.galerkin(&xf, Some(&ep), p, Projection::new(&half, &whole, true, 2))?;
+                let gm =
+                    self.galerkin(&xf, Some(&em), p, Projection::new(&half, &whole, true, 2))?;
                 let uv = DVector::from_column_slice(u);
                 let row = (gp - gm).tr_mul(&uv) / (2.0 * h);
                 for (k, g) in row.iter().enumerate() {
@@ -390,8 +415,8 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                     let (mut pp, mut pm) = (p, p);
                     pp[k] += hp;
                     pm[k] -= hp;
-                    let a = self.galerkin(&xf, None, pp, &one, &one, false, 1)?;
-                    let b = self.galerkin(&xf, None, pm, &one, &one, false, 1)?;
+                    let a = self.galerkin(&xf, None, pp, Projection::new(&one, &one, false, 1))?;
+                    let b = self.galerkin(&xf, None, pm, Projection::new(&one, &one, false, 1))?;
                     grad[n + k] = uv.dot(&((a - b) * &vv)) / (2.0 * hp);
                 }
             }
