@@ -1,7 +1,7 @@
 """Continuation of equilibria: one-parameter branches with their stability and located
 events (fold, Hopf, branch point / pitchfork), branch switching at a branch point, and
 two-parameter curves of those bifurcations (the core's
-``rust/core/src/continuation/equilibria.rs``); and seed 003's nondimensionalisation.
+``rust/core/src/bifurcation/equilibria.rs``); and seed 003's nondimensionalisation.
 """
 
 from __future__ import annotations
