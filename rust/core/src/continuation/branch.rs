@@ -65,6 +65,12 @@ fn pair_rate(a: &Spectrum, b: &Spectrum, ds: f64) -> Option<f64> {
     r.is_finite().then_some(r)
 }
 
+/// Whether events that move `moved` eigenvalues (multipliers) across the boundary
+/// account for the change in the unstable count from `a` to `b`.
+fn explained(a: &Spectrum, b: &Spectrum, moved: usize) -> bool {
+    a.unstable.abs_diff(b.unstable) <= moved
+}
+
 /// A branch's declared test functions and what it keeps: the bifurcation side of
 /// [`branch`]. Test `i` is the `i`-th of [`Declared::names`]; its value at a point may be
 /// missing (`None`, e.g. multipliers where a certificate failed), and then no event of
@@ -258,7 +264,7 @@ where
             // account for them crossed inside the step: it is taken again in halves.
             if let (Some(sa), Some(sb)) = (sa, sb) {
                 let moved: usize = found.iter().map(|e| tests.moves(e)).sum();
-                if may_hide && sa.unstable.abs_diff(sb.unstable) > moved && arc.subdivide() {
+                if may_hide && !explained(&sa, &sb, moved) && arc.subdivide() {
                     splits += 1;
                     continue;
                 }
