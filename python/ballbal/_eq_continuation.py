@@ -1,7 +1,7 @@
 """Continuation of equilibria: one-parameter branches with their stability and located
 events (fold, Hopf, branch point / pitchfork), branch switching at a branch point, and
 two-parameter curves of those bifurcations (the core's
-``rust/core/src/continuation/equilibria.rs``); and the balancer in the disk's units.
+``rust/core/src/bifurcation/equilibria.rs``); and the balancer in the disk's units.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Continuation of periodic solutions in one parameter (pseudo-arclength on the
-harmonic-balance equations, ``rust/core/src/analysis/po_branch.rs``), every point
+harmonic-balance equations, ``rust/core/src/bifurcation/po_branch.rs``), every point
 certified and judged as :func:`ballbal.periodic` does, with its bifurcations located.
 """
 

@@ -1,7 +1,7 @@
 """Two-parameter curves of bifurcations of periodic solutions (``fold``,
 ``branch_point`` of merged balls, ``period_doubling``, ``neimark_sacker``): a
 minimally augmented harmonic-balance system continued by pseudo-arclength
-(``rust/core/src/analysis/po_curves.rs``), from an event of a periodic branch.
+(``rust/core/src/bifurcation/po_curves/``), from an event of a periodic branch.
 """
 
 from __future__ import annotations

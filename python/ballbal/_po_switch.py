@@ -1,6 +1,6 @@
 """Branch switching: the first solution of the branch that leaves a known solution at
 a bifurcation, from the critical eigenvector (no simulation). The numerics are the
-core's ``analysis/switch.rs``."""
+core's ``bifurcation/switch.rs``."""
 
 from __future__ import annotations
 

@@ -6,8 +6,10 @@
 //! * [`numerics`]: integrator, linear algebra, harmonic balance, Floquet multipliers;
 //! * [`analysis`]: simulation, attractors, equilibria, periodic solutions and their
 //!   certificates;
-//! * [`continuation`]: following solutions through parameter space, generic over a
-//!   corrector (the problems of [`numerics::problem`]);
+//! * [`continuation`]: the generic engine that follows solutions through parameter
+//!   space, over a corrector (the problems of [`numerics::problem`]); it knows no model;
+//! * [`bifurcation`]: branches of equilibria and periodic solutions with their events,
+//!   branch switching and two-parameter curves, on that engine;
 //! * [`scan`]: parallel parameter scans;
 //! * [`error`] and [`cancel`]: what every layer shares.
 
@@ -15,6 +17,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod bifurcation;
 pub mod cancel;
 pub mod continuation;
 pub mod error;

@@ -1,17 +1,18 @@
 //! Continuation of equilibria (`ballbal.continuation`): branches with events, switching
 //! at a branch point, two-parameter bifurcation curves. Glue only: the core's
-//! `continuation::equilibria` does the work, off the GIL.
+//! `bifurcation::equilibria` does the work, off the GIL.
 
 use crate::continuation::ContinuationArgs;
 use crate::convert::{dispatch, Model, ModelArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
 use crate::tables::equilibrium_dict;
-use ballbal_core::continuation::equilibria::{
+use ballbal_core::bifurcation::equilibria::{
     branch, branch_both_ways, curve, switch, CurveKind, EqBranch, EqCurve, EqOptions, EqSystem,
 };
-use ballbal_core::continuation::event::VOCABULARY;
-use ballbal_core::continuation::{ArcStop, Event};
+use ballbal_core::bifurcation::event::Event;
+use ballbal_core::bifurcation::event::VOCABULARY;
+use ballbal_core::continuation::ArcStop;
 use ballbal_core::equilibria::EquilibriumKind;
 use ballbal_core::model::DiskUnits;
 use ballbal_core::numerics::problem::{Parametric, Problem};
@@ -367,7 +368,7 @@ fn options_checked(m: &Model, args: &ContinuationArgs, range: (f64, f64)) -> PyR
 }
 
 /// The events' vocabulary: `(name, aliases, meaning)` for every event, in the order
-/// the docs list them (the core's `continuation::event::VOCABULARY`).
+/// the docs list them (the core's `bifurcation::event::VOCABULARY`).
 #[pyfunction]
 pub fn event_vocabulary() -> Vec<(&'static str, Vec<&'static str>, &'static str)> {
     VOCABULARY

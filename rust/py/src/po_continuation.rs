@@ -1,12 +1,12 @@
 //! Continuation of periodic solutions in one parameter: `ballbal.continuation.
-//! periodic_branch`'s native half (core: `ballbal_core::analysis::po_branch`).
+//! periodic_branch`'s native half (core: `ballbal_core::bifurcation::po_branch`).
 
 use crate::continuation::ContinuationArgs;
 use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
 use crate::tables::solution_dict;
-use ballbal_core::analysis::po_branch::{
+use ballbal_core::bifurcation::po_branch::{
     periodic_branch as core_branch, periodic_branch_both_ways, PoBranchOptions, PoPoint,
 };
 use ballbal_core::hb::{HbSolution, Status};

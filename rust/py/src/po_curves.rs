@@ -1,12 +1,12 @@
 //! Two-parameter curves of periodic bifurcations: `ballbal.continuation.periodic_curve`'s
-//! native half (core: `ballbal_core::analysis::po_curves`).
+//! native half (core: `ballbal_core::bifurcation::po_curves`).
 
 use crate::continuation::ContinuationArgs;
 use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
 use crate::tables::solution_dict;
-use ballbal_core::analysis::po_curves::{
+use ballbal_core::bifurcation::po_curves::{
     periodic_curve as core_curve, PoCurveKind, PoCurveOptions,
 };
 use ballbal_core::hb::{HbSolution, Status};

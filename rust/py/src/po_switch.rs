@@ -1,12 +1,12 @@
 //! Branch switching entries (`ballbal.continuation.switch`): the core's
-//! `analysis::switch` on a periodic solution (period doubling, branch point) or an
+//! `bifurcation::switch` on a periodic solution (period doubling, branch point) or an
 //! equilibrium (Hopf point), in a named parameter.
 
 use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::CoreResult;
 use crate::run::guarded;
 use crate::tables::solution_dict;
-use ballbal_core::analysis::switch::{
+use ballbal_core::bifurcation::switch::{
     switch_hopf as core_hopf, switch_periodic as core_periodic, Switch, Switched,
 };
 use ballbal_core::Error;

@@ -10,8 +10,5 @@ pub mod family;
 pub mod homotopy;
 pub mod journal;
 pub mod periodic;
-pub mod po_branch;
-pub mod po_curves;
 pub mod record;
 pub mod simulate;
-pub mod switch;

@@ -388,26 +388,39 @@ pub fn point_at<P: Problem + ?Sized>(
     }))
 }
 
-/// Locates a zero of the test function `g` between `a` and the next point `b` of the
-/// same branch (`g(a) = ga`, `g(b) = gb` of opposite signs) by the Illinois variant of
-/// regula falsi on the arclength from `a`, to `|Δs| <= s_tol` or `|g| <= g_tol`.
+/// Two consecutive points `a`, `b` of a branch and a test function's values `ga`, `gb`
+/// there, of opposite signs: where [`locate`] looks for its zero.
+#[derive(Debug, Clone, Copy)]
+pub struct Bracket<'a> {
+    pub a: &'a ArcPoint,
+    pub b: &'a ArcPoint,
+    pub ga: f64,
+    pub gb: f64,
+}
+
+/// How close [`locate`] gets: to an arclength interval of `s` or a test value of `g`.
+#[derive(Debug, Clone, Copy)]
+pub struct Within {
+    pub s: f64,
+    pub g: f64,
+}
+
+/// Locates a zero of the test function `g` inside `bracket` by the Illinois variant of
+/// regula falsi on the arclength from `a`, to `|Δs| <= within.s` or `|g| <= within.g`.
 /// Returns the point and its `g`, or `None` if a corrector fails.
-#[allow(clippy::too_many_arguments)]
 pub fn locate<P, G>(
     problem: &mut P,
-    a: &ArcPoint,
-    b: &ArcPoint,
-    ga: f64,
-    gb: f64,
+    bracket: Bracket<'_>,
     mut g: G,
-    s_tol: f64,
-    g_tol: f64,
+    within: Within,
     opts: &ArcOptions,
 ) -> Result<Option<(ArcPoint, f64)>>
 where
     P: Problem + ?Sized,
     G: FnMut(&mut P, &ArcPoint) -> Result<f64>,
 {
+    let Bracket { a, b, ga, gb } = bracket;
+    let Within { s: s_tol, g: g_tol } = within;
     let (mut s0, mut g0) = (0.0, ga);
     let (mut s1, mut g1) = (b.ds, gb);
     let mut best: Option<(ArcPoint, f64)> = None;
@@ -764,19 +777,16 @@ mod tests {
         assert!(pts.last().unwrap().x[0] < 0.0);
         let (a, b) = (&pts[k], &pts[k + 1]);
         let mut prob = Circle;
-        let (fold, g) = locate(
-            &mut prob,
+        let bracket = Bracket {
             a,
             b,
-            a.dp_ds(),
-            b.dp_ds(),
-            |_, pt| Ok(pt.dp_ds()),
-            1e-12,
-            1e-12,
-            &opts,
-        )
-        .unwrap()
-        .unwrap();
+            ga: a.dp_ds(),
+            gb: b.dp_ds(),
+        };
+        let within = Within { s: 1e-12, g: 1e-12 };
+        let (fold, g) = locate(&mut prob, bracket, |_, pt| Ok(pt.dp_ds()), within, &opts)
+            .unwrap()
+            .unwrap();
         assert!(g.abs() < 1e-9);
         assert!((fold.p - 1.0).abs() < 1e-12 && fold.x[0].abs() < 1e-6);
     }
@@ -860,19 +870,17 @@ mod tests {
         let (a, b) = (&pts[k], &pts[k + 1]);
         let mut prob = Pitchfork;
         // The test function: F_x on the branch (here p - 3 x^2).
-        let (bp, _) = locate(
-            &mut prob,
+        let bracket = Bracket {
             a,
             b,
-            a.p,
-            b.p,
-            |_, pt| Ok(pt.p - 3.0 * pt.x[0] * pt.x[0]),
-            1e-13,
-            1e-13,
-            &opts,
-        )
-        .unwrap()
-        .unwrap();
+            ga: a.p,
+            gb: b.p,
+        };
+        let within = Within { s: 1e-13, g: 1e-13 };
+        let g = |_: &mut Pitchfork, pt: &ArcPoint| Ok(pt.p - 3.0 * pt.x[0] * pt.x[0]);
+        let (bp, _) = locate(&mut prob, bracket, g, within, &opts)
+            .unwrap()
+            .unwrap();
         assert!(bp.p.abs() < 1e-12);
         // Switching with the null direction (x) follows the parabola x^2 = p.
         let mut prob = Pitchfork;

@@ -16,6 +16,9 @@
 //! taken by central differences (minimally augmented systems supply `g` by one bordered
 //! solve, which is what makes this cheap).
 
+use crate::continuation::arclength::{
+    locate, ArcOptions, ArcPoint, ArcStop, Arclength, Bracket, Within,
+};
 use crate::error::{Error, Result};
 use crate::numerics::problem::Problem;
 
@@ -54,7 +57,6 @@ impl<T: TwoParameter + ?Sized, G: FnMut(&mut T, &[f64], [f64; 2]) -> Result<f64>
     }
 }
 
-/// `[F; g] = 0` as a [`Problem`] in `(x, p1)` with parameter `p2`.
 /// One curve from its two halves, continued from the same start backwards and forwards:
 /// the backward points reversed, then the forward ones (the start, first of both, once);
 /// the special points in that order, their `row` (index into the half's points,
@@ -83,6 +85,171 @@ pub fn join_halves<P, C>(
     (points, special)
 }
 
+/// What the bifurcation side supplies to [`curve_half`] along a curve continued as a
+/// [`Problem`] `P` whose unknowns are `(x, p1, ...)` (`x` of [`CurveHook::n`] entries)
+/// with `p2` its parameter: the codimension-two test functions, what a located zero of
+/// one is, and the row kept per point.
+pub trait CurveHook<P: Problem + ?Sized> {
+    /// The row kept per curve point.
+    type Point;
+    /// A located codimension-two point.
+    type Special;
+    /// The size of `x`: `p1` is the unknown after it.
+    fn n(&self) -> usize;
+    /// Why the curve ends at the corrected point `pt` (it is not kept), if it does:
+    /// a window the arclength corrector does not know, a degenerate solution.
+    fn end(&mut self, _problem: &mut P, _pt: &ArcPoint) -> Result<Option<&'static str>> {
+        Ok(None)
+    }
+    /// The labelled scalar tests whose sign changes between two points are
+    /// codimension-two points (the same labels, in the same order, at every point).
+    fn tests(&mut self, problem: &mut P, pt: &ArcPoint) -> Result<Vec<(&'static str, f64)>>;
+    /// The label of a cusp (the curve's direction in the parameter plane reverses), or
+    /// `None` when cusps are not watched.
+    fn cusp(&self) -> Option<&'static str>;
+    /// The codimension-two point at the located zero `e` of test `label` (or a cusp),
+    /// `row` the index of the first point past it; `None` when the zero is not one (a
+    /// neutral saddle on a Hopf test, say).
+    fn special(
+        &mut self,
+        problem: &mut P,
+        label: &'static str,
+        e: &ArcPoint,
+        row: usize,
+    ) -> Result<Option<Self::Special>>;
+    /// The row kept at the corrected point `pt`, with its tests; the last call at a
+    /// point (it may rebase the problem's borders for the next step).
+    fn point(
+        &mut self,
+        problem: &mut P,
+        pt: &ArcPoint,
+        tests: &[(&'static str, f64)],
+    ) -> Result<Self::Point>;
+}
+
+/// One half of a curve (or a whole curve, its halves joined).
+#[derive(Debug, Clone)]
+pub struct CurveHalf<Pt, Sp> {
+    pub points: Vec<Pt>,
+    pub special: Vec<Sp>,
+    /// Why each half ended: towards decreasing, then increasing second parameter (a
+    /// single half reports its own end twice).
+    pub stop: [ArcStop; 2],
+}
+
+/// The one two-parameter curve loop: continues `problem` by pseudo-arclength from `y0`
+/// at `p2` in the direction `opts.forward`, keeps a row per corrected point, and locates
+/// (to arclength `locate_tol`) every codimension-two test's sign change and every cusp
+/// between two points. Errors when not even the start converges.
+pub fn curve_half<P, H>(
+    problem: &mut P,
+    y0: &[f64],
+    p2: f64,
+    opts: &ArcOptions,
+    locate_tol: f64,
+    hook: &mut H,
+) -> Result<CurveHalf<H::Point, H::Special>>
+where
+    P: Problem + ?Sized,
+    H: CurveHook<P>,
+{
+    let n = hook.n();
+    let within = Within {
+        s: locate_tol,
+        g: 0.0,
+    };
+    let mut arc = Arclength::new(problem, y0, p2, None, opts.clone())?;
+    let mut points = vec![];
+    let mut special = vec![];
+    let mut prev: Option<(ArcPoint, Vec<(&'static str, f64)>)> = None;
+    while let Some(pt) = arc.next() {
+        if let Some(why) = hook.end(arc.problem(), &pt)? {
+            arc.finish(why);
+            break;
+        }
+        let tt = hook.tests(arc.problem(), &pt)?;
+        let row = points.len();
+        if let Some((a, ta)) = &prev {
+            for (i, ((label, ga), (_, gb))) in ta.iter().zip(&tt).enumerate() {
+                if ga * gb >= 0.0 {
+                    continue;
+                }
+                let g = |e: &mut P, pt: &ArcPoint| hook.tests(e, pt).map(|v| v[i].1);
+                let bracket = Bracket {
+                    a,
+                    b: &pt,
+                    ga: *ga,
+                    gb: *gb,
+                };
+                let located = locate(arc.problem(), bracket, g, within, opts)?;
+                if let Some((e, _)) = located {
+                    special.extend(hook.special(arc.problem(), label, &e, row)?);
+                }
+            }
+            if let Some(label) = hook.cusp() {
+                // The curve's direction in the parameter plane reverses.
+                let ua = [a.tangent[n], a.tangent[n + 1]];
+                let ub = [pt.tangent[n], pt.tangent[n + 1]];
+                let gb = ub[0] * ua[0] + ub[1] * ua[1];
+                if gb < 0.0 {
+                    let ga = ua[0] * ua[0] + ua[1] * ua[1];
+                    let g = |_: &mut P, pt: &ArcPoint| {
+                        Ok(pt.tangent[n] * ua[0] + pt.tangent[n + 1] * ua[1])
+                    };
+                    let bracket = Bracket { a, b: &pt, ga, gb };
+                    let located = locate(arc.problem(), bracket, g, within, opts)?;
+                    if let Some((e, _)) = located {
+                        special.extend(hook.special(arc.problem(), label, &e, row)?);
+                    }
+                }
+            }
+        }
+        points.push(hook.point(arc.problem(), &pt, &tt)?);
+        prev = Some((pt, tt));
+    }
+    let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
+    if crate::cancel::cancelled() {
+        return Err(Error::Cancelled);
+    }
+    if points.is_empty() {
+        return Err(Error::param(
+            "event",
+            format!(
+                "the curve's start does not converge: {}",
+                ArcStop::text(Some(&stop))
+            ),
+        ));
+    }
+    Ok(CurveHalf {
+        points,
+        special,
+        stop: [stop.clone(), stop],
+    })
+}
+
+/// A whole curve: `half` run towards decreasing, then increasing `p2` (with
+/// `opts.forward` set accordingly), the halves joined by [`join_halves`].
+pub fn both_halves<Pt, Sp>(
+    opts: &ArcOptions,
+    mut half: impl FnMut(&ArcOptions) -> Result<CurveHalf<Pt, Sp>>,
+    row: impl Fn(&mut Sp) -> &mut usize,
+) -> Result<CurveHalf<Pt, Sp>> {
+    let mut o = opts.clone();
+    o.forward = false;
+    let back = half(&o)?;
+    o.forward = true;
+    let fwd = half(&o)?;
+    let stop = [back.stop[1].clone(), fwd.stop[1].clone()];
+    let (points, special) =
+        join_halves((back.points, back.special), (fwd.points, fwd.special), row);
+    Ok(CurveHalf {
+        points,
+        special,
+        stop,
+    })
+}
+
+/// `[F; g] = 0` as a [`Problem`] in `(x, p1)` with parameter `p2`.
 pub struct Extended<T, G> {
     pub system: T,
     pub test: G,

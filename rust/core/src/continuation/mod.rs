@@ -8,17 +8,25 @@
 //! after wave, as the scans do. [`arclength`] (pseudo-arclength continuation) steps
 //! along the branch and lets the parameter follow, through folds; it works over the
 //! [`crate::numerics::problem::Problem`] trait (`jac_x`, `jac_p` give its tangent).
+//! [`curves`] presents a two-parameter curve of a test function's zeros as such a
+//! problem.
+//!
+//! This is the generic engine: it knows no model, no analysis and no bifurcation. It
+//! imports nothing from the crate's analysis, bifurcation, scan or model modules (the
+//! test `engine_imports_no_higher_layer` below holds it to that); the bifurcation layer
+//! and the scans build on it, never the other way.
 
 pub mod arclength;
+pub mod branch;
 pub mod curves;
-pub mod equilibria;
-pub mod event;
 pub mod lattice;
 pub mod natural;
 
-pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
-pub use curves::{Extended, TestFunction, TwoParameter};
-pub use event::Event;
+pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength, Bracket, Within};
+pub use branch::{branch, Branch, Declared, Spectrum, Start};
+pub use curves::{
+    both_halves, curve_half, CurveHalf, CurveHook, Extended, TestFunction, TwoParameter,
+};
 pub use lattice::{waves, Lattice, Tally, Waves};
 pub use natural::{natural_step, Natural, Step};
 
@@ -51,4 +59,46 @@ pub struct BranchPoint<A, P> {
     pub point: P,
     /// Corrector calls spent on this point (failed predictions included).
     pub attempts: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    /// The engine's sources, read at compile time so that the layer rule is checked on
+    /// what is built.
+    const SOURCES: [(&str, &str); 6] = [
+        ("mod.rs", include_str!("mod.rs")),
+        ("arclength.rs", include_str!("arclength.rs")),
+        ("curves.rs", include_str!("curves.rs")),
+        ("lattice.rs", include_str!("lattice.rs")),
+        ("natural.rs", include_str!("natural.rs")),
+        ("branch.rs", include_str!("branch.rs")),
+    ];
+
+    #[test]
+    fn engine_imports_no_higher_layer() {
+        let higher = ["analysis", "bifurcation", "scan", "model"];
+        for (file, text) in SOURCES {
+            // Whatever follows a path from the crate's root on a line (`a::b`, a
+            // `{a, b}` group) is what that line reaches into.
+            for (row, line) in text.lines().enumerate() {
+                for (at, _) in line.match_indices("crate::") {
+                    let path: String = line[at + 7..]
+                        .chars()
+                        .take_while(|c| c.is_alphanumeric() || "_:{}, ".contains(*c))
+                        .collect();
+                    let reached = path
+                        .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                        .filter(|w| !w.is_empty());
+                    for word in reached {
+                        assert!(
+                            !higher.contains(&word),
+                            "continuation/{file}:{} reaches into `{word}`: the engine must not \
+                             know a higher layer",
+                            row + 1
+                        );
+                    }
+                }
+            }
+        }
+    }
 }

@@ -11,7 +11,7 @@ use super::seeding::new_orbit;
 use super::waves::{accept, admit, orbit_key};
 use super::{count, work, Family, Found, Origin, ScanSpec};
 use crate::analysis::periodic::{is_plain, repetitions};
-use crate::analysis::switch::period_doubling_starts;
+use crate::bifurcation::switch::period_doubling_starts;
 use crate::hb::{solve, Status};
 use crate::periodic::finish;
 use rayon::prelude::*;

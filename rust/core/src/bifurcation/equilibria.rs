@@ -26,9 +26,12 @@
 //! the point where it meets the pitchfork.
 
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
-use crate::continuation::arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength};
-use crate::continuation::curves::{join_halves, Extended, TwoParameter};
-use crate::continuation::event::Event;
+use crate::bifurcation::event::Event;
+use crate::continuation::arclength::{point_at, ArcOptions, ArcPoint, ArcStop};
+use crate::continuation::curves::{
+    both_halves, curve_half, join_halves, CurveHook, Extended, TwoParameter,
+};
+use crate::continuation::{self, Declared, Spectrum, Start};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::disk_units::DiskUnits;
@@ -487,131 +490,31 @@ pub struct EqBranch {
     pub stop_back: Option<ArcStop>,
 }
 
-struct Tests {
-    fold: f64,
-    bp: f64,
-    hopf: f64,
-}
-
-fn tests<D: Dynamics + Clone>(
-    sys: &mut EqSystem<'_, D>,
-    pt: &ArcPoint,
-    together: bool,
-) -> Result<Tests> {
-    let q = sys.full(&pt.x);
-    let bp = if together {
-        sys.transverse(&q, &[pt.p])?
-    } else {
-        sys.bordered_det(&pt.x, pt.p, &pt.tangent)?
-    };
-    Ok(Tests {
-        fold: pt.dp_ds(),
-        bp,
-        hopf: sys.hopf_test(&q, &[pt.p])?,
-    })
-}
-
-/// At most this many halvings of one step by [`branch`]'s checks for events hidden
-/// inside it (the step then stands: a check that keeps failing, e.g. on an eigenvalue
-/// that sits on the axis, must not stall the branch).
-const MAX_SPLITS: usize = 6;
-
-/// What [`branch`]'s step control reads of a point's eigenvalues.
-struct Spectrum {
-    /// Eigenvalues with a positive real part (above [`UNSTABLE_TOL`]).
-    unstable: usize,
-    /// The real part of the complex eigenvalue nearest the imaginary axis (NaN without
-    /// one).
-    pair_re: f64,
-}
-
 /// Real parts below this count as on the axis, not unstable: neutral directions of a
 /// family sit at round-off from zero and must not look like crossings.
 const UNSTABLE_TOL: f64 = 1e-7;
 
-impl Spectrum {
-    fn of(eq: &Equilibrium) -> Spectrum {
-        let unstable = eq
-            .eigenvalues
-            .iter()
-            .filter(|(re, _)| *re > UNSTABLE_TOL)
-            .count();
-        let pair_re = eq
-            .eigenvalues
-            .iter()
-            .filter(|(_, im)| im.abs() > UNSTABLE_TOL)
-            .map(|(re, _)| *re)
-            .fold(f64::NAN, |m, re| {
-                if re.abs() < m.abs() || m.is_nan() {
-                    re
-                } else {
-                    m
-                }
-            });
-        Spectrum { unstable, pair_re }
-    }
-
-    fn pair_distance(&self) -> f64 {
-        if self.pair_re.is_nan() {
-            f64::INFINITY
-        } else {
-            self.pair_re.abs()
-        }
-    }
-}
-
-/// Whether the complex pair nearest the axis could cross it and come back inside a step
-/// of arclength `ds` from `a` to `b`. Near its largest value inside the step the real
-/// part is `m - k (s - s*)^2`: an end a distance `d <= ds` from `s*` that is still off
-/// the axis has `|Re| <= k d^2` and slope `2 k d`, so `|Re| <= slope ds / 2`. `rate` is
-/// that slope at `a` from the step before it (the secant); twice `rate ds`, four times
-/// the parabola's bound, allows for the secant's error. Without a step before `a`, the
-/// slope is taken as one (unknowns and parameters are O(1)).
-fn pair_may_return(a: &Spectrum, b: &Spectrum, rate: Option<f64>, ds: f64) -> bool {
-    let reach = rate.map_or(ds.abs(), |r| 2.0 * r * ds.abs());
-    a.pair_distance().max(b.pair_distance()) < reach
-}
-
-/// The rate at which the pair nearest the axis moves over a step of arclength `ds`.
-fn pair_rate(a: &Spectrum, b: &Spectrum, ds: f64) -> Option<f64> {
-    let r = (b.pair_re - a.pair_re).abs() / ds.abs();
-    // a pair appearing or vanishing (NaN) or a zero step: no rate, the O(1) default
-    r.is_finite().then_some(r)
-}
-
-/// Whether the test functions change sign at the step's midpoint though not between
-/// its ends: two zeros (a Hopf point and its return, two folds) inside one step.
-#[allow(clippy::too_many_arguments)]
-fn crossed_twice<D: Dynamics + Clone>(
-    sys: &mut EqSystem<'_, D>,
-    a: &ArcPoint,
-    b: &ArcPoint,
-    ta: &Tests,
-    tb: &Tests,
-    together: bool,
-    opts: &ArcOptions,
-) -> Result<bool> {
-    let Some(m) = point_at(sys, a, 0.5 * b.ds, opts)? else {
-        return Ok(false);
-    };
-    let tm = tests(sys, &m, together)?;
-    let twice = |ga: f64, gm: f64, gb: f64| ga * gb > 0.0 && ga * gm < 0.0;
-    Ok(twice(ta.hopf, tm.hopf, tb.hopf)
-        || twice(ta.fold, tm.fold, tb.fold)
-        || twice(ta.bp, tm.bp, tb.bp))
-}
-
-/// Whether the located events account for the change in the count of unstable
-/// eigenvalues over a step: a Hopf point moves two, a fold or branch point one.
-fn explained(a: &Spectrum, b: &Spectrum, events: &[EqEvent]) -> bool {
-    let moved: usize = events
+/// What the step control reads of an equilibrium's eigenvalues: those with a positive
+/// real part, and the real part of the complex eigenvalue nearest the imaginary axis.
+fn spectrum_of(eq: &Equilibrium) -> Spectrum {
+    let unstable = eq
+        .eigenvalues
         .iter()
-        .map(|e| match e.kind {
-            EventKind::Hopf => 2,
-            EventKind::Fold | EventKind::BranchPoint => 1,
-        })
-        .sum();
-    a.unstable.abs_diff(b.unstable) <= moved
+        .filter(|(re, _)| *re > UNSTABLE_TOL)
+        .count();
+    let pair = eq
+        .eigenvalues
+        .iter()
+        .filter(|(_, im)| im.abs() > UNSTABLE_TOL)
+        .map(|(re, _)| *re)
+        .fold(f64::NAN, |m, re| {
+            if re.abs() < m.abs() || m.is_nan() {
+                re
+            } else {
+                m
+            }
+        });
+    Spectrum { unstable, pair }
 }
 
 fn analyse_at<D: Dynamics + Clone>(
@@ -627,9 +530,170 @@ fn analyse_at<D: Dynamics + Clone>(
     Ok(analyse_model(sys.model(&[p])?, &q, kind, family))
 }
 
+/// The declared tests of an equilibrium branch, in [`EqTests::NAMES`]' order: `dp/ds`
+/// (fold), the branch point's (the bordered determinant, or on the together subspace
+/// the transverse stiffness), the bialternate Hopf test.
+struct EqTests {
+    start: EquilibriumKind,
+    family: bool,
+}
+
+/// A row of an equilibrium branch as the loop keeps it.
+struct EqRow {
+    arc: ArcPoint,
+    /// Whether the point is balls-together (its branch-point test is the transverse
+    /// stiffness).
+    together: bool,
+    point: EqPoint,
+    spectrum: Spectrum,
+}
+
+impl EqTests {
+    const NAMES: [&'static str; 3] = ["fold", "branch_point", "hopf"];
+    const KINDS: [EventKind; 3] = [EventKind::Fold, EventKind::BranchPoint, EventKind::Hopf];
+
+    fn together<D: Dynamics + Clone>(&self, sys: &EqSystem<'_, D>, pt: &ArcPoint) -> bool {
+        kind_of(&sys.full(&pt.x), sys.o, self.start) == EquilibriumKind::Together
+    }
+
+    fn all<D: Dynamics + Clone>(
+        sys: &mut EqSystem<'_, D>,
+        pt: &ArcPoint,
+        together: bool,
+    ) -> Result<[f64; 3]> {
+        let q = sys.full(&pt.x);
+        let bp = if together {
+            sys.transverse(&q, &[pt.p])?
+        } else {
+            sys.bordered_det(&pt.x, pt.p, &pt.tangent)?
+        };
+        Ok([pt.dp_ds(), bp, sys.hopf_test(&q, &[pt.p])?])
+    }
+}
+
+impl<'a, D: Dynamics + Clone> Declared<EqSystem<'a, D>> for EqTests {
+    type Point = EqRow;
+    type Event = EqEvent;
+
+    fn names(&self) -> &'static [&'static str] {
+        &Self::NAMES
+    }
+
+    fn point(&mut self, sys: &mut EqSystem<'a, D>, pt: &ArcPoint) -> Result<EqRow> {
+        let together = self.together(sys, pt);
+        let [fold, bp, hopf] = Self::all(sys, pt, together)?;
+        let eq = analyse_at(sys, &pt.x, pt.p, self.start, self.family)?;
+        let spectrum = spectrum_of(&eq);
+        Ok(EqRow {
+            arc: pt.clone(),
+            together,
+            point: EqPoint {
+                p: pt.p,
+                x: pt.x.clone(),
+                tangent: pt.tangent.clone(),
+                eq,
+                fold,
+                bp,
+                hopf,
+            },
+            spectrum,
+        })
+    }
+
+    fn arc<'p>(&self, row: &'p EqRow) -> &'p ArcPoint {
+        &row.arc
+    }
+
+    fn values(&self, row: &EqRow) -> Vec<Option<f64>> {
+        let p = &row.point;
+        vec![Some(p.fold), Some(p.bp), Some(p.hopf)]
+    }
+
+    fn spectrum(&self, row: &EqRow) -> Option<Spectrum> {
+        Some(row.spectrum)
+    }
+
+    fn value_at(
+        &mut self,
+        sys: &mut EqSystem<'a, D>,
+        a: &EqRow,
+        pt: &ArcPoint,
+        i: usize,
+    ) -> Result<f64> {
+        Ok(Self::all(sys, pt, a.together)?[i])
+    }
+
+    fn values_at(
+        &mut self,
+        sys: &mut EqSystem<'a, D>,
+        b: &EqRow,
+        pt: &ArcPoint,
+    ) -> Result<Vec<Option<f64>>> {
+        Ok(Self::all(sys, pt, b.together)?.map(Some).to_vec())
+    }
+
+    fn comparable(&self, a: &EqRow, b: &EqRow) -> bool {
+        a.together == b.together
+    }
+
+    fn watched(&self, a: &EqRow, b: &EqRow) -> Vec<usize> {
+        let (va, vb) = (
+            <Self as Declared<EqSystem<'a, D>>>::values(self, a),
+            <Self as Declared<EqSystem<'a, D>>>::values(self, b),
+        );
+        // The branch-point function changes with the kind on a switched branch.
+        (0..3)
+            .filter(|&i| i != 1 || a.together == b.together)
+            .filter(|&i| matches!((va[i], vb[i]), (Some(x), Some(y)) if x * y < 0.0))
+            .collect()
+    }
+
+    fn event(
+        &mut self,
+        s: &mut EqSystem<'a, D>,
+        i: usize,
+        e: &ArcPoint,
+        g: f64,
+        row: usize,
+    ) -> Result<Option<EqEvent>> {
+        let kind = Self::KINDS[i];
+        let q = s.full(&e.x);
+        let omega = if kind == EventKind::Hopf {
+            let (kappa, om) = s.critical_pair(&q, &[e.p])?;
+            if kappa <= 0.0 {
+                // a neutral saddle: not a bifurcation
+                return Ok(None);
+            }
+            om
+        } else {
+            f64::NAN
+        };
+        let eq = analyse_at(s, &e.x, e.p, self.start, self.family)?;
+        Ok(Some(EqEvent {
+            kind,
+            row,
+            p: e.p,
+            x: e.x.clone(),
+            tangent: e.tangent.clone(),
+            eq,
+            test: g,
+            omega,
+        }))
+    }
+
+    /// A Hopf point moves two eigenvalues across the axis, a fold or branch point one.
+    fn moves(&self, e: &EqEvent) -> usize {
+        match e.kind {
+            EventKind::Hopf => 2,
+            EventKind::Fold | EventKind::BranchPoint => 1,
+        }
+    }
+}
+
 /// Continues the equilibrium `x0` (full coordinates) at `p0` of the one-parameter
-/// family `sys`, locating folds, Hopf points and branch points between points.
-/// `start` is the start's kind (kinds along the branch are judged by shape, see
+/// family `sys`, locating folds, Hopf points and branch points between points
+/// ([`crate::continuation::branch`], with its step control against events hidden in a
+/// step). `start` is the start's kind (kinds along the branch are judged by shape, see
 /// [`kind_of`]); `direction` (in `(x, p)`) orients the first tangent, as at a switch.
 pub fn branch<D: Dynamics + Clone>(
     sys: &mut EqSystem<'_, D>,
@@ -657,123 +721,18 @@ pub fn branch<D: Dynamics + Clone>(
             ),
         ));
     }
-    let o = sys.o;
-    let arc_opts = opts.arc.clone();
-    let mut arc = Arclength::new(sys, x0, p0, direction, arc_opts.clone())?;
-    let mut points: Vec<EqPoint> = vec![];
-    let mut events: Vec<EqEvent> = vec![];
-    let mut prev: Option<(ArcPoint, Tests, bool, Spectrum, Option<f64>)> = None;
-    let mut splits = 0;
-    while let Some(pt) = arc.next() {
-        let q = arc.problem().full(&pt.x);
-        let together = kind_of(&q, o, start) == EquilibriumKind::Together;
-        let t = tests(arc.problem(), &pt, together)?;
-        let eq = analyse_at(arc.problem(), &pt.x, pt.p, start, opts.family)?;
-        let spectrum = Spectrum::of(&eq);
-        let row = points.len();
-        let mut found_events = vec![];
-        let mut rate = None;
-        if let Some((a, ta, tog_a, sa, rate_a)) = &prev {
-            rate = pair_rate(sa, &spectrum, pt.ds);
-            let may_hide = splits < MAX_SPLITS && *tog_a == together;
-            if may_hide
-                && pair_may_return(sa, &spectrum, *rate_a, pt.ds)
-                && crossed_twice(arc.problem(), a, &pt, ta, &t, together, &arc_opts)?
-                && arc.subdivide()
-            {
-                splits += 1;
-                continue;
-            }
-            let mut found = vec![];
-            if ta.fold * t.fold < 0.0 {
-                found.push(EventKind::Fold);
-            }
-            // The branch-point function changes with the kind on a switched branch.
-            if *tog_a == together && ta.bp * t.bp < 0.0 {
-                found.push(EventKind::BranchPoint);
-            }
-            if ta.hopf * t.hopf < 0.0 {
-                found.push(EventKind::Hopf);
-            }
-            for kind in found {
-                let (ga, gb) = match kind {
-                    EventKind::Fold => (ta.fold, t.fold),
-                    EventKind::BranchPoint => (ta.bp, t.bp),
-                    EventKind::Hopf => (ta.hopf, t.hopf),
-                };
-                let tog = *tog_a;
-                let g = |s: &mut EqSystem<'_, D>, pt: &ArcPoint| -> Result<f64> {
-                    let tt = tests(s, pt, tog)?;
-                    Ok(match kind {
-                        EventKind::Fold => tt.fold,
-                        EventKind::BranchPoint => tt.bp,
-                        EventKind::Hopf => tt.hopf,
-                    })
-                };
-                let Some((e, ge)) = locate(
-                    arc.problem(),
-                    a,
-                    &pt,
-                    ga,
-                    gb,
-                    g,
-                    opts.locate_tol,
-                    0.0,
-                    &arc_opts,
-                )?
-                else {
-                    continue;
-                };
-                let s = arc.problem();
-                let q = s.full(&e.x);
-                let omega = if kind == EventKind::Hopf {
-                    let (kappa, om) = s.critical_pair(&q, &[e.p])?;
-                    if kappa <= 0.0 {
-                        // a neutral saddle: not a bifurcation
-                        continue;
-                    }
-                    om
-                } else {
-                    f64::NAN
-                };
-                let eq = analyse_at(s, &e.x, e.p, start, opts.family)?;
-                found_events.push(EqEvent {
-                    kind,
-                    row,
-                    p: e.p,
-                    x: e.x.clone(),
-                    tangent: e.tangent.clone(),
-                    eq,
-                    test: ge,
-                    omega,
-                });
-            }
-            // Unstable eigenvalues that appear or vanish with no located event to
-            // account for them crossed inside the step (a Hopf pair and its return, or
-            // two pairs at once): the step is taken again in halves.
-            if may_hide && !explained(sa, &spectrum, &found_events) && arc.subdivide() {
-                splits += 1;
-                continue;
-            }
-        }
-        splits = 0;
-        events.extend(found_events);
-        points.push(EqPoint {
-            p: pt.p,
-            x: pt.x.clone(),
-            tangent: pt.tangent.clone(),
-            eq,
-            fold: t.fold,
-            bp: t.bp,
-            hopf: t.hopf,
-        });
-        prev = Some((pt, t, together, spectrum, rate));
-    }
-    let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
-    if crate::cancel::cancelled() {
-        return Err(Error::Cancelled);
-    }
-    if points.is_empty() {
+    let mut tests = EqTests {
+        start,
+        family: opts.family,
+    };
+    let from = Start {
+        x: x0,
+        p: p0,
+        direction,
+    };
+    let run = continuation::branch(sys, from, &opts.arc, opts.locate_tol, &mut tests)?;
+    let stop = run.stop;
+    if run.points.is_empty() {
         return Err(Error::param(
             "start",
             match &stop {
@@ -785,8 +744,8 @@ pub fn branch<D: Dynamics + Clone>(
         ));
     }
     Ok(EqBranch {
-        points,
-        events,
+        points: run.points.into_iter().map(|r| r.point).collect(),
+        events: run.events,
         stop,
         stop_back: None,
     })
@@ -1057,41 +1016,13 @@ fn codim_tests<D: Dynamics + Clone>(
 /// from the start: the rows run from the end reached towards decreasing `p2` to the
 /// end reached towards increasing `p2`.
 pub fn curve<D: Dynamics + Clone>(
-    mut sys: EqSystem<'_, D>,
+    sys: EqSystem<'_, D>,
     kind: CurveKind,
     q: &[f64],
     p1: f64,
     p2: f64,
     opts: &EqOptions,
 ) -> Result<EqCurve> {
-    let mut o = opts.clone();
-    o.arc.forward = false;
-    let back;
-    (back, sys) = curve_half(sys, kind, q, p1, p2, &o)?;
-    o.arc.forward = true;
-    let (fwd, _) = curve_half(sys, kind, q, p1, p2, &o)?;
-    let stop = [back.stop[1].clone(), fwd.stop[1].clone()];
-    let (points, special) = join_halves(
-        (back.points, back.special),
-        (fwd.points, fwd.special),
-        |c: &mut Codim2| &mut c.row,
-    );
-    Ok(EqCurve {
-        kind,
-        points,
-        special,
-        stop,
-    })
-}
-
-fn curve_half<'a, D: Dynamics + Clone>(
-    sys: EqSystem<'a, D>,
-    kind: CurveKind,
-    q: &[f64],
-    p1: f64,
-    p2: f64,
-    opts: &EqOptions,
-) -> Result<(EqCurve, EqSystem<'a, D>)> {
     if kind == CurveKind::Pitchfork && !sys.reduced {
         return Err(Error::param(
             "event",
@@ -1137,113 +1068,115 @@ fn curve_half<'a, D: Dynamics + Clone>(
         ));
     }
     ext.test.scale = 1.0 / grad2.sqrt();
-    let arc_opts = opts.arc.clone();
-    let mut arc = Arclength::new(&mut ext, &y0, p2, None, arc_opts.clone())?;
-    let mut points: Vec<CurvePoint> = vec![];
-    let mut special: Vec<Codim2> = vec![];
-    let mut prev: Option<(ArcPoint, Vec<(&'static str, f64)>)> = None;
-    while let Some(pt) = arc.next() {
-        let s = &mut arc.problem().system;
+    let mut hook = EqCurveHook {
+        kind,
+        n,
+        family: opts.family,
+    };
+    let whole = both_halves(
+        &opts.arc,
+        |arc| curve_half(&mut ext, &y0, p2, arc, opts.locate_tol, &mut hook),
+        |c: &mut Codim2| &mut c.row,
+    )?;
+    Ok(EqCurve {
+        kind,
+        points: whole.points,
+        special: whole.special,
+        stop: whole.stop,
+    })
+}
+
+/// The equilibrium side of the curve loop: codimension-two tests, their located points
+/// (a Hopf test's zero told apart into Bogdanov–Takens, zero-Hopf or neither), and each
+/// point's equilibrium with its stability.
+struct EqCurveHook {
+    kind: CurveKind,
+    n: usize,
+    family: bool,
+}
+
+type EqExtended<'a, D> = Extended<EqSystem<'a, D>, CurveTest>;
+
+impl<'a, D: Dynamics + Clone> CurveHook<EqExtended<'a, D>> for EqCurveHook {
+    type Point = CurvePoint;
+    type Special = Codim2;
+
+    fn n(&self) -> usize {
+        self.n
+    }
+
+    fn tests(
+        &mut self,
+        e: &mut EqExtended<'a, D>,
+        pt: &ArcPoint,
+    ) -> Result<Vec<(&'static str, f64)>> {
+        let n = self.n;
+        codim_tests(self.kind, &mut e.system, &pt.x[..n], [pt.x[n], pt.p])
+    }
+
+    fn cusp(&self) -> Option<&'static str> {
+        Some("cusp")
+    }
+
+    fn special(
+        &mut self,
+        e: &mut EqExtended<'a, D>,
+        label: &'static str,
+        at: &ArcPoint,
+        row: usize,
+    ) -> Result<Option<Codim2>> {
+        let n = self.n;
+        let s = &mut e.system;
+        let q = s.full(&at.x[..n]);
+        let p = [at.x[n], at.p];
+        let label = match label {
+            "hopf_test" => {
+                // the located zero of the Hopf test on a fold / pitchfork curve:
+                // a double zero, a zero-Hopf point, or a neutral saddle (none)
+                let (kappa, _) = s.critical_pair(&q, &p)?;
+                let a = s.state(&q, &p)?;
+                let ev = eigenvalues(&a, 2 * s.d).unwrap_or_default();
+                let scale = ev.iter().map(|z| z.0.hypot(z.1)).fold(1.0, f64::max);
+                let zeros = ev.iter().filter(|z| z.0.hypot(z.1) < 1e-5 * scale).count();
+                if zeros >= 2 {
+                    // Two zero eigenvalues with a two-dimensional kernel of K are two
+                    // simultaneous zero-eigenvalue bifurcations, not a Bogdanov–Takens
+                    // point (a Jordan block, a one-dimensional kernel): where the
+                    // together branch's fold meets its pitchfork the second zero belongs
+                    // to the antisymmetric ball mode, and the curve's other test flags
+                    // the point.
+                    let (k, _, _) = s.kcm(&q, &p)?;
+                    if kernel_dim(&k, s.d) >= 2 {
+                        return Ok(None);
+                    }
+                    "BT"
+                } else if kappa > 0.0 {
+                    "ZH"
+                } else {
+                    return Ok(None);
+                }
+            }
+            other => other,
+        };
+        Ok(Some(Codim2 {
+            kind: label,
+            p,
+            q,
+            row,
+        }))
+    }
+
+    fn point(
+        &mut self,
+        e: &mut EqExtended<'a, D>,
+        pt: &ArcPoint,
+        _tests: &[(&'static str, f64)],
+    ) -> Result<CurvePoint> {
+        let n = self.n;
         let p = [pt.x[n], pt.p];
-        let tt = codim_tests(kind, s, &pt.x[..n], p)?;
-        let row = points.len();
-        if let Some((a, ta)) = &prev {
-            let mut found: Vec<(usize, f64, f64)> = vec![];
-            for (i, ((_, ga), (_, gb))) in ta.iter().zip(&tt).enumerate() {
-                if ga * gb < 0.0 {
-                    found.push((i, *ga, *gb));
-                }
-            }
-            for (i, ga, gb) in found {
-                let label = tt[i].0;
-                let g = |e: &mut Extended<EqSystem<'_, D>, CurveTest>, pt: &ArcPoint| {
-                    codim_tests(kind, &mut e.system, &pt.x[..n], [pt.x[n], pt.p]).map(|v| v[i].1)
-                };
-                if let Some((e, _)) = locate(
-                    arc.problem(),
-                    a,
-                    &pt,
-                    ga,
-                    gb,
-                    g,
-                    opts.locate_tol,
-                    0.0,
-                    &arc_opts,
-                )? {
-                    let s = &mut arc.problem().system;
-                    let q = s.full(&e.x[..n]);
-                    let label = match label {
-                        "hopf_test" => {
-                            // the located zero of the Hopf test on a fold / pitchfork curve:
-                            // a double zero, a zero-Hopf point, or a neutral saddle (none)
-                            let (kappa, _) = s.critical_pair(&q, &[e.x[n], e.p])?;
-                            let a = s.state(&q, &[e.x[n], e.p])?;
-                            let ev = eigenvalues(&a, 2 * s.d).unwrap_or_default();
-                            let scale = ev.iter().map(|z| z.0.hypot(z.1)).fold(1.0, f64::max);
-                            let zeros = ev.iter().filter(|z| z.0.hypot(z.1) < 1e-5 * scale).count();
-                            if zeros >= 2 {
-                                // Two zero eigenvalues with a two-dimensional kernel of K
-                                // are two simultaneous zero-eigenvalue bifurcations, not a
-                                // Bogdanov–Takens point (a Jordan block, a one-dimensional
-                                // kernel): where the together branch's fold meets its
-                                // pitchfork the second zero belongs to the antisymmetric
-                                // ball mode, and the curve's other test flags the point.
-                                let (k, _, _) = s.kcm(&q, &[e.x[n], e.p])?;
-                                if kernel_dim(&k, s.d) >= 2 {
-                                    continue;
-                                }
-                                "BT"
-                            } else if kappa > 0.0 {
-                                "ZH"
-                            } else {
-                                continue;
-                            }
-                        }
-                        other => other,
-                    };
-                    special.push(Codim2 {
-                        kind: label,
-                        p: [e.x[n], e.p],
-                        q,
-                        row,
-                    });
-                }
-            }
-            // A cusp: the curve's direction in the parameter plane reverses.
-            let (ua, ub) = (
-                [a.tangent[n], a.tangent[n + 1]],
-                [pt.tangent[n], pt.tangent[n + 1]],
-            );
-            if ua[0] * ub[0] + ua[1] * ub[1] < 0.0 {
-                let g = |_: &mut Extended<EqSystem<'_, D>, CurveTest>, pt: &ArcPoint| {
-                    Ok(pt.tangent[n] * ua[0] + pt.tangent[n + 1] * ua[1])
-                };
-                let gb = ub[0] * ua[0] + ub[1] * ua[1];
-                let ga = ua[0] * ua[0] + ua[1] * ua[1];
-                if let Some((e, _)) = locate(
-                    arc.problem(),
-                    a,
-                    &pt,
-                    ga,
-                    gb,
-                    g,
-                    opts.locate_tol,
-                    0.0,
-                    &arc_opts,
-                )? {
-                    let q = arc.problem().system.full(&e.x[..n]);
-                    special.push(Codim2 {
-                        kind: "cusp",
-                        p: [e.x[n], e.p],
-                        q,
-                        row,
-                    });
-                }
-            }
-        }
-        let s = &mut arc.problem().system;
+        let s = &mut e.system;
         let q = s.full(&pt.x[..n]);
-        let omega = if kind == CurveKind::Hopf {
+        let omega = if self.kind == CurveKind::Hopf {
             s.critical_pair(&q, &p)?.1
         } else {
             f64::NAN
@@ -1254,31 +1187,10 @@ fn curve_half<'a, D: Dynamics + Clone>(
             kind_of(&q, s.o, EquilibriumKind::Unbalanced)
         };
         let k = kind_of(&q, s.o, start_kind);
-        let eq = analyse_model(s.model(&p)?, &q, k, opts.family);
-        let g = raw_curve_test(kind, s, &pt.x[..n], &p)? * arc.problem().test.scale;
-        points.push(CurvePoint { p, q, eq, omega, g });
-        prev = Some((pt, tt));
+        let eq = analyse_model(s.model(&p)?, &q, k, self.family);
+        let g = raw_curve_test(self.kind, s, &pt.x[..n], &p)? * e.test.scale;
+        Ok(CurvePoint { p, q, eq, omega, g })
     }
-    let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
-    if crate::cancel::cancelled() {
-        return Err(Error::Cancelled);
-    }
-    if points.is_empty() {
-        return Err(Error::param(
-            "event",
-            format!("the curve's start does not converge: {stop:?}"),
-        ));
-    }
-    drop(arc);
-    Ok((
-        EqCurve {
-            kind,
-            points,
-            special,
-            stop: [stop.clone(), stop],
-        },
-        ext.system,
-    ))
 }
 
 #[cfg(test)]

@@ -22,16 +22,17 @@
 //!   harmonics cannot follow it: the branch ends when omega falls below `min_omega`, or
 //!   when a point fails its certificate while omega is falling. That point is not
 //!   kept; `p*` is fitted on the last three kept points as `T = C / sqrt|p - p*| + D`
-//!   (the constant `D`, the time spent away from the bottleneck, matters: without it,
-//!   `omega^2` linear in `p` through the last two points, `p*` at the standard point was
-//!   1.4e-3 short of the saddle-node's closed form, ten times the fit's error).
+//!   (the constant `D`, the time spent away from the bottleneck, matters: without it the
+//!   fitted `p*` falls short of the saddle-node's closed form by far more than the fit's
+//!   error; docs/measurements.md, "Continuation and bifurcation", has the numbers).
 //!
 //! Every test function is continuous along the branch and changes sign exactly at its
 //! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
 //! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
 
+use crate::bifurcation::event::Event;
 use crate::continuation::curves::join_halves;
-use crate::continuation::{locate, ArcOptions, ArcPoint, ArcStop, Arclength, Event};
+use crate::continuation::{self, ArcOptions, ArcPoint, ArcStop, Declared, Spectrum, Start};
 use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
@@ -286,19 +287,23 @@ fn bordered_det<P: Problem + ?Sized>(prob: &mut P, pt: &ArcPoint, w: &[f64]) -> 
     Ok(m.lu().determinant())
 }
 
-/// `(bp, pd, ns, complex pairs)` from the multipliers, the trivial one (closest to 1)
-/// left out. Each factor is divided by a positive scale so that strongly unstable orbits
-/// (moduli up to 1e7) keep the products in range.
-fn multiplier_tests(m: &[(f64, f64)]) -> (f64, f64, f64, usize) {
-    let trivial = m
-        .iter()
+/// The index of the trivial multiplier (the one closest to 1; `usize::MAX` without any).
+fn trivial_index(m: &[(f64, f64)]) -> usize {
+    m.iter()
         .enumerate()
         .min_by(|a, b| {
             let da = (a.1 .0 - 1.0).hypot(a.1 .1);
             let db = (b.1 .0 - 1.0).hypot(b.1 .1);
             da.total_cmp(&db)
         })
-        .map_or(usize::MAX, |(i, _)| i);
+        .map_or(usize::MAX, |(i, _)| i)
+}
+
+/// `(bp, pd, ns, complex pairs)` from the multipliers, the trivial one (closest to 1)
+/// left out. Each factor is divided by a positive scale so that strongly unstable orbits
+/// (moduli up to 1e7) keep the products in range.
+fn multiplier_tests(m: &[(f64, f64)]) -> (f64, f64, f64, usize) {
+    let trivial = trivial_index(m);
     let (mut bp, mut pd, mut ns) = ((1.0, 0.0), (1.0, 0.0), 1.0);
     let mut pairs = 0;
     let mul = |a: (f64, f64), b: (f64, f64)| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
@@ -427,31 +432,196 @@ pub fn periodic_branch<D: Parametric>(
             .filter(|w| w.len() == n1)
             .unwrap_or_else(|| vec![1.0; n1]),
     };
-    let mut arc = Arclength::new(&mut prob, &first.unknowns(), p0, None, opts.arc.clone())?;
-    let mut points: Vec<PoPoint> = Vec::new();
-    let mut events: Vec<PoEvent> = Vec::new();
-    while let Some(pt) = arc.next() {
-        let mut po = ctx.point(arc.problem(), &pt)?;
-        let certified = po.result.sol.status == Status::Converged;
-        if let Some(prev) = points.last() {
-            let falling = po.omega() < prev.omega();
-            if po.omega() < opts.min_omega || (!certified && falling) {
-                events.push(infinite_period(&points));
-                arc.finish("infinite_period");
-                break;
-            }
-            let found = between(arc.problem(), &ctx, prev, &po, opts, points.len())?;
-            po.events = found.iter().map(|e| e.kind).collect();
-            events.extend(found);
-        }
-        points.push(po);
-    }
-    let stop = ArcStop::text(arc.stop());
+    let mut tests = PoTestsDeclared {
+        ctx,
+        min_omega: opts.min_omega,
+    };
+    let x0 = first.unknowns();
+    let from = Start {
+        x: &x0,
+        p: p0,
+        direction: None,
+    };
+    let run = continuation::branch(&mut prob, from, &opts.arc, opts.event_tol, &mut tests)?;
     Ok(PoBranch {
-        points,
-        events,
-        stop,
+        points: run.points,
+        events: run.events,
+        stop: ArcStop::text(Some(&run.stop)),
     })
+}
+
+/// Multipliers farther than this outside the unit circle count as unstable (a
+/// multiplier on the circle, a family's neutral direction, sits at the monodromy's
+/// error from it and must not look like a crossing).
+const UNSTABLE_MULTIPLIER: f64 = 1e-6;
+
+/// What the step control reads of a point's multipliers (the trivial one, nearest 1,
+/// left out): those outside the unit circle, and the modulus minus one of the complex
+/// pair nearest it.
+fn multiplier_spectrum(m: &[(f64, f64)]) -> Spectrum {
+    let trivial = trivial_index(m);
+    let others = m.iter().enumerate().filter(|(i, _)| *i != trivial);
+    let unstable = others
+        .clone()
+        .filter(|(_, z)| z.0.hypot(z.1) > 1.0 + UNSTABLE_MULTIPLIER)
+        .count();
+    let pair = others
+        .filter(|(_, z)| z.1.abs() > 1e-9 * z.0.hypot(z.1).max(1.0))
+        .map(|(_, z)| z.0.hypot(z.1) - 1.0)
+        .fold(f64::NAN, |m, d| {
+            if d.abs() < m.abs() || m.is_nan() {
+                d
+            } else {
+                m
+            }
+        });
+    Spectrum { unstable, pair }
+}
+
+/// The declared tests of a periodic branch, in [`PoTestsDeclared::NAMES`]' order: `dp/ds`
+/// (fold), the bordered determinant (branch point), and on the multipliers: period
+/// doubling, Neimark–Sacker, and a real multiplier through +1 that neither of the first
+/// two explains (branch point).
+struct PoTestsDeclared<'a, D> {
+    ctx: Ctx<'a, D>,
+    min_omega: f64,
+}
+
+impl<D> PoTestsDeclared<'_, D> {
+    const NAMES: [&'static str; 5] = [
+        "fold",
+        "branch_point",
+        "period_doubling",
+        "neimark_sacker",
+        "branch_point_multipliers",
+    ];
+    const KINDS: [PoEventKind; 5] = [
+        PoEventKind::Fold,
+        PoEventKind::BranchPoint,
+        PoEventKind::PeriodDoubling,
+        PoEventKind::NeimarkSacker,
+        PoEventKind::BranchPoint,
+    ];
+}
+
+fn po_values(t: &PoTests) -> Vec<Option<f64>> {
+    vec![Some(t.lp), Some(t.bp), t.pd, t.ns, t.bp_multipliers]
+}
+
+impl<D: Parametric, P: Problem + ?Sized> Declared<P> for PoTestsDeclared<'_, D> {
+    type Point = PoPoint;
+    type Event = PoEvent;
+
+    fn names(&self) -> &'static [&'static str] {
+        &Self::NAMES
+    }
+
+    fn point(&mut self, prob: &mut P, pt: &ArcPoint) -> Result<PoPoint> {
+        self.ctx.point(prob, pt)
+    }
+
+    fn arc<'p>(&self, point: &'p PoPoint) -> &'p ArcPoint {
+        &point.arc
+    }
+
+    fn values(&self, point: &PoPoint) -> Vec<Option<f64>> {
+        po_values(&point.tests)
+    }
+
+    fn spectrum(&self, point: &PoPoint) -> Option<Spectrum> {
+        point.multipliers().map(multiplier_spectrum)
+    }
+
+    fn value_at(&mut self, prob: &mut P, _a: &PoPoint, pt: &ArcPoint, i: usize) -> Result<f64> {
+        match i {
+            0 => Ok(pt.dp_ds()),
+            1 => bordered_det(prob, pt, &self.ctx.w),
+            // Multiplier test functions: evaluated (monodromy or Hill) at each trial point.
+            _ => {
+                let r = self.ctx.trial(pt)?;
+                let m = match (&r.floquet, &r.hill) {
+                    (Some(f), _) => f.multipliers.clone(),
+                    (None, Some((m, _))) => m.clone(),
+                    _ => return Ok(f64::NAN),
+                };
+                let t = multiplier_tests(&m);
+                Ok([t.1, t.2, t.0][i - 2])
+            }
+        }
+    }
+
+    fn values_at(&mut self, prob: &mut P, b: &PoPoint, pt: &ArcPoint) -> Result<Vec<Option<f64>>> {
+        let mut v = vec![Some(pt.dp_ds()), Some(bordered_det(prob, pt, &self.ctx.w)?)];
+        let r = self.ctx.trial(pt)?;
+        let m = match (&r.floquet, &r.hill) {
+            (Some(f), _) => Some(&f.multipliers),
+            (None, Some((m, _))) => Some(m),
+            _ => None,
+        };
+        match m.map(|m| multiplier_tests(m)) {
+            Some(t) => {
+                // The Neimark–Sacker product compares only across the same pairs.
+                let ns = (t.3 == b.tests.complex_pairs).then_some(t.2);
+                v.extend([Some(t.1), ns, Some(t.0)]);
+            }
+            None => v.extend([None, None, None]),
+        }
+        Ok(v)
+    }
+
+    fn watched(&self, a: &PoPoint, b: &PoPoint) -> Vec<usize> {
+        let (va, vb) = (po_values(&a.tests), po_values(&b.tests));
+        let changes = |i: usize| matches!((va[i], vb[i]), (Some(x), Some(y)) if x * y < 0.0);
+        let (fold, det_flip) = (changes(0), changes(1));
+        let same_pairs = a.tests.complex_pairs == b.tests.complex_pairs;
+        (0..5)
+            .filter(|&i| changes(i))
+            .filter(|&i| i != 3 || same_pairs)
+            .filter(|&i| i != 4 || !(fold || det_flip))
+            .collect()
+    }
+
+    fn event(
+        &mut self,
+        prob: &mut P,
+        i: usize,
+        e: &ArcPoint,
+        g: f64,
+        row: usize,
+    ) -> Result<Option<PoEvent>> {
+        Ok(Some(PoEvent {
+            kind: Self::KINDS[i],
+            p: e.p,
+            point: self.ctx.point(prob, e)?,
+            test: g,
+            index: row,
+        }))
+    }
+
+    /// A Neimark–Sacker pair moves two multipliers across the circle, the others one.
+    fn moves(&self, e: &PoEvent) -> usize {
+        match e.kind {
+            PoEventKind::NeimarkSacker => 2,
+            _ => 1,
+        }
+    }
+
+    fn end(&mut self, points: &[PoPoint], b: &PoPoint) -> Option<(&'static str, Option<PoEvent>)> {
+        let prev = points.last()?;
+        let certified = b.result.sol.status == Status::Converged;
+        let falling = b.omega() < prev.omega();
+        (b.omega() < self.min_omega || (!certified && falling))
+            .then(|| ("infinite_period", Some(infinite_period(points))))
+    }
+
+    /// Events in the order the branch meets them, noted on the row that follows them.
+    fn settle(&mut self, a: &PoPoint, b: &mut PoPoint, events: &mut Vec<PoEvent>) {
+        events.sort_by(|x, y| {
+            let s = |e: &PoEvent| (e.p - a.p).abs();
+            s(x).total_cmp(&s(y))
+        });
+        b.events = events.iter().map(|e| e.kind).collect();
+    }
 }
 
 /// The `IP` event: `p*` from the last three points kept, fitted as
@@ -533,129 +703,6 @@ fn snic_fit(pts: [(f64, f64); 3]) -> Option<f64> {
     (c > 0.0 && ps.is_finite()).then_some(ps)
 }
 
-/// Events between consecutive points `a` and `b` (`b` will have row `index`).
-fn between<P: Problem + ?Sized, D: Parametric>(
-    prob: &mut P,
-    ctx: &Ctx<'_, D>,
-    a: &PoPoint,
-    b: &PoPoint,
-    opts: &PoBranchOptions,
-    index: usize,
-) -> Result<Vec<PoEvent>> {
-    let mut out = Vec::new();
-    let tol = opts.event_tol;
-    let changes = |x: f64, y: f64| x * y < 0.0;
-    let fold = changes(a.tests.lp, b.tests.lp);
-    let det_flip = changes(a.tests.bp, b.tests.bp);
-    let mut push =
-        |prob: &mut P, kind: PoEventKind, found: Option<(ArcPoint, f64)>| -> Result<()> {
-            if let Some((pt, g)) = found {
-                let point = ctx.point(prob, &pt)?;
-                out.push(PoEvent {
-                    kind,
-                    p: pt.p,
-                    point,
-                    test: g,
-                    index,
-                });
-            }
-            Ok(())
-        };
-    if fold {
-        let f = locate(
-            prob,
-            &a.arc,
-            &b.arc,
-            a.tests.lp,
-            b.tests.lp,
-            |_, pt| Ok(pt.dp_ds()),
-            tol,
-            0.0,
-            &opts.arc,
-        )?;
-        push(prob, PoEventKind::Fold, f)?;
-    }
-    if det_flip {
-        let f = locate(
-            prob,
-            &a.arc,
-            &b.arc,
-            a.tests.bp,
-            b.tests.bp,
-            |pr, pt| bordered_det(pr, pt, &ctx.w),
-            tol,
-            0.0,
-            &opts.arc,
-        )?;
-        push(prob, PoEventKind::BranchPoint, f)?;
-    }
-    // Multiplier test functions: evaluated (monodromy or Hill) at each trial point.
-    let on_multipliers = |which: usize| {
-        move |_: &mut P, pt: &ArcPoint| -> Result<f64> {
-            let r = ctx.trial(pt)?;
-            let m = match (&r.floquet, &r.hill) {
-                (Some(f), _) => f.multipliers.clone(),
-                (None, Some((m, _))) => m.clone(),
-                _ => return Ok(f64::NAN),
-            };
-            let t = multiplier_tests(&m);
-            Ok([t.0, t.1, t.2][which])
-        }
-    };
-    let pair = |x: Option<f64>, y: Option<f64>| x.zip(y).filter(|(x, y)| changes(*x, *y));
-    if let Some((ga, gb)) = pair(a.tests.pd, b.tests.pd) {
-        let f = locate(
-            prob,
-            &a.arc,
-            &b.arc,
-            ga,
-            gb,
-            on_multipliers(1),
-            tol,
-            0.0,
-            &opts.arc,
-        )?;
-        push(prob, PoEventKind::PeriodDoubling, f)?;
-    }
-    if a.tests.complex_pairs == b.tests.complex_pairs {
-        if let Some((ga, gb)) = pair(a.tests.ns, b.tests.ns) {
-            let f = locate(
-                prob,
-                &a.arc,
-                &b.arc,
-                ga,
-                gb,
-                on_multipliers(2),
-                tol,
-                0.0,
-                &opts.arc,
-            )?;
-            push(prob, PoEventKind::NeimarkSacker, f)?;
-        }
-    }
-    if !fold && !det_flip {
-        if let Some((ga, gb)) = pair(a.tests.bp_multipliers, b.tests.bp_multipliers) {
-            let f = locate(
-                prob,
-                &a.arc,
-                &b.arc,
-                ga,
-                gb,
-                on_multipliers(0),
-                tol,
-                0.0,
-                &opts.arc,
-            )?;
-            push(prob, PoEventKind::BranchPoint, f)?;
-        }
-    }
-    out.sort_by(|x, y| {
-        let s = |e: &PoEvent| (e.p - a.p).abs();
-        s(x).total_cmp(&s(y))
-    });
-    Ok(out)
-}
-
 /// `Err` naming `start` unless it is a periodic solution of `base`'s shape with a
 /// positive frequency and finite coefficients.
 pub(crate) fn check_start<D: crate::Dynamics + ?Sized>(base: &D, start: &HbSolution) -> Result<()> {
@@ -685,14 +732,19 @@ pub(crate) fn branch_options(periodic: &PeriodicOptions) -> (PeriodicOptions, us
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::floquet::FloquetOptions;
     use crate::hb::HbOptions;
     use crate::periodic::periodic;
     use crate::Planar;
 
-    pub(super) fn opts(n: usize, lo: f64, hi: f64, forward: bool) -> PoBranchOptions {
+    pub(in crate::bifurcation) fn opts(
+        n: usize,
+        lo: f64,
+        hi: f64,
+        forward: bool,
+    ) -> PoBranchOptions {
         PoBranchOptions {
             arc: ArcOptions {
                 ds: 0.02,
@@ -752,7 +804,7 @@ mod tests {
         assert!(ns(0.9).1 > 0.0 && ns(1.1).1 > 0.0);
     }
 
-    /// The thesis' standard R-R orbit continued up in Omega: every point's residual is
+    /// Tien's (2011) standard R-R orbit continued up in Omega: every point's residual is
     /// Newton's, and a point re-solved by `periodic()` at its Omega gives the same omega.
     #[test]
     fn branch_points_are_solutions_of_periodic() {
@@ -810,81 +862,5 @@ mod tests {
             name(periodic_branch(&p, "Omega", &start.sol, &o2)),
             "min_omega"
         );
-    }
-}
-
-#[cfg(test)]
-mod explore {
-    use super::tests::opts;
-    use super::*;
-    use crate::periodic::periodic;
-    use crate::Planar;
-
-    /// Measurement: `cargo test --release -p ballbal-core explore_branch -- --ignored
-    /// --nocapture`.
-    #[test]
-    #[ignore]
-    fn explore_branch() {
-        let zb: f64 = std::env::var("ZB")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(0.05);
-        let eta: f64 = std::env::var("ETA")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(1.0);
-        let om: f64 = std::env::var("OM")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(1.2);
-        let fwd = std::env::var("FWD").as_deref() != Ok("0");
-        let n: usize = std::env::var("N")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(8);
-        let p = Planar::new(0.2, 0.05, &[zb], 50.0, om, &[eta, eta]).unwrap();
-        let mut o = opts(n, 0.5, 3.0, fwd);
-        o.arc.max_points = 400;
-        let start = periodic(&p, &[true, true], None, &o.periodic);
-        println!("start {:?} omega {}", start.sol.status, start.sol.omega);
-        let t = std::time::Instant::now();
-        let b = periodic_branch(&p, "Omega", &start.sol, &o).unwrap();
-        println!(
-            "{} points in {:?}, stop {}",
-            b.points.len(),
-            t.elapsed(),
-            b.stop
-        );
-        for pt in &b.points {
-            let m = pt.multipliers().map(|m| {
-                m.iter()
-                    .map(|z| format!("{:.3}{:+.3}i", z.0, z.1))
-                    .collect::<Vec<_>>()
-                    .join(" ")
-            });
-            println!(
-                "p={:.6} w={:.5} {} {} lp={:+.2e} bp={:+.2e} pd={:?} ns={:?} ev={:?} | {}",
-                pt.p,
-                pt.omega(),
-                pt.result.sol.status.as_str(),
-                pt.stability().as_str(),
-                pt.tests.lp,
-                pt.tests.bp,
-                pt.tests.pd.map(|v| (v * 1e3).round() / 1e3),
-                pt.tests.ns.map(|v| (v * 1e3).round() / 1e3),
-                pt.events,
-                m.unwrap_or_default()
-            );
-        }
-        for e in &b.events {
-            println!(
-                "EVENT {} p={:.9} test={:.3e} idx={} w={}",
-                e.kind.as_str(),
-                e.p,
-                e.test,
-                e.index,
-                e.point.omega()
-            );
-        }
     }
 }

@@ -20,7 +20,8 @@
 //! finds by itself.
 
 use crate::analysis::periodic::{finish_on_branch, Periodic, PeriodicOptions};
-use crate::continuation::{point_at, ArcOptions, ArcPoint, Event};
+use crate::bifurcation::event::Event;
+use crate::continuation::{point_at, ArcOptions, ArcPoint};
 use crate::error::{Error, Result};
 use crate::floquet::{merged_pair, monodromy, FloquetOptions};
 use crate::hb::{default_samples, fit_coefficients, HbProblem, HbSolution, Status};
@@ -278,19 +279,32 @@ fn critical_mode<D: Dynamics + ?Sized>(
     }
 }
 
+/// Where a new branch leaves the known one: the known solution `base` written in the
+/// new branch's unknowns, the direction `dir` it leaves in, how far to step
+/// (`amplitude`), and the critical multiplier (or eigenvalue) that marks the point.
+struct Departure<'a> {
+    base: &'a HbSolution,
+    dir: Vec<f64>,
+    amplitude: f64,
+    critical: (f64, f64),
+}
+
 /// Corrects along `dir` at distance `amplitude` (halved up to 4 times when the
-/// corrector fails) and finishes the solution at the parameter found.
-#[allow(clippy::too_many_arguments)]
+/// corrector fails) and finishes the solution at the parameter found; `accept` refuses
+/// a solution that is the known branch again.
 fn step_off<D: Parametric>(
     model: &D,
     name: &str,
-    base: &HbSolution,
-    dir: Vec<f64>,
-    amplitude: f64,
+    leave: Departure<'_>,
     opts: &PeriodicOptions,
-    critical: (f64, f64),
     accept: impl Fn(&HbSolution) -> bool,
 ) -> Result<Switched> {
+    let Departure {
+        base,
+        dir,
+        amplitude,
+        critical,
+    } = leave;
     crate::error::check_range("amplitude", amplitude, 0.0, true, 10.0, false)?;
     let p0 = model.param_value(name)?;
     let samples = default_samples(base.n_harm);
@@ -381,22 +395,27 @@ pub fn switch_periodic<D: Parametric>(
     let o = model.first_ball();
     match kind {
         Switch::PeriodDoubling => {
-            step_off(model, name, &base, dir, amplitude, opts, (lam, 0.0), |s| {
+            let leave = Departure {
+                base: &base,
+                dir,
+                amplitude,
+                critical: (lam, 0.0),
+            };
+            step_off(model, name, leave, opts, |s| {
                 !crate::analysis::periodic::repeats(s, 2)
             })
         }
         Switch::BranchPoint => {
             let merged = merged_pair(sol, o).is_some();
-            step_off(
-                model,
-                name,
-                &base,
+            let leave = Departure {
+                base: &base,
                 dir,
                 amplitude,
-                opts,
-                (lam, 0.0),
-                move |s| !merged || merged_pair(s, o).is_none(),
-            )
+                critical: (lam, 0.0),
+            };
+            step_off(model, name, leave, opts, move |s| {
+                !merged || merged_pair(s, o).is_none()
+            })
         }
     }
 }
@@ -526,7 +545,13 @@ pub fn switch_hopf<D: Parametric>(
         dir[j * l + 2] = -vi[j];
     }
     let base = HbSolution::start(lam.1, coeffs, vec![0.0; d], n_harm, Status::NoGuess);
-    step_off(model, name, &base, dir, amplitude, opts, lam, |s| {
+    let leave = Departure {
+        base: &base,
+        dir,
+        amplitude,
+        critical: lam,
+    };
+    step_off(model, name, leave, opts, |s| {
         // Not the equilibrium again: a first harmonic in some coordinate.
         (0..d).any(|j| s.coord(j)[1].hypot(s.coord(j)[2]) > 1e-9)
     })
