@@ -1,6 +1,6 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
-from . import basins, bearing, continuation, data, exceptions, sweep
+from . import basins, bearing, calibration, continuation, data, exceptions, rig, sweep
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -63,6 +63,7 @@ __all__ = [
     "balanced_state",
     "basins",
     "bearing",
+    "calibration",
     "continuation",
     "disturbance_response",
     "equilibria",
@@ -73,6 +74,7 @@ __all__ = [
     "label_peaks",
     "line_spectrum",
     "load_scene",
+    "rig",
     "periodic",
     "plot_accuracy_cost",
     "plot_balance_map",
