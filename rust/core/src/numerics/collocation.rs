@@ -1051,7 +1051,11 @@ pub fn solve<D: Dynamics + ?Sized>(
             ),
         ));
     }
-    crate::periodic::require_autonomous(model)?;
+    // A periodic orbit needs autonomous equations (the model says; numerics names no
+    // analysis).
+    if let Some(effect) = model.time_dependence() {
+        return Err(Error::NotAutonomous { effect });
+    }
     // Another NTST: a mesh of that many intervals adapted to the guess (a uniform one
     // would lose the fast jump of a long-period orbit).
     let mut start = if guess.ntst() == opts.ntst {
