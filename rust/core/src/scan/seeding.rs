@@ -386,9 +386,9 @@ pub(super) fn gap_tasks<D: Family>(
         .collect()
 }
 
-/// Runs the gap seeds: the first start at rest at each point, accepted only as one of
-/// the types missing there ([`gap_tasks`]), solved, resolved and analysed. Returns the
-/// solutions found, in task order.
+/// Runs the gap seeds: the first start at rest at each point, its balls set slightly
+/// apart, accepted only as one of the types missing there ([`gap_tasks`]), solved,
+/// resolved and analysed. Returns the solutions found, in task order.
 pub(super) fn run_gap_seeds<D: Family>(
     spec: &ScanSpec<'_, D>,
     params: &[D],
@@ -412,8 +412,19 @@ pub(super) fn run_gap_seeds<D: Family>(
                     .iter()
                     .filter_map(|(q, rate)| Capture::new(model, q, *rate))
                     .collect();
-                let y0 = &initial_states(model)[start];
-                let (k, sol, key) = simulated_candidate(spec, model, y0, &captures, Some(missing))?;
+                // Identical balls started together stay together for ever (merged balls
+                // are an invariant set): such a start settles on a merged orbit even where
+                // it is unstable to the balls' separation, and misses the separated orbit
+                // that attracts there (fine_rr at Omega 1.1, eta 0.46). The balls are
+                // set apart by a milliradian or so, as a tap on a rig would.
+                let mut y0 = initial_states(model)[start].clone();
+                let balls = model.layout().balls();
+                let mid = (balls.len() as f64 - 1.0) / 2.0;
+                for (k, i) in balls.enumerate() {
+                    y0[i] += 1e-3 * (k as f64 - mid);
+                }
+                let (k, sol, key) =
+                    simulated_candidate(spec, model, &y0, &captures, Some(missing))?;
                 count(work::FINISH);
                 let res = finish(model, sol, &spec.opts);
                 (res.sol.status == Status::Converged).then(|| {
