@@ -22,8 +22,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import polars as pl
+from reference_outputs import _max_diff  # same folder: the scripts' shared comparison
 
 import ballbal
 from ballbal.continuation import (
@@ -128,29 +128,6 @@ def _tables(obj: Any) -> dict[str, pl.DataFrame]:
     return {k: v.drop([c for c in v.columns if c in DROP]) for k, v in out.items()}
 
 
-def _max_diff(a: pl.DataFrame, b: pl.DataFrame) -> float | None:
-    """Largest absolute difference over numeric columns (lists flattened); None if the
-    tables differ in anything else (shape, columns, non-numeric values)."""
-    if a.columns != b.columns or a.height != b.height:
-        return None
-    worst = 0.0
-    for c in a.columns:
-        x, y = a[c], b[c]
-        if x.dtype != y.dtype:
-            return None
-        while isinstance(x.dtype, pl.List | pl.Array):
-            x, y = x.explode(), y.explode()
-        if x.dtype.is_numeric():
-            xv, yv = x.cast(pl.Float64).to_numpy(), y.cast(pl.Float64).to_numpy()
-            if xv.shape != yv.shape or not np.array_equal(np.isnan(xv), np.isnan(yv)):
-                return None
-            d = np.abs(xv - yv)[~np.isnan(xv)]
-            worst = max(worst, float(d.max()) if d.size else 0.0)
-        elif not x.equals(y):
-            return None
-    return worst
-
-
 def main(argv: list[str]) -> int:
     mode, d = argv[1], Path(argv[2])
     d.mkdir(parents=True, exist_ok=True)
@@ -167,7 +144,7 @@ def main(argv: list[str]) -> int:
                 print(f"same {name}.{part}: {df.height} rows")
                 continue
             bad += 1
-            worst = _max_diff(ref, df)
+            worst = _max_diff(ref, df, set())
             how = (f"largest difference {worst:.2e}" if worst is not None else
                    f"shape or labels differ: {df.height}x{df.width} against "
                    f"{ref.height}x{ref.width}, columns {set(ref.columns) ^ set(df.columns)}")

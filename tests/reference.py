@@ -29,31 +29,33 @@ def rhs(b, t, s):
     return np.concatenate([v, np.linalg.solve(M, -g)])
 
 
-def rhs_many(b, S):
-    """:func:`rhs` at many states at once (``S``: one state per column), for sampled
-    records: the same equations, the mass matrices solved as a stack."""
+def rhs_many(b, t, s):
+    """:func:`rhs` for a batch of states (the columns of ``s``): the same equations, the
+    mass matrices solved as a stack (perturbed flows integrated together, sampled
+    records)."""
     n = len(b.eta)
+    k = s.shape[1]
     zb = np.broadcast_to(np.asarray(b.zeta_b, dtype=float), (n,))[:, None]
-    x, y, beta = S[0], S[1], S[2 : n + 2]
-    vx, vy, vb = S[n + 2], S[n + 3], S[n + 4 :]
+    x, y, beta = s[0], s[1], s[2 : n + 2]
+    vx, vy, vb = s[n + 2], s[n + 3], s[n + 4 :]
     m = (b.mu * np.asarray(b.eta))[:, None]
-    Sn, Cs = np.sin(beta), np.cos(beta)
+    S, C = np.sin(beta), np.cos(beta)
     Om, z, dl = b.Omega, b.zeta, b.delta
-    k = S.shape[1]
-    M = np.broadcast_to(np.eye(n + 2), (k, n + 2, n + 2)).copy()
-    M[:, 0, 2:] = M[:, 2:, 0] = (-m * Sn).T
-    M[:, 1, 2:] = M[:, 2:, 1] = (m * Cs).T
+    M = np.zeros((k, n + 2, n + 2))
+    M[:, 0, 0] = M[:, 1, 1] = 1.0
+    M[:, 0, 2:] = M[:, 2:, 0] = (-m * S).T
+    M[:, 1, 2:] = M[:, 2:, 1] = (m * C).T
     idx = np.arange(2, n + 2)
     M[:, idx, idx] = (m * dl).T
     w2 = (Om + vb) ** 2
     g = np.empty((n + 2, k))
     g[0] = (2 * z * vx - 2 * Om * vy + (1 - Om**2) * x - 2 * z * Om * y
-            - np.sum(m * w2 * Cs, axis=0) - b.mu * Om**2)
+            - np.sum(m * w2 * C, axis=0) - b.mu * Om**2)
     g[1] = (2 * z * vy + 2 * Om * vx + (1 - Om**2) * y + 2 * z * Om * x
-            - np.sum(m * w2 * Sn, axis=0))
-    g[2:] = m * (2 * Om * (Cs * vx + Sn * vy) + 2 * zb * dl * vb + Om**2 * (x * Sn - y * Cs))
+            - np.sum(m * w2 * S, axis=0))
+    g[2:] = m * (2 * Om * (C * vx + S * vy) + 2 * zb * dl * vb + Om**2 * (x * S - y * C))
     acc = np.linalg.solve(M, -g.T[:, :, None])[:, :, 0].T
-    return np.concatenate([S[n + 2 :], acc])
+    return np.concatenate([s[n + 2 :], acc])
 
 
 def jacobi_integral(b, s):

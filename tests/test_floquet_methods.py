@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 import ballbal
 from ballbal.exceptions import ParameterError, ParameterTypeError
 
-from reference import rhs
+from reference import rhs, rhs_many
 from shooting import flow, match_error
 
 STANDARD_PARAMS = {"mu": 0.2, "zeta": 0.05, "zeta_b": 0.05, "delta": 50.0}
@@ -62,44 +62,16 @@ def test_magnus_matches_tight_rk45(solutions, point, N):
             assert rk.floquet_steps > 2 * m.floquet_steps
 
 
-def batched_rhs(b, t, s):
-    """reference.rhs for a batch of states (columns of ``s``), so that the
-    finite-difference monodromy's 2 n perturbed flows run as one integration."""
-    n = len(b.eta)
-    k = s.shape[1]
-    zb = np.broadcast_to(np.asarray(b.zeta_b, dtype=float), (n,))[:, None]
-    x, y, beta = s[0], s[1], s[2 : n + 2]
-    vx, vy, vb = s[n + 2], s[n + 3], s[n + 4 :]
-    m = (b.mu * np.asarray(b.eta))[:, None]
-    S, C = np.sin(beta), np.cos(beta)
-    Om, z, dl = b.Omega, b.zeta, b.delta
-    M = np.zeros((k, n + 2, n + 2))
-    M[:, 0, 0] = M[:, 1, 1] = 1.0
-    M[:, 0, 2:] = M[:, 2:, 0] = (-m * S).T
-    M[:, 1, 2:] = M[:, 2:, 1] = (m * C).T
-    idx = np.arange(2, n + 2)
-    M[:, idx, idx] = (m * dl).T
-    w2 = (Om + vb) ** 2
-    g = np.empty((n + 2, k))
-    g[0] = (2 * z * vx - 2 * Om * vy + (1 - Om**2) * x - 2 * z * Om * y
-            - np.sum(m * w2 * C, axis=0) - b.mu * Om**2)
-    g[1] = (2 * z * vy + 2 * Om * vx + (1 - Om**2) * y + 2 * z * Om * x
-            - np.sum(m * w2 * S, axis=0))
-    g[2:] = m * (2 * Om * (C * vx + S * vy) + 2 * zb * dl * vb + Om**2 * (x * S - y * C))
-    acc = np.linalg.solve(M, -g.T[:, :, None])[:, :, 0].T
-    return np.concatenate([s[n + 2 :], acc])
-
-
 def shooting_multipliers(b, y0, T, h=1e-6):
     """tests/shooting.py's central-difference monodromy, its flows integrated together."""
     n2 = len(y0)
     # the batched equations are the reference's
     probe = y0 + 0.1 * np.arange(n2)
-    assert np.allclose(batched_rhs(b, 0.0, probe[:, None])[:, 0], rhs(b, 0.0, probe),
+    assert np.allclose(rhs_many(b, 0.0, probe[:, None])[:, 0], rhs(b, 0.0, probe),
                        rtol=1e-13, atol=1e-13)
     starts = np.concatenate([y0[:, None] + h * np.eye(n2), y0[:, None] - h * np.eye(n2)],
                             axis=1)
-    r = solve_ivp(lambda t, v: batched_rhs(b, t, v.reshape(n2, 2 * n2)).ravel(), (0, T),
+    r = solve_ivp(lambda t, v: rhs_many(b, t, v.reshape(n2, 2 * n2)).ravel(), (0, T),
                   starts.ravel(), rtol=1e-11, atol=1e-13, method="DOP853")
     end = r.y[:, -1].reshape(n2, 2 * n2)
     ev = np.linalg.eigvals((end[:, :n2] - end[:, n2:]) / (2 * h))

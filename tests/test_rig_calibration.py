@@ -45,7 +45,7 @@ def clean_sweep() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         r = solve_ivp(lambda t, y, b=b: rhs(b, t, y), (0, RECORD), s, method="DOP853",
                       rtol=1e-9, atol=1e-11, t_eval=grid)
         Y = r.y
-        dd = rhs_many(b, Y)[n + 2 : n + 4]
+        dd = rhs_many(b, 0.0, Y)[n + 2 : n + 4]
         x, y, vx, vy = Y[0], Y[1], Y[n + 2], Y[n + 3]
         # Z'' = e^{i Om t} ((x'' + i y'') + 2 i Om (x' + i y') - Om^2 (x + i y))
         Z2 = np.exp(1j * Om * grid) * ((dd[0] + 1j * dd[1]) + 2j * Om * (vx + 1j * vy)
