@@ -230,13 +230,7 @@ pub(super) fn run_seeds<D: Family>(
     points.dedup();
     let captures: Vec<Vec<Capture>> = points
         .par_iter()
-        .map(|&p| {
-            let m = &params[p];
-            m.attracting_rests()
-                .iter()
-                .filter_map(|(q, rate)| Capture::new(m, q, *rate))
-                .collect()
-        })
+        .map(|&p| captures_at(&params[p]))
         .collect();
     let captures_of = |p: usize| &captures[points.binary_search(&p).unwrap()];
     let (cands, times): (Vec<Option<(usize, Candidate)>>, Vec<profile::Task>) = order
@@ -346,6 +340,15 @@ pub(super) fn run_seeds<D: Family>(
     (sols, frontier)
 }
 
+/// The equilibria a start at the point of `model` may stop at once it gets close.
+fn captures_at<D: Family>(model: &D) -> Vec<Capture> {
+    model
+        .attracting_rests()
+        .iter()
+        .filter_map(|(q, rate)| Capture::new(model, q, *rate))
+        .collect()
+}
+
 /// Gap seeds: the points of a block where the perfect balance is not stable and a
 /// requested single-turn type has no stable solution after the seeds and their
 /// continuation, with the types missing there. Something attracts the motion at such a
@@ -407,11 +410,7 @@ pub(super) fn run_gap_seeds<D: Family>(
                 }
                 let t = Instant::now();
                 let model = &params[*p];
-                let captures: Vec<Capture> = model
-                    .attracting_rests()
-                    .iter()
-                    .filter_map(|(q, rate)| Capture::new(model, q, *rate))
-                    .collect();
+                let captures = captures_at(model);
                 // Identical balls started together stay together for ever (merged balls
                 // are an invariant set): such a start settles on a merged orbit even where
                 // it is unstable to the balls' separation, and misses the separated orbit
