@@ -86,6 +86,15 @@ pub fn initial_states<D: Dynamics + ?Sized>(p: &D) -> Vec<Vec<f64>> {
     out
 }
 
+/// How many observation windows a slowly turning motion is watched for at most (see
+/// [`classify_with`]).
+const SLOW_WINDOWS: f64 = 16.0;
+
+/// Net turn of a ball (radians) over the observation window above which a motion too
+/// slow to show its period there is watched on: a ball that oscillates without turning
+/// returns to where it was.
+const SLOW_DRIFT: f64 = 1.0;
+
 /// Where the motion from one initial state settles.
 #[derive(Debug, Clone)]
 pub enum Attractor {
@@ -508,13 +517,15 @@ fn classify_with<D: Dynamics + ?Sized>(
     let mut watch = RestWatch::new(g.settle);
     let mut rested = false;
     let mut solver = Dopri5::new(2 * d);
-    let res = solver.integrate(
-        |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy),
-        g.settle,
-        &ys,
-        g.settle + g.window,
-        &opts,
-        |_, tb, dense| {
+    // A rotation near its infinite-period end turns too slowly for one window to show
+    // the turns a period needs (census point random-22: period 3 530 against a scan's
+    // 2 000-unit window; simulation settles there from every start). Such a motion is
+    // watched on, for as long as its drift says the turns take, up to SLOW_WINDOWS
+    // windows: its integration steps are long, so this costs milliseconds.
+    let (mut t_from, mut y_from, mut t_end) = (g.settle, ys.clone(), g.settle + g.window);
+    loop {
+        let rhs = |t: f64, y: &[f64], dy: &mut [f64]| first_order_rhs(model, t, y, dy);
+        let observe = |_: f64, tb: f64, dense: &Dense<'_>| {
             let mut t = t_prev + dt;
             while t <= tb {
                 dense.eval(t, &mut tmp);
@@ -539,10 +550,32 @@ fn classify_with<D: Dynamics + ?Sized>(
             rested = quick && (watch.at_rest(tb, dense.end(), d) || captured(dense.end()));
             // Enough turns of some ball to measure a period: a rotating motion.
             !rested && crossings.iter().all(|c| c.len() < need)
-        },
-    );
-    if res.is_err() {
-        return Failed;
+        };
+        let Ok((t, y, _)) = solver.integrate(rhs, t_from, &y_from, t_end, &opts, observe) else {
+            return Failed;
+        };
+        let short = !rested && crossings.iter().all(|c| c.len() < need);
+        let drift = start_b
+            .iter()
+            .zip(&end_b)
+            .map(|(a, b)| (b - a).abs())
+            .fold(0.0, f64::max);
+        let cap = g.settle + SLOW_WINDOWS * g.window;
+        if !short || t < t_end || drift < SLOW_DRIFT || t_end >= cap {
+            break;
+        }
+        // A wide oscillation may end its window away from where it began; it shows
+        // its period already.
+        if let Oscillation::Period(..) = oscillation_period(&xs) {
+            break;
+        }
+        // Time for `need` turns (and one more) at the drift seen so far.
+        let rate = drift / (t - g.settle);
+        let wanted = g.settle + (need + 1) as f64 * 2.0 * PI / rate;
+        if wanted > cap {
+            break;
+        }
+        (t_from, y_from, t_end) = (t, y, wanted.max(t + g.window));
     }
     if rested {
         return Rest;
