@@ -47,6 +47,7 @@ from . import _check, _native
 from .exceptions import ParameterError, ParameterTypeError, ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .options import Execution
+from .scan import SCHEMA
 from .scene import Scene, model_argument
 
 LABELS = ("perfect_balance", "other_equilibrium", "merged_R-R", "separated_R-R", "R-O",
@@ -64,13 +65,15 @@ LINK_TOL = 0.01
 _NO_ROWS: dict[str, list[Any]] = {k: [] for k in (
     "label", "pattern", "omega", "period", "rate1", "rate2", "t_stop", "motion",
     "winding1", "winding2", "extensions", "long_label", "state")}
-#: Columns of :attr:`Basins.orbits`.
+#: Columns of :attr:`Basins.orbits`: the basin's own, and the periodic solution's
+#: fields with the types of a scan's table (:data:`ballbal.scan.SCHEMA`), which the core
+#: declares.
 ORBIT_SCHEMA = {
     "orbit": pl.Int64, "label": pl.Utf8, "pattern": pl.Utf8, "winding1": pl.Int64,
     "winding2": pl.Int64, "count": pl.Int64, "period_simulated": pl.Float64,
-    "omega": pl.Float64, "period": pl.Float64, "frequency_error": pl.Float64,
-    "status": pl.Utf8, "stability": pl.Utf8, "max_modulus": pl.Float64,
-    "modulus_error": pl.Float64, "N": pl.Int64, "b1": pl.Float64, "b2": pl.Float64,
+    "omega": SCHEMA["omega"], "period": pl.Float64, "period_difference": pl.Float64,
+    **{k: SCHEMA[k] for k in ("status", "stability", "max_modulus", "modulus_error", "N")},
+    "b1": pl.Float64, "b2": pl.Float64,
 }
 
 
@@ -133,8 +136,8 @@ class Basins:
     ``orbits``: one row per distinct periodic orbit the starts reached (columns
     :data:`ORBIT_SCHEMA`: its class ``label``, ``pattern`` and windings, ``count`` of
     starts, ``period_simulated`` (its representative start's period), the harmonic
-    balance's ``omega`` and ``period = 2 pi / omega``, ``frequency_error`` (their
-    relative difference from the simulated period), ``status``, ``stability``,
+    balance's ``omega`` and ``period = 2 pi / omega``, ``period_difference`` (the
+    relative difference of that period from the simulated one), ``status``, ``stability``,
     ``max_modulus``, ``modulus_error`` and ``N`` of :func:`ballbal.analysis.periodic`,
     and ``b1, b2``: the representative start). ``status`` ``mismatch``: the solve
     converged to another orbit (its period more than :data:`LINK_TOL` from the
@@ -631,7 +634,7 @@ def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
     row: dict[str, Any] = {
         "label": r["label"], "pattern": "-".join("R" if x else "O" for x in rotating),
         "winding1": wind[0], "winding2": wind[1], "count": 0, "period_simulated": per,
-        "omega": None, "period": None, "frequency_error": None, "status": "no_guess",
+        "omega": None, "period": None, "period_difference": None, "status": "no_guess",
         "stability": None, "max_modulus": None, "modulus_error": None, "N": None,
         "b1": r["b1"], "b2": r["b2"]}
     cap = 1e5  # GuessOptions' longest settle and window
@@ -644,7 +647,7 @@ def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
         return row, per
     period = 2 * math.pi / sol.omega
     err = abs(period - per) / per
-    row.update(period=period, frequency_error=err)
+    row.update(period=period, period_difference=err)
     if err > LINK_TOL:
         row.update(status="mismatch")
         return row, per
