@@ -261,7 +261,10 @@ class ScanOptions:
     the scan's defaults, see the module's table) and ``block``, the values of the last
     axis per continuation block (None: about 1024 points, fixed by the grid's shape).
     ``block`` is mathematics, not execution: continuation does not cross block edges,
-    so smaller blocks find fewer continued solutions."""
+    so smaller blocks find fewer *unstable* solutions (which only continuation reaches).
+    The stable ones are also sought at every block's own points by gap seeds, and on
+    the maps measured (Tien's map at zeta 0.02, zeta_b 0.05, three types, blocks of 3
+    and 7 against one) the stable rows do not depend on it."""
 
     harmonic_balance: HarmonicBalance = field(
         default_factory=lambda: HarmonicBalance(target=1e-4))

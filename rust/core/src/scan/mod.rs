@@ -238,9 +238,10 @@ fn scan_chunk<D: Family>(
     // Gap seeds where nothing stable of a type is listed yet, continued in turn.
     let mut seeded: Vec<usize> = tasks.iter().map(|t| t.0).collect();
     seeded.dedup();
-    let gaps = seeding::gap_tasks(spec, &geo, np, &sols, &pb, &seeded);
+    let gaps = seeding::gap_tasks(spec, &geo, np, &sols, &pb, &lattice);
+    let gap_starts = seeding::gap_starts(spec, &params, &geo, &gaps, &seeded);
     let mut frontier = vec![];
-    for (p, f) in seeding::run_gap_seeds(spec, &params, &gaps, starts[0], cancel) {
+    for (p, f) in seeding::run_gap_seeds(spec, &params, &gaps, &gap_starts, starts[0], cancel) {
         if waves::admit(&sols[p], f.pattern, &f.key) {
             sols[p].push(f);
             frontier.push((p, sols[p].len() - 1));
@@ -258,13 +259,19 @@ fn scan_chunk<D: Family>(
     continuation::waves(&block, &geo, &mut sols, frontier, &mut tally, cancel)?;
     add_stage(2, t);
     let t = std::time::Instant::now();
-    // Each gap seed counts as one run for every type it was asked for.
+    // A gap seed at rest counts as one run for every type it was asked for, a gap
+    // whirl start as one of its own type.
     let whirls: Vec<(usize, usize, usize)> = whirls
         .into_iter()
         .filter(|w| w.1 < np)
         .chain(
             gaps.iter()
                 .flat_map(|(p, ks)| ks.iter().map(move |&k| (*p, k, 0))),
+        )
+        .chain(
+            gap_starts
+                .iter()
+                .filter_map(|&(p, w)| w.map(|(k, j)| (p, k, j))),
         )
         .collect();
     let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &whirls, &pb);
