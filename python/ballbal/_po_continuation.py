@@ -5,8 +5,8 @@ certified and judged as :func:`ballbal.periodic` does, with its bifurcations loc
 
 from __future__ import annotations
 
-from dataclasses import replace
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
