@@ -139,6 +139,24 @@ def test_periodic_at_points_against_shooting() -> None:
     assert np.abs(br.table["Omega"].to_numpy() - plain.table["Omega"].to_numpy()).max() < 1e-12
 
 
+def test_the_slow_orbit_at_omega_095_against_shooting() -> None:
+    """The issue's case: down the R-R branch at zeta_b 0.1 towards its infinite-period
+    end, the orbit at Omega 0.95 (period ~196, twice the start's), stopping there. With
+    N = 16 the series is resolved: its period agrees with shooting to 1e-9 (measured
+    3e-11), and the orbit's own row is that point."""
+    opts = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=16))
+    start = ballbal.periodic(_rr(1.0, 0.1), "R-R", options=opts)
+    br = periodic_branch(start, "Omega", range=(0.5, 1.0), options=STEPS, direction="backward",
+                         at=0.95, stop="user")
+    assert br.stop == "user"
+    assert br.table["Omega"][-1] == pytest.approx(0.95, abs=1e-12)
+    s = br.solutions[-1]
+    assert s.period > 1.9 * start.period
+    y0, T = shoot(s.balancer, s.state(0.0), s.period, s.winding, 2)
+    assert abs(s.period / T - 1) < 1e-9, (s.period, T)
+    assert np.abs(s.state(0.0) - y0).max() < 1e-4
+
+
 def test_periodic_branch_stops_at_an_event() -> None:
     plain = rr_up()
     kinds = plain.events["type"].to_list()

@@ -209,7 +209,7 @@ pub struct PoBranch {
     pub points: Vec<PoPoint>,
     pub events: Vec<PoEvent>,
     /// `"boundary"`, `"max_points"`, `"step_too_small"`, `"infinite_period"`,
-    /// `"failed: ..."`.
+    /// `"failed: ..."`, or a stop asked for: `"period"`, the name of the event stopped at.
     pub stop: String,
 }
 
