@@ -30,7 +30,7 @@ from ballbal.continuation import (
 from ballbal.exceptions import ParameterError
 
 CANONICAL = ["fold", "branch_point", "hopf", "period_doubling", "neimark_sacker",
-             "infinite_period"]
+             "infinite_period", "user"]
 OPTS = Continuation(ds=0.01, ds_max=0.05, max_points=400, tol=1e-12)
 
 
@@ -40,7 +40,8 @@ def test_one_vocabulary_with_autos_abbreviations_as_aliases() -> None:
     for alias, name in [("LP", "fold"), ("lp", "fold"), ("BP", "branch_point"),
                         ("HB", "hopf"), ("Hopf", "hopf"), ("PD", "period_doubling"),
                         ("NS", "neimark_sacker"), ("TR", "neimark_sacker"),
-                        ("Neimark-Sacker", "neimark_sacker"), ("IP", "infinite_period")]:
+                        ("Neimark-Sacker", "neimark_sacker"), ("IP", "infinite_period"),
+                        ("UZ", "user")]:
         assert event_name(alias) == name, alias
     with pytest.raises(ParameterError) as e:
         event_name("cusp", "kind")

@@ -98,6 +98,23 @@ def directed(options: Continuation, direction: Any) -> tuple[Continuation, bool]
     return replace(options, forward=direction == "forward"), False
 
 
+def branch_controls(at: Any, stop: Any) -> tuple[list[float] | None, list[str] | None]:
+    """A branch function's ``at=`` (parameter values: a number or a list of at most
+    :data:`~ballbal._check.MAX_USER_POINTS` finite ones) and ``stop=`` (an event name or
+    alias, or a list of them) as the binding takes them; the core checks the values
+    against the branch's range and the events against the branch's kind."""
+    values = None if at is None else [
+        float(v) for v in _check.vector("at", at, _check.MAX_USER_POINTS, empty=True)]
+    if stop is None:
+        return values, None
+    names = [stop] if isinstance(stop, str) else _check.sequence("stop", stop, empty=True)
+    if len(names) > _check.MAX_STOP_EVENTS:
+        raise ParameterError("stop", f"{len(names)} event names, at most "
+                             f"{_check.MAX_STOP_EVENTS}",
+                             allowed=f"at most {_check.MAX_STOP_EVENTS} names")
+    return values, [event_name(n, "stop") for n in names]
+
+
 def model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:
     """``model`` with ``parameter`` set to ``value``. A ball-indexed name counts balls
     from 0, as Python indexes ``Balancer.eta`` and as the core and the scans do:

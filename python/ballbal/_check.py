@@ -330,6 +330,12 @@ MAX_SEARCH_DAMPING = 30.0
 #: ``tol``, ``rtol``, ``magnus_rtol``) and of a :func:`ballbal.track_damping_study`:
 #: each value is a full solve (``repeats`` times) or simulation.
 MAX_STUDY_VALUES = 1000
+#: Most parameter values of one branch's ``at=`` (the core's ``MAX_USER_POINTS``,
+#: checked there too): each is a solve, and a judged point, wherever the branch crosses it.
+MAX_USER_POINTS = 1000
+#: Most event names in one branch's ``stop=`` (there are fewer events than this; a
+#: longer list is a mistake).
+MAX_STOP_EVENTS = 32
 
 
 def vector(name: str, v: Any, max_size: int, *, empty: bool = False) -> np.ndarray:

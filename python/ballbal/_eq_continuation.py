@@ -6,6 +6,7 @@ two-parameter curves of those bifurcations (the core's
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -16,6 +17,7 @@ from ballbal._branch import (
     Branch,
     Continuation,
     Curve,
+    branch_controls,
     directed,
     event_row,
     model_at,
@@ -130,8 +132,9 @@ def _branch(d: dict[str, Any], parameter: str, model: Any, rng: tuple[float, flo
 
 def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str = "perfect_balance",
                        range: tuple[float, float], options: Continuation = _DEFAULT,
-                       direction: Literal["forward", "backward", "both"] | None = None
-                       ) -> Branch:
+                       direction: Literal["forward", "backward", "both"] | None = None,
+                       at: float | Sequence[float] | None = None,
+                       stop: str | Sequence[str] | None = None) -> Branch:
     """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
     ``model``, or a kind name: the first equilibrium of that kind) continued in
     ``parameter`` (any name ``with_param`` takes: ``"Omega"``, ``"eta"`` (all balls),
@@ -152,6 +155,15 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     oriented along the rows), ``stop`` then ``"<lower end>/<upper end>"``. Default:
     ``options.forward``.
 
+    ``at``: parameter values inside ``range`` (AUTO's ``UZ``): each time a step crosses
+    one (or ends on it; not at the start), the equilibrium there is solved with the
+    parameter fixed at the value and listed in ``events`` as a ``"user"`` event (test
+    0), its ``row`` the row after it; the rows are those of the branch without ``at``.
+    ``stop``: an event name (or alias: ``"LP"``, ``"BP"``, ``"HB"``, ``"UZ"``) or a list
+    of them: the branch ends at the first such event, its last row that event's point,
+    ``stop`` (the attribute) the event's name. The branch also stops on ``range``'s
+    edges (``"boundary"``, a row on the edge): that is its stop at a parameter value.
+
     ``table``: one row per point (the parameter, ``q``, ``kind``, ``stability``,
     ``max_real``, the eigenvalues, the test functions ``test_fold`` (dp/ds),
     ``test_branch_point`` (the bordered determinant, or on the balls-together branch the
@@ -165,6 +177,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     rng = parameter_range(range)
     options = _options(options)
     options, both = directed(options, direction)
+    at_values, stop_events = branch_controls(at, stop)
     if isinstance(start, str):
         found = [e for e in equilibria(native) if e.kind == start]
         if not found:
@@ -175,7 +188,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     if not isinstance(start, Equilibrium):
         raise ParameterTypeError("start", "must be an Equilibrium or a kind name")
     d = _native.equilibrium_branch(native, parameter, [float(v) for v in start.q], start.kind,
-                                   rng, options, both, seed)
+                                   rng, options, both, seed, at_values, stop_events)
     return _branch(d, parameter, model, rng, options)
 
 

@@ -74,7 +74,8 @@ def event_vocabulary() -> list[tuple[str, list[str], str]]: ...
 def event_name(text: str, parameter: str = "event") -> str: ...
 def equilibrium_branch(model: Balancer | Scene, parameter: str, q: Sequence[float], kind: str,
                        range: tuple[float, float], options: Any, both: bool = False,
-                       disk_units: Any = None) -> dict[str, Any]: ...
+                       disk_units: Any = None, at: Sequence[float] | None = None,
+                       stop: Sequence[str] | None = None) -> dict[str, Any]: ...
 def equilibrium_switch(model: Balancer | Scene, parameter: str, x: Sequence[float], p: float,
                        tangent: Sequence[float], range: tuple[float, float],
                        options: Any, disk_units: Any = None) -> dict[str, Any]: ...
@@ -156,7 +157,8 @@ def periodic_branch(
     model: Balancer | Scene, parameter: str,
     start: tuple[float, npt.NDArray[np.float64], list[float]], p_range: tuple[float, float],
     continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
-    both: bool = False,
+    both: bool = False, at: Sequence[float] | None = None, stop: Sequence[str] | None = None,
+    stop_period: float | None = None,
 ) -> dict[str, Any]: ...
 # {"kind", "together", "points": [solution dict + p1, p2, test, test_*], "special", "stop"}
 # special: [{"type", "p1", "p2", "omega", "row", "status" ("confirmed" | "rejected" |

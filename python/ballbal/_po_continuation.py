@@ -5,6 +5,7 @@ certified and judged as :func:`ballbal.periodic` does, with its bifurcations loc
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any, Literal
 
@@ -12,7 +13,14 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from ._branch import Branch, Continuation, directed, model_at, parameter_range
+from ._branch import (
+    Branch,
+    Continuation,
+    branch_controls,
+    directed,
+    model_at,
+    parameter_range,
+)
 from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
@@ -72,6 +80,9 @@ def periodic_branch(
     min_omega: float = 1e-3,
     event_tol: float = 1e-7,
     direction: Literal["forward", "backward", "both"] | None = None,
+    at: float | Sequence[float] | None = None,
+    stop: str | Sequence[str] | None = None,
+    stop_period: float | None = None,
 ) -> Branch:
     """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
     in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
@@ -86,6 +97,18 @@ def periodic_branch(
     ``det_sign``, ``test_fold`` and ``test_branch_point`` oriented along the rows),
     ``stop`` then ``"<lower end>/<upper end>"``. Default: ``options.forward``, as for
     :func:`~ballbal.continuation.equilibrium_branch`.
+
+    ``at``: parameter values inside ``range`` (AUTO's ``UZ``): each time a step crosses
+    one (or ends on it; not at the start), the orbit there is solved with the parameter
+    fixed at the value, judged as a row is, and listed in ``events`` as a ``"user"``
+    event (test 0), its ``index`` the row after it; the rows are those of the branch
+    without ``at``. Stop conditions: ``stop``, an event name (or alias: ``"LP"``,
+    ``"BP"``, ``"PD"``, ``"NS"``, ``"UZ"``) or a list of them: the branch ends at the first
+    such event, its last row that event's point, ``stop`` (the attribute) the event's
+    name; ``stop_period`` (above the start's period): the branch ends where the period
+    reaches it, its last row solved with that period, ``stop`` ``"period"``. It also
+    stops on ``range``'s edges (``"boundary"``, a row on the edge: its stop at a
+    parameter value) and at an infinite period.
 
     Every point gets the certificates and Floquet multipliers of :func:`ballbal.periodic`
     with ``periodic_options`` (default :data:`ballbal.options.PERIODIC_DEFAULTS`;
@@ -143,11 +166,15 @@ def periodic_branch(
     popts = replace(popts, harmonic_balance=replace(popts.harmonic_balance, N=n))
     min_omega = _check.real("min_omega", min_omega)
     event_tol = _check.real("event_tol", event_tol)
+    at_values, stop_events = branch_controls(at, stop)
+    if stop_period is not None:
+        stop_period = _check.real("stop_period", stop_period)
     model = start.balancer
     coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
     winding = [float(w) for w in start.winding]
     d = _native.periodic_branch(model, parameter, (float(start.omega), coeffs, winding),
-                                (lo, hi), options, popts, min_omega, event_tol, both)
+                                (lo, hi), options, popts, min_omega, event_tol, both,
+                                at_values, stop_events, stop_period)
     table = pl.DataFrame([_row(parameter, p) for p in d["points"]], schema=_schema(parameter),
                          orient="row") if d["points"] else pl.DataFrame(schema=_schema(parameter))
     ev_rows = []

@@ -1,7 +1,10 @@
 //! Continuation options: `ballbal._branch.Continuation` into the core's `ArcOptions`
 //! (the values are checked by `ArcOptions::validate`, once, in the core).
 
-use ballbal_core::continuation::ArcOptions;
+use crate::errors::CoreResult;
+use ballbal_core::bifurcation::event::Event;
+use ballbal_core::continuation::{ArcOptions, Controls};
+use ballbal_core::Result;
 use pyo3::prelude::*;
 
 /// `ballbal._branch.Continuation`'s fields.
@@ -36,4 +39,20 @@ impl ContinuationArgs {
             weights: None,
         }
     }
+}
+
+/// A branch's user points and the events it stops at (`at=`, `stop=`: names or aliases
+/// `Event::parse` reads), as the core takes them (it checks them against the branch).
+pub fn controls(at: Option<Vec<f64>>, stop: Option<Vec<String>>) -> PyResult<Controls> {
+    let stop_events = stop
+        .unwrap_or_default()
+        .iter()
+        .map(|k| Event::parse(k, "stop").map(|e| e.name()))
+        .collect::<Result<Vec<_>>>()
+        .py()?;
+    Ok(Controls {
+        at: at.unwrap_or_default(),
+        stop_events,
+        stop_level: None,
+    })
 }

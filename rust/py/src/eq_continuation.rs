@@ -2,7 +2,7 @@
 //! at a branch point, two-parameter bifurcation curves. Glue only: the core's
 //! `bifurcation::equilibria` does the work, off the GIL.
 
-use crate::continuation::ContinuationArgs;
+use crate::continuation::{controls, ContinuationArgs};
 use crate::convert::{dispatch, Model, ModelArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
@@ -262,9 +262,10 @@ fn curve_dict(py: Python<'_>, c: EqCurve) -> PyResult<Bound<'_, PyDict>> {
 }
 
 /// A branch of equilibria from `q` (the model's equilibrium of kind `kind`) in
-/// `parameter` over `range`: a dict of `points`, `events` and `stop`.
+/// `parameter` over `range`, with user points at the parameter values `at`, stopping at
+/// the first event named in `stop`: a dict of `points`, `events` and `stop`.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, q, kind, range, options, both=false, disk_units=None))]
+#[pyo3(signature = (model, parameter, q, kind, range, options, both=false, disk_units=None, at=None, stop=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn equilibrium_branch<'py>(
     py: Python<'py>,
@@ -276,10 +277,13 @@ pub fn equilibrium_branch<'py>(
     options: ContinuationArgs,
     both: bool,
     disk_units: Option<DiskUnitsArgs>,
+    at: Option<Vec<f64>>,
+    stop: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let k = kind_from(&kind).py()?;
-    let opts = options_checked(&m, &options, range)?;
+    let mut opts = options_checked(&m, &options, range)?;
+    opts.controls = controls(at, stop)?;
     let b = guarded(
         py,
         || dispatch!(&m, d => run_branch(d, disk_units.as_ref(), &parameter, &q, k, both, &opts)),

@@ -1,7 +1,7 @@
 //! Continuation of periodic solutions in one parameter: `ballbal.continuation.
 //! periodic_branch`'s native half (core: `ballbal_core::bifurcation::po_branch`).
 
-use crate::continuation::ContinuationArgs;
+use crate::continuation::{controls, ContinuationArgs};
 use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
@@ -46,10 +46,12 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
 }
 
 /// Continues the periodic solution `start = (omega, coeffs, winding)` of `model` in
-/// `parameter` over `p_range` (`both`: both ways from the start, joined into one branch);
-/// returns `{"points": [dict], "events": [dict], "stop": str}`.
+/// `parameter` over `p_range` (`both`: both ways from the start, joined into one branch),
+/// with user points at the parameter values `at`, stopping at the first event named in
+/// `stop` or where the period reaches `stop_period`; returns `{"points": [dict],
+/// "events": [dict], "stop": str}`.
 #[pyfunction]
-#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false))]
+#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false, at=None, stop=None, stop_period=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn periodic_branch<'py>(
     py: Python<'py>,
@@ -62,6 +64,9 @@ pub fn periodic_branch<'py>(
     min_omega: f64,
     event_tol: f64,
     both: bool,
+    at: Option<Vec<f64>>,
+    stop: Option<Vec<String>>,
+    stop_period: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     // A scene is continued as a scene even with every effect off (as a scan does).
     let always_scene = matches!(model, ModelArgs::Scene(_));
@@ -90,6 +95,8 @@ pub fn periodic_branch<'py>(
         periodic: popts,
         min_omega,
         event_tol,
+        controls: controls(at, stop)?,
+        stop_period,
     };
     let name = parameter.to_string();
     let b = guarded(py, || {

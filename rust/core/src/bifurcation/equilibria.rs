@@ -26,12 +26,12 @@
 //! the point where it meets the pitchfork.
 
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
-use crate::bifurcation::event::Event;
+use crate::bifurcation::event::{check_stop_events, Event};
 use crate::continuation::arclength::{point_at, ArcOptions, ArcPoint, ArcStop};
 use crate::continuation::curves::{
     both_halves, curve_half, join_halves, CurveHook, Extended, TwoParameter,
 };
-use crate::continuation::{self, Declared, Spectrum, Start};
+use crate::continuation::{self, Controls, Declared, Spectrum, Start};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::disk_units::DiskUnits;
@@ -416,7 +416,13 @@ pub struct EqOptions {
     pub family: bool,
     /// Arclength tolerance of event location.
     pub locate_tol: f64,
+    /// User points and stop conditions of a branch (curves ignore them); a stop event
+    /// must be one an equilibrium branch locates ([`EQ_STOP_EVENTS`]).
+    pub controls: Controls,
 }
+
+/// The events an equilibrium branch can be asked to stop at.
+pub const EQ_STOP_EVENTS: [Event; 4] = [Event::Fold, Event::BranchPoint, Event::Hopf, Event::User];
 
 impl Default for EqOptions {
     fn default() -> Self {
@@ -424,6 +430,7 @@ impl Default for EqOptions {
             arc: ArcOptions::default(),
             family: true,
             locate_tol: 1e-11,
+            controls: Controls::default(),
         }
     }
 }
@@ -433,6 +440,8 @@ pub enum EventKind {
     Fold,
     Hopf,
     BranchPoint,
+    /// A point at a parameter value the user asked for ([`Controls::at`]).
+    User,
 }
 
 impl EventKind {
@@ -442,6 +451,7 @@ impl EventKind {
             EventKind::Fold => Event::Fold,
             EventKind::Hopf => Event::Hopf,
             EventKind::BranchPoint => Event::BranchPoint,
+            EventKind::User => Event::User,
         }
     }
 
@@ -686,7 +696,32 @@ impl<'a, D: Dynamics + Clone> Declared<EqSystem<'a, D>> for EqTests {
         match e.kind {
             EventKind::Hopf => 2,
             EventKind::Fold | EventKind::BranchPoint => 1,
+            EventKind::User => 0,
         }
+    }
+
+    fn kind(&self, e: &EqEvent) -> &'static str {
+        e.kind.as_str()
+    }
+
+    /// The user point's test is its parameter's distance from the value asked for: 0.
+    fn user(
+        &mut self,
+        s: &mut EqSystem<'a, D>,
+        e: &ArcPoint,
+        row: usize,
+    ) -> Result<Option<EqEvent>> {
+        let eq = analyse_at(s, &e.x, e.p, self.start, self.family)?;
+        Ok(Some(EqEvent {
+            kind: EventKind::User,
+            row,
+            p: e.p,
+            x: e.x.clone(),
+            tangent: e.tangent.clone(),
+            eq,
+            test: 0.0,
+            omega: f64::NAN,
+        }))
     }
 }
 
@@ -712,6 +747,7 @@ pub fn branch<D: Dynamics + Clone>(
     if !(opts.locate_tol > 0.0) {
         return Err(Error::param("locate_tol", "must be positive"));
     }
+    check_stop_events(&opts.controls, &EQ_STOP_EVENTS)?;
     if !(opts.arc.p_min <= p0 && p0 <= opts.arc.p_max) {
         return Err(Error::param(
             "range",
@@ -730,7 +766,14 @@ pub fn branch<D: Dynamics + Clone>(
         p: p0,
         direction,
     };
-    let run = continuation::branch(sys, from, &opts.arc, opts.locate_tol, &mut tests)?;
+    let run = continuation::branch(
+        sys,
+        from,
+        &opts.arc,
+        opts.locate_tol,
+        &opts.controls,
+        &mut tests,
+    )?;
     let stop = run.stop;
     if run.points.is_empty() {
         return Err(Error::param(
@@ -781,7 +824,7 @@ pub fn branch_both_ways<D: Dynamics + Clone>(
         let oriented = match e.kind {
             EventKind::Fold => true,
             EventKind::BranchPoint => e.eq.kind != EquilibriumKind::Together,
-            EventKind::Hopf => false,
+            EventKind::Hopf | EventKind::User => false,
         };
         if oriented {
             e.test = -e.test;

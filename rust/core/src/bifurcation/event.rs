@@ -4,10 +4,11 @@
 //! abbreviations (`LP`, `BP`, `HB`, `PD`, `NS` / `TR`), in any case. The binding serves
 //! [`VOCABULARY`] to Python, so that no list of names is kept twice.
 
+use crate::continuation::Controls;
 use crate::{Error, Result};
 
-/// A codimension-one bifurcation (or the end of a branch of periodic orbits) located
-/// between two points of a branch.
+/// A codimension-one bifurcation (or the end of a branch of periodic orbits, or a point
+/// the user asked for) located between two points of a branch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Event {
     /// The branch turns back in its parameter (a limit point): a real eigenvalue (a
@@ -29,6 +30,9 @@ pub enum Event {
     /// The orbit's period grows without bound at the branch's end: the orbit meets an
     /// equilibrium (a saddle-node on the invariant circle or a homoclinic orbit).
     InfinitePeriod,
+    /// Not a bifurcation: the point at a parameter value the user asked for (a branch's
+    /// `at=`, AUTO's `UZ`), solved there exactly.
+    User,
 }
 
 /// One entry of the vocabulary: the canonical name, the other spellings read as it,
@@ -42,7 +46,7 @@ pub struct EventName {
 }
 
 /// Every event, in the order the docs list them.
-pub const VOCABULARY: [EventName; 6] = [
+pub const VOCABULARY: [EventName; 7] = [
     EventName {
         event: Event::Fold,
         name: "fold",
@@ -83,6 +87,13 @@ pub const VOCABULARY: [EventName; 6] = [
         meaning: "the period of a periodic orbit grows without bound (the orbit meets \
                   an equilibrium)",
     },
+    EventName {
+        event: Event::User,
+        name: "user",
+        aliases: &["UZ", "user_point"],
+        meaning: "the point at a parameter value asked for with at= (not a bifurcation), \
+                  solved there with the parameter fixed",
+    },
 ];
 
 impl Event {
@@ -121,6 +132,27 @@ impl Event {
                     names(),
                 )
             })
+    }
+}
+
+/// `Err` naming `stop` unless every event `controls` stops at is one of `allowed` (the
+/// events a branch of that kind locates).
+pub fn check_stop_events(controls: &Controls, allowed: &[Event]) -> Result<()> {
+    match controls
+        .stop_events
+        .iter()
+        .find(|k| !allowed.iter().any(|e| e.name() == **k))
+    {
+        None => Ok(()),
+        Some(k) => Err(Error::param_range(
+            "stop",
+            format!("this branch locates no {k} event"),
+            allowed
+                .iter()
+                .map(|e| e.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        )),
     }
 }
 

@@ -30,9 +30,11 @@
 //! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
 //! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
 
-use crate::bifurcation::event::Event;
+use crate::bifurcation::event::{check_stop_events, Event};
 use crate::continuation::curves::join_halves;
-use crate::continuation::{self, ArcOptions, ArcPoint, ArcStop, Declared, Spectrum, Start};
+use crate::continuation::{
+    self, ArcOptions, ArcPoint, ArcStop, Controls, Declared, Level, Spectrum, Start,
+};
 use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
@@ -52,7 +54,23 @@ pub struct PoBranchOptions {
     pub min_omega: f64,
     /// Events are located to this arclength, hence to this in the parameter.
     pub event_tol: f64,
+    /// User points and the events to stop at (one of [`PO_STOP_EVENTS`]); its
+    /// `stop_level` is set from `stop_period`.
+    pub controls: Controls,
+    /// The branch ends where the period reaches this (it must exceed the start's), its
+    /// last row solved with that period; the stop reason is `"period"`.
+    pub stop_period: Option<f64>,
 }
+
+/// The events a periodic branch can be asked to stop at (it always stops at an
+/// infinite period).
+pub const PO_STOP_EVENTS: [Event; 5] = [
+    Event::Fold,
+    Event::BranchPoint,
+    Event::PeriodDoubling,
+    Event::NeimarkSacker,
+    Event::User,
+];
 
 impl Default for PoBranchOptions {
     fn default() -> Self {
@@ -61,6 +79,8 @@ impl Default for PoBranchOptions {
             periodic: PeriodicOptions::default(),
             min_omega: 1e-3,
             event_tol: 1e-7,
+            controls: Controls::default(),
+            stop_period: None,
         }
     }
 }
@@ -81,6 +101,11 @@ impl PoBranchOptions {
         self.periodic.validate()?;
         crate::error::check_range("min_omega", self.min_omega, 0.0, false, 1e3, true)?;
         crate::error::check_range("event_tol", self.event_tol, 0.0, true, 1.0, true)?;
+        check_stop_events(&self.controls, &PO_STOP_EVENTS)?;
+        self.controls.validate(self.arc.p_min, self.arc.p_max)?;
+        if let Some(t) = self.stop_period {
+            crate::error::check_range("stop_period", t, 0.0, true, f64::MAX, true)?;
+        }
         Ok(())
     }
 }
@@ -93,6 +118,8 @@ pub enum PoEventKind {
     PeriodDoubling,
     NeimarkSacker,
     InfinitePeriod,
+    /// A point at a parameter value the user asked for ([`Controls::at`]).
+    User,
 }
 
 impl PoEventKind {
@@ -104,6 +131,7 @@ impl PoEventKind {
             PoEventKind::PeriodDoubling => Event::PeriodDoubling,
             PoEventKind::NeimarkSacker => Event::NeimarkSacker,
             PoEventKind::InfinitePeriod => Event::InfinitePeriod,
+            PoEventKind::User => Event::User,
         }
     }
 
@@ -181,7 +209,7 @@ pub struct PoBranch {
     pub points: Vec<PoPoint>,
     pub events: Vec<PoEvent>,
     /// `"boundary"`, `"max_points"`, `"step_too_small"`, `"infinite_period"`,
-    /// `"failed: ..."`.
+    /// `"failed: ..."`, or a stop asked for: `"period"`, the name of the event stopped at.
     pub stop: String,
 }
 
@@ -442,7 +470,31 @@ pub fn periodic_branch<D: Parametric>(
         p: p0,
         direction: None,
     };
-    let run = continuation::branch(&mut prob, from, &opts.arc, opts.event_tol, &mut tests)?;
+    let mut controls = opts.controls.clone();
+    if let Some(t) = opts.stop_period {
+        let t0 = first.period();
+        if !(t > t0) {
+            return Err(Error::param_range(
+                "stop_period",
+                format!("{t} does not exceed the start's period {t0}"),
+                format!("> {t0}"),
+            ));
+        }
+        // omega, the last unknown, falls through 2 pi / T as the period grows through T
+        controls.stop_level = Some(Level {
+            index: n1 - 2,
+            value: std::f64::consts::TAU / t,
+            why: "period",
+        });
+    }
+    let run = continuation::branch(
+        &mut prob,
+        from,
+        &opts.arc,
+        opts.event_tol,
+        &controls,
+        &mut tests,
+    )?;
     Ok(PoBranch {
         points: run.points,
         events: run.events,
@@ -598,12 +650,30 @@ impl<D: Parametric, P: Problem + ?Sized> Declared<P> for PoTestsDeclared<'_, D> 
         }))
     }
 
-    /// A Neimark–Sacker pair moves two multipliers across the circle, the others one.
+    /// A Neimark–Sacker pair moves two multipliers across the circle, a user point
+    /// none, the others one.
     fn moves(&self, e: &PoEvent) -> usize {
         match e.kind {
             PoEventKind::NeimarkSacker => 2,
+            PoEventKind::User => 0,
             _ => 1,
         }
+    }
+
+    fn kind(&self, e: &PoEvent) -> &'static str {
+        e.kind.as_str()
+    }
+
+    /// The user point judged as a row; its test is the parameter's distance from the
+    /// value asked for: 0.
+    fn user(&mut self, prob: &mut P, e: &ArcPoint, row: usize) -> Result<Option<PoEvent>> {
+        Ok(Some(PoEvent {
+            kind: PoEventKind::User,
+            p: e.p,
+            point: self.ctx.point(prob, e)?,
+            test: 0.0,
+            index: row,
+        }))
     }
 
     fn end(&mut self, points: &[PoPoint], b: &PoPoint) -> Option<(&'static str, Option<PoEvent>)> {

@@ -388,6 +388,52 @@ pub fn point_at<P: Problem + ?Sized>(
     }))
 }
 
+/// Component `k` of a point's `y = (x, p)` (`k = x.len()`: the parameter).
+pub fn component(pt: &ArcPoint, k: usize) -> f64 {
+    if k == pt.x.len() {
+        pt.p
+    } else {
+        pt.x[k]
+    }
+}
+
+/// The solution whose component `k` of `y = (x, p)` is `value`, by Newton from `near`
+/// on `F = 0` bordered by `y_k = value` (for `k` the parameter's index: the corrector
+/// with the parameter fixed), with its tangent oriented as `near`'s; `None` if Newton
+/// fails. The constraint is linear, so it holds after the first update up to the
+/// solve's round-off: `y_k` is then set to `value` itself, so that a table reads the
+/// value asked for. The point keeps `near`'s `ds`.
+pub fn point_on_level<P: Problem + ?Sized>(
+    problem: &mut P,
+    near: &ArcPoint,
+    k: usize,
+    value: f64,
+    opts: &ArcOptions,
+) -> Result<Option<ArcPoint>> {
+    let n1 = near.tangent.len();
+    let mut y0: Vec<f64> = near.x.iter().copied().chain([near.p]).collect();
+    y0[k] = value;
+    let mut row = vec![0.0; n1];
+    row[k] = 1.0;
+    let Some((mut y, iterations, residual)) = correct(problem, &y0, &row, &vec![1.0; n1], opts)?
+    else {
+        return Ok(None);
+    };
+    y[k] = value;
+    let w = weights(opts, n1);
+    let (tangent, det_sign) =
+        tangent_at(problem, &y, &near.tangent, &w)?.unwrap_or_else(|| (near.tangent.clone(), 0.0));
+    Ok(Some(ArcPoint {
+        x: y[..n1 - 1].to_vec(),
+        p: y[n1 - 1],
+        tangent,
+        ds: near.ds,
+        iterations,
+        residual,
+        det_sign,
+    }))
+}
+
 /// Two consecutive points `a`, `b` of a branch and a test function's values `ga`, `gb`
 /// there, of opposite signs: where [`locate`] looks for its zero.
 #[derive(Debug, Clone, Copy)]

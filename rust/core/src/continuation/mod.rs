@@ -22,8 +22,11 @@ pub mod curves;
 pub mod lattice;
 pub mod natural;
 
-pub use arclength::{locate, point_at, ArcOptions, ArcPoint, ArcStop, Arclength, Bracket, Within};
-pub use branch::{branch, Branch, Declared, Spectrum, Start};
+pub use arclength::{
+    component, locate, point_at, point_on_level, ArcOptions, ArcPoint, ArcStop, Arclength, Bracket,
+    Within,
+};
+pub use branch::{branch, Branch, Controls, Declared, Level, Spectrum, Start, MAX_USER_POINTS};
 pub use curves::{
     both_halves, curve_half, CurveHalf, CurveHook, Extended, TestFunction, TwoParameter,
 };
