@@ -198,10 +198,10 @@ def accuracy_cost(
 def plot_accuracy_cost(df: pl.DataFrame, *, error: str = "multiplier_error", ax: Any = None,
                        title: str | None = None) -> Any:
     """Error against time, one curve per knob, with the Pareto front of all settings."""
-    import matplotlib.pyplot as plt
+    from ._style import pyplot
 
     if ax is None:
-        _, ax = plt.subplots(figsize=(6.5, 4.5))
+        _, ax = pyplot().subplots(figsize=(6.5, 4.5))
     ok = df.filter(pl.col(error).is_not_null() & (pl.col(error) > 0))
     for knob, mark in (("N", "o-"), ("samples", "s-"), ("tol", "^-"), ("rtol", "v-"),
                        ("magnus", "D-")):

@@ -169,12 +169,27 @@ class Basins:
         return lines
 
     def __repr__(self) -> str:
-        return "\n".join(self._summary())
+        lines = self._summary()
+        if len(lines) > 6:  # a notebook's summary stays short: the orbits are in .orbits
+            lines = [*lines[:5], f"  ... {len(lines) - 5} more lines: see .orbits"]
+        return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        import html
+        from ._style import html_table
 
-        return "<pre>" + html.escape(repr(self)) + "</pre>"
+        rows: list[tuple[str, Any]] = [
+            (r["label"], f"{r['count']} ({r['fraction']:.1%} ± {r['standard_error']:.1%})")
+            for r in self.fractions.iter_rows(named=True)]
+        for o in self.orbits.head(10).iter_rows(named=True):
+            om = "-" if o["omega"] is None else f"{o['omega']:.6g}"
+            rows.append((f"orbit {o['orbit']}", f"{o['label']} windings ({o['winding1']}, "
+                         f"{o['winding2']}), {o['count']} starts, omega {om}, "
+                         f"{o['status']}, {o['stability']}"))
+        return html_table(self._summary()[0], rows)
+
+    def plot(self, ax: Any = None) -> Any:
+        """The basin map (:func:`plot_basins`); returns the axes."""
+        return plot_basins(self, ax=ax)
 
     @property
     def fractions(self) -> pl.DataFrame:
@@ -656,9 +671,11 @@ def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
 def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> Any:
     """A categorical map of the labels over the starts (matplotlib, imported here); the
     legend names the orbits each class is linked to (:attr:`Basins.orbits`)."""
-    import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
+    from . import _style as style
+
+    plt = style.pyplot()
     if not isinstance(result, Basins):
         raise ParameterTypeError("result", "must be a Basins (from ballbal.basins.basins), "
                                  f"got {type(result).__name__}", value=result)
@@ -677,9 +694,11 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
         s = t.filter(pl.col("label") == lab)
         ax.scatter(s["b1"], s["b2"], s=size, c=colours[lab], edgecolors="0.6",
                    linewidths=0.2, marker="s")
-    ax.set_xlabel("b1 (rad)")
-    ax.set_ylabel("b2 (rad)")
+    ax.set_xlabel(style.label("b1"))
+    ax.set_ylabel(style.label("b2"))
     ax.set_aspect("equal")
+    style.caption(ax, style.fixed_caption(result.model))
+
     def name(lab: str) -> str:
         # the orbits a class is linked to, with their windings
         o = result.orbits.filter(pl.col("label") == lab)
@@ -690,5 +709,5 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
                               label=name(lab)) for lab in present],
               loc="upper left", fontsize="small", framealpha=0.8)
     if title is not None:
-        ax.set_title(title)
+        ax.set_title(title, pad=14)
     return ax

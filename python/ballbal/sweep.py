@@ -36,6 +36,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
+from ._style import Summarised, value_range
 from .basins import REST, ROTATING, BasinOptions
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
@@ -67,8 +68,8 @@ def carry_over(y: np.ndarray, omega_from: float, omega_to: float, n_balls: int,
     return y
 
 
-@dataclass(frozen=True)
-class Sweep:
+@dataclass(frozen=True, repr=False)
+class Sweep(Summarised):
     """The result of :func:`speed_sweep`: ``table`` (one row per step: ``step,
     direction, Omega, Omega_index`` (the speed's position on the ``speeds`` axis, for
     exact joins), ``label, omega`` (mean ball rate), ``period``, ``rotating``, and
@@ -99,12 +100,35 @@ class Sweep:
                  for (k, dirn, om), sp in zip(steps, self.spectra, strict=True)]
         return waterfall(parts)
 
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        span = value_range(self.table["Omega"])
+        dirs = "/".join(dict.fromkeys(self.table["direction"].to_list()))
+        hy = self.hysteresis
+        head = (f"Sweep Ω {span} {dirs}: {self.table.height} steps, up {_fmt(self.up)}, "
+                f"down {_fmt(self.down)}, hysteresis {_fmt(hy)}")
+        labels = self.table["label"].unique(maintain_order=True).to_list()
+        return head, [("speeds Ω", span), ("directions", dirs), ("steps", self.table.height),
+                      ("up (critical speed)", self.up), ("down (critical speed)", self.down),
+                      ("hysteresis up - down", hy), ("motions seen", ", ".join(labels)),
+                      ("spectra recorded", len(self.spectra))]
+
+    def plot(self, axes: Any = None) -> Any:
+        """The balls' mean rate and (when recorded) the vibration against the speed, up
+        and down, the transition speeds marked (the hysteresis); returns the figure."""
+        from ._figures import sweep
+
+        return sweep(self, axes)
+
     @property
     def hysteresis(self) -> float | None:
         """``up - down``: the width of the speed range where both motions are seen."""
         if self.up is None or self.down is None:
             return None
         return self.up - self.down
+
+
+def _fmt(v: float | None) -> str:
+    return "-" if v is None else f"{v:.4g}"
 
 
 def speed_sweep(
