@@ -345,3 +345,49 @@ def test_scan_map_carries_its_fixed_parameters_and_symbols() -> None:
     lo, hi = ax.get_xlim()
     assert lo <= 1.1 - 0.05 + 1e-12 and hi >= 1.3 + 0.05 - 1e-12
     plt.close(ax.figure)
+
+
+# -- progress on the long Python-side loops --------------------------------------------
+
+
+class _Calls:
+    def __init__(self) -> None:
+        self.calls: list[tuple[int, int]] = []
+
+    def __call__(self, done: int, total: int) -> None:
+        self.calls.append((done, total))
+
+
+def test_progress_counts_the_steps_of_the_long_loops(capsys: Any) -> None:
+    speeds = [0.8, 1.0, 1.2]  # explicit values (a 3-tuple is start, stop, step)
+    cb = _Calls()
+    speed_sweep(ballbal.Balancer(), speeds, dwell=50.0, record=None, progress=cb)
+    steps = 2 * len(speeds) - 1  # up, then down without repeating the top speed
+    assert cb.calls == [(k, steps) for k in range(1, steps + 1)]
+
+    cb = _Calls()
+    r = ballbal.basins.basins(ballbal.Balancer(Omega=1.35), n=4, orbits=False,
+                              execution=ballbal.Execution(chunk=5, progress=cb))
+    assert cb.calls and cb.calls[-1] == (16, 16) == (r.table.height, r.table.height)
+    assert all(b[0] > a[0] for a, b in zip(cb.calls, cb.calls[1:]))
+
+    cb = _Calls()
+    ballbal.track_damping_study(ballbal.Balancer(Omega=3.0), [0.05, 0.1], 2.5, t_end=100.0,
+                                progress=cb)
+    assert cb.calls == [(1, 2), (2, 2)]
+
+    cb = _Calls()
+    ballbal.accuracy_cost(ballbal.Balancer(), N=(3, 4), samples=(), tol=(), rtol=(),
+                          magnus_rtol=(), base_N=6, reference_N=8, repeats=1, progress=cb)
+    assert cb.calls == [(1, 2), (2, 2)]
+
+    # True: a tqdm bar (or a line on stderr without tqdm), on stderr, not stdout
+    speed_sweep(ballbal.Balancer(), speeds, dwell=50.0, record=None, progress=True)
+    out = capsys.readouterr()
+    assert "speed sweep" in out.err and out.out == ""
+
+
+def test_progress_must_be_a_flag_or_a_callable() -> None:
+    with pytest.raises(ballbal.exceptions.ParameterTypeError) as e:
+        speed_sweep(ballbal.Balancer(), (0.8, 1.0), dwell=50.0, progress="yes")  # type: ignore[arg-type]
+    assert e.value.parameter == "progress"

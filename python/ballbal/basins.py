@@ -44,6 +44,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
+from ._progress import Progress
 from .exceptions import ParameterError, ParameterTypeError, ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .options import Execution
@@ -414,8 +415,9 @@ def basins(
     a :class:`~ballbal.exceptions.ScanInterrupted` warning, as :func:`ballbal.scan`
     does (with ``out`` they are also on disk, and the same call resumes);
     ``executor``: a ``concurrent.futures`` executor or Dask ``Client`` running the
-    chunks as tasks (``threads`` per task, default 1). None of it changes the
-    table.
+    chunks as tasks (``threads`` per task, default 1); ``progress``: True for a
+    progress bar over the starts (tqdm, notebook-aware) or a callable ``f(done,
+    total)``. None of it changes the table.
 
     ``orbits``: link every periodic start to its orbit (:attr:`Basins.orbits`, the
     table's ``orbit`` column; see :func:`_link_orbits`), solved with ``N`` harmonics
@@ -522,16 +524,22 @@ def basins(
     interrupted = False
     from .scan import _as_completed, _interrupted
 
+    meter: list[Progress] = []  # made once the finished chunks on disk are known
+
     def keep(c: int, cols: dict[str, Any]) -> None:
         df = frame(c, cols)
         if store is not None:
             store.write(c, df)
         parts[c] = df
+        for m in meter:
+            m.update(sizes[c])
 
     def work() -> None:
         nonlocal done, todo
         done = store.done(sizes) if store is not None else set()
         todo = [c for c in range(n_chunks) if c not in done]
+        meter.append(Progress(execution.progress, len(starts), "ballbal basins", "start",
+                              done=sum(sizes[c] for c in done)))
         if todo and execution.executor is not None:
             per_task = 1 if execution.threads is None else threads
             futures = {execution.executor.submit(
@@ -571,6 +579,8 @@ def basins(
                 stacklevel=2,
             )
     finally:
+        for m in meter:
+            m.close()
         if store is not None:
             store.close()
     df = (pl.concat([parts[c] for c in sorted(parts)], how="vertical") if parts

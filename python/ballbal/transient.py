@@ -11,6 +11,7 @@ import numpy as np
 import polars as pl
 
 from . import _check
+from ._progress import Progress, ProgressArg
 from ._style import Summarised
 from .analysis import simulate
 from .balance import balanced_state
@@ -124,20 +125,26 @@ def track_damping_study(
     model: Balancer | Scene,
     zeta_b: Sequence[float],
     to: float,
+    *,
+    progress: ProgressArg = False,
     **kw: Any,
 ) -> pl.DataFrame:
     """Peak amplitude and settling time after the disturbance for each track damping,
     and [TwoBallStrength]'s combined index ``peak * s + settle_time`` with the scale ``s`` = mean
     settling time / mean peak (so both terms count alike); ``optimal`` marks its
     minimum. At most :data:`~ballbal._check.MAX_STUDY_VALUES` dampings (each a
-    simulation of ``t_end``)."""
+    simulation of ``t_end``). ``progress``: True for a progress bar over the dampings
+    (tqdm, notebook-aware), or a callable ``f(done, total)``."""
     rows = []
     model_argument("model", model)
     values = [zeta_b] if _check.is_real(zeta_b) else zeta_b
-    for zb in _check.vector("zeta_b", values, _check.MAX_STUDY_VALUES):
-        res = disturbance_response(model.replace(zeta_b=zb), to, **kw)
-        rows.append({"zeta_b": float(zb), "peak": res.peak, "settle_time": res.settle_time,
-                     "final_r": res.final_r})
+    dampings = _check.vector("zeta_b", values, _check.MAX_STUDY_VALUES)
+    with Progress(progress, dampings.size, "ballbal damping study") as bar:
+        for zb in dampings:
+            res = disturbance_response(model.replace(zeta_b=zb), to, **kw)
+            rows.append({"zeta_b": float(zb), "peak": res.peak, "settle_time": res.settle_time,
+                         "final_r": res.final_r})
+            bar.update()
     df = pl.DataFrame(rows, schema={"zeta_b": pl.Float64, "peak": pl.Float64,
                                     "settle_time": pl.Float64, "final_r": pl.Float64})
     ok = df.filter(pl.col("settle_time").is_not_null())
