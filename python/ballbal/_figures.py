@@ -17,9 +17,10 @@ from . import _style as st
 @cache
 def _event_short() -> dict[str, str]:
     """Each event's short name (its first alias in the core's vocabulary: LP, BP...)."""
-    from ._branch import event_vocabulary
+    from . import _native
 
-    return {name: (aliases[0] if aliases else name) for name, aliases, _ in event_vocabulary()}
+    return {name: (aliases[0] if aliases else name)
+            for name, aliases, _ in _native.event_vocabulary()}
 
 
 def _panels(n: int, axes: Any, figsize: tuple[float, float]) -> tuple[Any, list[Any]]:

@@ -161,9 +161,10 @@ def fixed_caption(source: Any, varying: Iterable[str] = ()) -> str:
     skip = set(varying)
     skip |= {_INDEXED.sub(r"\1", v) for v in skip}
     parts: list[str] = []
-    from .scene import Scene
-
-    bal = source.balancer if isinstance(source, Scene) else source
+    # a Scene holds its balancer as a field (DiskUnits derives one: its own are shown)
+    holds = dataclasses.is_dataclass(source) and any(
+        f.name == "balancer" for f in dataclasses.fields(source))
+    bal = source.balancer if holds else source
     if dataclasses.is_dataclass(bal) and not isinstance(bal, type):
         for f in dataclasses.fields(bal):
             v = getattr(bal, f.name)
