@@ -33,20 +33,20 @@ QUANTITIES: dict[str, tuple[str, str]] = {
     "delta": (r"$\delta$", ""),
     "Omega": (r"$\Omega$", r"$\omega_n$"),
     "eta": (r"$\eta$", ""),
-    # effects (registry)
-    "springs": (r"$k_b$", ""),
-    "gravity": (r"$g$", ""),
-    "tilt.a": (r"$a$", ""),
-    "tilt.b": (r"$b$", ""),
-    "tilt.j_t": (r"$J_t$", ""),
-    "tilt.j_z": (r"$J_z$", ""),
+    # effects (registry): lengths over e, time over 1/omega_n, forces over M e omega_n^2
+    "springs": (r"$k_d$", r"$k$"),
+    "gravity": (r"$g$", r"$e\,\omega_n^2$"),
+    "tilt.a": (r"$a$", r"$r_t$"),
+    "tilt.b": (r"$b$", r"$r_t$"),
+    "tilt.j_t": (r"$J_t$", r"$M r_t^2$"),
+    "tilt.j_z": (r"$J_z$", r"$M r_t^2$"),
     "tilt.zeta_r": (r"$\zeta_r$", ""),
     "ramp.to": (r"$\Omega_{end}$", r"$\omega_n$"),
     "ramp.start": (r"$t_{ramp}$", r"$1/\omega_n$"),
     "ramp.duration": (r"$T_{ramp}$", r"$1/\omega_n$"),
-    "impulse.amplitude": (r"$F_0$", ""),
+    "impulse.amplitude": (r"$F_0$", r"$M e\,\omega_n^2$"),
     "impulse.t0": (r"$t_0$", r"$1/\omega_n$"),
-    "impulse.sharpness": (r"$s$", ""),
+    "impulse.sharpness": (r"$s$", r"$\omega_n^2$"),
     "impulse.angle": (r"$\phi_0$", "rad"),
     # the journal bearing (registry)
     "rho": (r"$\rho$", ""),
@@ -117,7 +117,11 @@ def _written(name: str) -> tuple[str, str]:
     m = _INDEXED.match(name)
     if m and m.group(1) in _per_ball() and m.group(1) in QUANTITIES:
         sym, u = QUANTITIES[m.group(1)]
-        return sym[:-1] + "_{" + str(int(m.group(2)) + 1) + "}$", u
+        ball = str(int(m.group(2)) + 1)
+        sub = re.match(r"^\$(.*)_\{?([^{}$]*)\}?\$$", sym)
+        if sub:  # zeta_b of ball 1: zeta_{b,1}, not a double subscript
+            return f"${sub.group(1)}_{{{sub.group(2)},{ball}}}$", u
+        return f"{sym[:-1]}_{{{ball}}}$", u
     m = _BALL.match(name)
     if m:
         rate = name.startswith("d")
