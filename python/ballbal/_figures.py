@@ -125,9 +125,10 @@ def branch(br: Any, y: str | None = None, ax: Any = None) -> Any:
         ex = ev[br.parameter].to_numpy()
         ey = _column(ev, y) if (y in ev.columns or y == "r") else np.interp(ex, x, yy)
         short = _event_short()
-        for xi, yi, kind in zip(ex, ey, ev["type"].to_list(), strict=True):
-            ax.plot(xi, yi, "o", color="k", ms=5)
-            ax.annotate(short.get(kind, kind), (xi, yi), textcoords="offset points",
+        ax.plot(ex, ey, "o", color="k", ms=5, ls="none")
+        for (xi, yi), names in _near_groups(ex, ey, [short.get(k, k) for k in
+                                                     ev["type"].to_list()], x, yy):
+            ax.annotate("+".join(names), (xi, yi), textcoords="offset points",
                         xytext=(4, 4), fontsize=8)
     st.axes_labels(ax, br.parameter, y)
     model = _model_of(br)
@@ -136,6 +137,24 @@ def branch(br: Any, y: str | None = None, ax: Any = None) -> Any:
     if drawn:
         ax.legend(fontsize=8, loc="best")
     return ax
+
+
+def _near_groups(ex: np.ndarray, ey: np.ndarray, names: list[str], x: np.ndarray,
+                 y: np.ndarray) -> list[tuple[tuple[float, float], list[str]]]:
+    """Events within 4 % of the plotted ranges of one another, labelled once (``BP+LP``)
+    so that the labels of events located close together do not overprint."""
+    span_x = float(np.nanmax(x) - np.nanmin(x)) or 1.0 if x.size else 1.0
+    span_y = float(np.nanmax(y) - np.nanmin(y)) or 1.0 if y.size else 1.0
+    groups: list[tuple[tuple[float, float], list[str]]] = []
+    for xi, yi, name in zip(ex, ey, names, strict=True):
+        for (gx, gy), members in groups:
+            if abs(xi - gx) < 0.04 * span_x and abs(yi - gy) < 0.04 * span_y:
+                if name not in members:
+                    members.append(name)
+                break
+        else:
+            groups.append(((float(xi), float(yi)), [name]))
+    return groups
 
 
 def _model_of(result: Any) -> Any:
