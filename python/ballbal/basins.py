@@ -699,14 +699,21 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
                "failed": "magenta"}
     t = result.table
     present = [lab for lab in LABELS if lab in set(t["label"].to_list())]
-    size = (250.0 / np.sqrt(max(t.height, 1))) ** 2  # squares that tile the map
+    # squares that tile the map: a cell of the grid each (random starts: of the grid of
+    # as many points)
+    side = max(1, round(math.sqrt(t.height)))
+    nx, ny = ((side, side) if result.random or t.height == 0
+              else (t["b1"].n_unique(), t["b2"].n_unique()))
+    ax.set_aspect("equal")
+    size = style.grid_marker_size(ax, nx, ny, fill=0.95, largest=math.inf)
     for lab in present:
         s = t.filter(pl.col("label") == lab)
         ax.scatter(s["b1"], s["b2"], s=size, c=colours[lab], edgecolors="0.6",
                    linewidths=0.2, marker="s")
     ax.set_xlabel(style.label("b1"))
     ax.set_ylabel(style.label("b2"))
-    ax.set_aspect("equal")
+    if not result.random and t.height:
+        style.pad_to_grid(ax, t["b1"].to_numpy(), t["b2"].to_numpy())
     style.caption(ax, style.fixed_caption(result.model))
 
     def name(lab: str) -> str:
