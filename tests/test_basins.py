@@ -382,7 +382,7 @@ def test_link_and_extension_options_are_checked():
 def test_repr_names_the_orbits(maps):
     text = repr(maps[1.2])
     assert "orbit 0: separated_R-R windings (-2, -2)" in text
-    assert "<pre>" in maps[1.2]._repr_html_()
+    assert "<table" in maps[1.2]._repr_html_()
 
 
 def test_starts_of_one_class_link_to_distinct_orbits_by_period_and_rates(monkeypatch):

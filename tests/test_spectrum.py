@@ -388,7 +388,8 @@ def test_waterfall_table_and_plots(rr, tmp_path):
     ax = sp.plot_waterfall(w)
     ax2 = sp.plot_spectrum(sol.spectrum())
     ax2.figure.savefig(tmp_path / "s.png")
-    assert ax.get_ylabel() == "Omega" and (tmp_path / "s.png").stat().st_size > 0
+    # the speed axis in the plot style's symbol and unit (ballbal._style)
+    assert ax.get_ylabel() == r"$\Omega$ ($\omega_n$)" and (tmp_path / "s.png").stat().st_size > 0
 
 
 def test_ground_signal_during_a_ramp_matches_the_ground_frame_equations():

@@ -14,6 +14,7 @@ from typing import Any
 import polars as pl
 
 from ballbal import _check, _native
+from ballbal._style import Summarised, value_range
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer
 from ballbal.scene import Scene
@@ -167,8 +168,8 @@ class Continuation:
         _native.validate_continuation(self)
 
 
-@dataclass(frozen=True)
-class Branch:
+@dataclass(frozen=True, repr=False)
+class Branch(Summarised):
     """A branch of equilibria or periodic solutions continued in ``parameter``.
 
     ``table`` has one row per point, in order along the branch (the parameter, the
@@ -192,9 +193,31 @@ class Branch:
     event_solutions: tuple[Any, ...] = ()
     meta: dict[str, Any] = field(default_factory=dict)
 
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        span = (" " + value_range(self.table[self.parameter])
+                if self.parameter in self.table.columns and self.table.height else "")
+        kinds = self.events["type"].to_list() if self.events.height else []
+        stable = (self.table.filter(pl.col("stability") == "stable").height
+                  if "stability" in self.table.columns else None)
+        head = (f"Branch {self.kind} in {self.parameter}{span}: {self.table.height} points "
+                f"({stable} stable), events [{_counts(kinds)}], stop {self.stop}")
+        return head, [("kind", self.kind), ("parameter", self.parameter),
+                      ("range", span.strip() or "-"), ("points", self.table.height),
+                      ("stable points", stable), ("events", _counts(kinds) or "none"),
+                      ("stop", self.stop)]
 
-@dataclass(frozen=True)
-class Curve:
+    def plot(self, y: str | None = None, ax: Any = None) -> Any:
+        """Bifurcation diagram: ``y`` (a column of ``table``; default ``omega`` for
+        periodic solutions, ``r``, the disk centre's offset, for equilibria) against the
+        parameter, stable parts solid and unstable dashed, events marked with their
+        short names (LP, BP, HB, PD, NS); returns the axes."""
+        from ._figures import branch
+
+        return branch(self, y, ax)
+
+
+@dataclass(frozen=True, repr=False)
+class Curve(Summarised):
     """A curve of bifurcation points of type ``kind`` in ``parameters`` (two names),
     one row per point in ``table``; ``points`` lists the codimension-two points found on
     it (e.g. Bogdanov–Takens, cusp); ``stop`` as for :class:`Branch`."""
@@ -205,3 +228,31 @@ class Curve:
     points: pl.DataFrame
     stop: str
     meta: dict[str, Any] = field(default_factory=dict)
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        kinds = self.points["type"].to_list() if self.points.height else []
+        head = (f"Curve {self.kind} in ({', '.join(self.parameters)}): {self.table.height} "
+                f"points, codimension-two [{_counts(kinds)}], stop {self.stop}")
+        rows: list[tuple[str, Any]] = [("kind", self.kind),
+                                       ("parameters", ", ".join(self.parameters))]
+        for name in self.parameters:
+            if name in self.table.columns and self.table.height:
+                rows.append((f"{name} range", value_range(self.table[name])))
+        rows += [("points", self.table.height), ("codimension-two", _counts(kinds) or "none"),
+                 ("stop", self.stop)]
+        return head, rows
+
+    def plot(self, ax: Any = None) -> Any:
+        """The curve in its two parameters, stable parts solid and unstable dashed, its
+        codimension-two points starred and labelled; returns the axes."""
+        from ._figures import curve
+
+        return curve(self, ax)
+
+
+def _counts(kinds: list[str]) -> str:
+    """``"fold 2, hopf 1"``: how many of each kind, in order of first appearance."""
+    seen: dict[str, int] = {}
+    for k in kinds:
+        seen[k] = seen.get(k, 0) + 1
+    return ", ".join(f"{k} {n}" if n > 1 else k for k, n in seen.items())

@@ -130,6 +130,7 @@ def plot_groove_study(df: pl.DataFrame, x: str = "angle", y: str = "k_centre",
     """``y`` against ``x`` from a :func:`groove_study` table (rows with status ``"ok"``),
     one line per value of ``by`` (default: the first other axis that varies). Returns the
     matplotlib Figure."""
+    from . import _style
     from .plot import _pyplot
 
     if not isinstance(df, pl.DataFrame):
@@ -158,8 +159,8 @@ def plot_groove_study(df: pl.DataFrame, x: str = "angle", y: str = "k_centre",
         g = g.sort(x)
         ax.plot(g[x].to_numpy(), g[y].to_numpy(), marker="o",
                 label=None if key is None else f"{by} = {key:g}")
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    ax.set_xlabel(_style.label(x))
+    ax.set_ylabel(_style.label(y))
     if by is not None and ok.height:
         ax.legend()
     return fig

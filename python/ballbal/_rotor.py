@@ -34,6 +34,7 @@ import polars as pl
 
 from . import _check
 from ._geometry import Bearing
+from ._style import Summarised
 from .exceptions import ParameterError, ParameterTypeError
 
 if TYPE_CHECKING:
@@ -121,8 +122,8 @@ class RotorOnBearing:
         return self.mass_parameter * self.gravity
 
 
-@dataclass(frozen=True)
-class RotorTrajectory:
+@dataclass(frozen=True, repr=False)
+class RotorTrajectory(Summarised):
     """A simulated trajectory: ``table`` (polars) with columns ``tau, x, y, vx, vy,
     eccentricity, attitude`` (degrees, the journal's direction from ``x``), ``fx, fy,
     radial, tangential`` (film force in ``F_S``; radial positive towards the centre,
@@ -140,6 +141,25 @@ class RotorTrajectory:
     force_evals: int
     message: str
     rotor: RotorOnBearing = field(repr=False)
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        ecc = self.table["eccentricity"]
+        top = float(ecc.max()) if ecc.len() else math.nan  # type: ignore[arg-type]
+        head = (f"RotorTrajectory {self.outcome} τ to {self.t_end:.4g}: {self.table.height} "
+                f"rows, ε max={top:.4g}, {self.accepted_steps} steps")
+        return head, [("outcome", self.outcome), ("τ reached", self.t_end),
+                      ("rows", self.table.height), ("largest eccentricity", top),
+                      ("contact at τ", self.contact_time),
+                      ("steps accepted / rejected",
+                       f"{self.accepted_steps} / {self.rejected_steps}"),
+                      ("force evaluations", self.force_evals), ("message", self.message)]
+
+    def plot(self, axes: Any = None) -> Any:
+        """The journal orbit in the clearance circle and the eccentricity against time
+        (two panels; :func:`plot_trajectory` compares several runs); returns the figure."""
+        from ._figures import rotor_trajectory
+
+        return rotor_trajectory(self, axes)
 
 
 def rotor_equilibrium(rotor: RotorOnBearing) -> tuple[float, float]:
@@ -246,10 +266,10 @@ def plot_trajectory(trajectories: RotorTrajectory | dict[str, RotorTrajectory], 
     ax.set_aspect("equal")
     ax.set_xlim(-1.05, 1.05)
     ax.set_ylim(-1.05, 1.05)
-    ax.set_xlabel("y / c")
-    ax.set_ylabel("-x / c  (x down)")
-    axf.set_xlabel("tau = w t")
-    axf.set_ylabel("tangential film force / F_S")
+    ax.set_xlabel(r"$y/c$")
+    ax.set_ylabel(r"$-x/c$ ($x$ down)")
+    axf.set_xlabel(r"$\tau = \omega t$ (rad)")
+    axf.set_ylabel(r"tangential film force $F_t$ ($F_S$)")
     for a in (ax, axf):
         if any(runs):
             a.legend(fontsize=7)

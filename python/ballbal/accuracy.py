@@ -13,6 +13,7 @@ import numpy as np
 import polars as pl
 
 from . import _check
+from ._progress import Progress, ProgressArg, checked
 from .analysis import PeriodicSolution, periodic
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
@@ -73,6 +74,7 @@ def accuracy_cost(
     neighbour: float = 0.01,
     repeats: int = 5,
     guess: PeriodicSolution | None = None,
+    progress: ProgressArg = False,
 ) -> pl.DataFrame:
     """Error against time for each accuracy knob at one point, as a polars table
     (``model`` may be an autonomous scene).
@@ -101,9 +103,11 @@ def accuracy_cost(
     ``base_N`` and at least every ``N`` (at most 256), at most
     :data:`~ballbal._check.MAX_STUDY_VALUES` values per knob, ``samples`` multiples
     giving at most 65536 samples, ``tol > 0``, ``rtol`` and ``magnus_rtol`` in (0, 1),
-    ``neighbour <= Omega``.
+    ``neighbour <= Omega``. ``progress``: True for a progress bar over the settings
+    (tqdm, notebook-aware), or a callable ``f(done, total)``.
     """
     model_argument("model", model)
+    progress = checked(progress)
     _check.string("pattern", pattern)
     N = [_check.integer("N", n, 1, 256) for n in _knob("N", N)]
     base_N = _check.integer("base_N", base_N, 1, 255)
@@ -162,46 +166,48 @@ def accuracy_cost(
                                        "floquet_method": "magnus"}))
 
     rows = []
-    for knob, value, kw in settings:
-        times = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            # The truncation under study, not one the verdict's bound refined.
-            s = periodic(model, pattern, guess=warm, options=_study_options(kw))
-            times.append(time.perf_counter() - t0)
-        ok = s.converged and s.multipliers is not None
-        errors: dict[str, float | None] = dict.fromkeys(
-            ("omega_error", "coeff_error", "multiplier_error"))
-        if (s.converged and s.omega is not None and s.multipliers is not None
-                and ref.omega is not None and ref.multipliers is not None):
-            errors = {
-                "omega_error": abs(s.omega - ref.omega) / ref.omega,
-                "coeff_error": _coeff_error(s.coeffs, ref.coeffs),
-                "multiplier_error": _match_error(s.multipliers, ref.multipliers),
-            }
-        rows.append({
-            "knob": knob, "value": float(value), "N": int(kw["N"]),
-            "samples": s.samples, "tol": float(kw["tol"]), "rtol": float(kw["rtol"]),
-            "status": s.status, "iterations": s.iterations,
-            "floquet_steps": s.floquet_steps, "seconds": statistics.median(times),
-            **errors,
-            "trivial_error": s.trivial_error, "tail": s.tail if ok else None,
-            "closure": s.closure, "separation_error": s.separation_error,
-            "stability": s.stability,
-            "verdict_ok": (s.stability == ref.stability)
-            if ok and "undetermined" not in (s.stability, ref.stability) else None,
-            "reference_closure": closure,
-        })
+    with Progress(progress, len(settings), "ballbal accuracy study") as bar:
+        for knob, value, kw in settings:
+            times = []
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                # The truncation under study, not one the verdict's bound refined.
+                s = periodic(model, pattern, guess=warm, options=_study_options(kw))
+                times.append(time.perf_counter() - t0)
+            ok = s.converged and s.multipliers is not None
+            errors: dict[str, float | None] = dict.fromkeys(
+                ("omega_error", "coeff_error", "multiplier_error"))
+            if (s.converged and s.omega is not None and s.multipliers is not None
+                    and ref.omega is not None and ref.multipliers is not None):
+                errors = {
+                    "omega_error": abs(s.omega - ref.omega) / ref.omega,
+                    "coeff_error": _coeff_error(s.coeffs, ref.coeffs),
+                    "multiplier_error": _match_error(s.multipliers, ref.multipliers),
+                }
+            rows.append({
+                "knob": knob, "value": float(value), "N": int(kw["N"]),
+                "samples": s.samples, "tol": float(kw["tol"]), "rtol": float(kw["rtol"]),
+                "status": s.status, "iterations": s.iterations,
+                "floquet_steps": s.floquet_steps, "seconds": statistics.median(times),
+                **errors,
+                "trivial_error": s.trivial_error, "tail": s.tail if ok else None,
+                "closure": s.closure, "separation_error": s.separation_error,
+                "stability": s.stability,
+                "verdict_ok": (s.stability == ref.stability)
+                if ok and "undetermined" not in (s.stability, ref.stability) else None,
+                "reference_closure": closure,
+            })
+            bar.update()
     return pl.DataFrame(rows)
 
 
 def plot_accuracy_cost(df: pl.DataFrame, *, error: str = "multiplier_error", ax: Any = None,
                        title: str | None = None) -> Any:
     """Error against time, one curve per knob, with the Pareto front of all settings."""
-    import matplotlib.pyplot as plt
+    from ._style import pyplot
 
     if ax is None:
-        _, ax = plt.subplots(figsize=(6.5, 4.5))
+        _, ax = pyplot().subplots(figsize=(6.5, 4.5))
     ok = df.filter(pl.col(error).is_not_null() & (pl.col(error) > 0))
     for knob, mark in (("N", "o-"), ("samples", "s-"), ("tol", "^-"), ("rtol", "v-"),
                        ("magnus", "D-")):

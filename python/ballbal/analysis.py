@@ -10,6 +10,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
+from ._style import Summarised
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
 from .options import PERIODIC_DEFAULTS, PeriodicOptions, refuses_keywords, with_harmonics
@@ -148,9 +149,10 @@ def _span(t_span: Any) -> tuple[float, float]:
     return a, b
 
 
-@dataclass(frozen=True)
-class Equilibrium(LineSource):
-    """One equilibrium: balls at rest relative to the disk."""
+@dataclass(frozen=True, repr=False)
+class Equilibrium(Summarised, LineSource):
+    """One equilibrium: balls at rest relative to the disk. In a notebook: a one-line
+    summary, an HTML table, and :meth:`plot` (its eigenvalues)."""
 
     kind: str
     q: np.ndarray
@@ -179,6 +181,23 @@ class Equilibrium(LineSource):
         spin = _check.real("Omega", Omega, finite=True)
         return (np.zeros(1, dtype=int), np.array([self.q[0] + 1j * self.q[1]]),
                 spin, float("nan"))
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        r = float(np.hypot(self.q[0], self.q[1]))
+        head = (f"Equilibrium {self.kind} {self.stability} max Re λ={self.stability_index:.4g} "
+                f"|Z|={r:.4g} residual imbalance={self.residual_imbalance:.4g}")
+        return head, [("kind", self.kind), ("stability", self.stability),
+                      ("max Re λ", self.stability_index), ("|Z| (e)", r),
+                      ("residual imbalance", self.residual_imbalance),
+                      ("neutral eigenvalues", self.neutral),
+                      ("Routh-Hurwitz stable", self.routh_hurwitz),
+                      ("residual", self.residual), ("exhaustive search", self.exhaustive)]
+
+    def plot(self, ax: Any = None) -> Any:
+        """The eigenvalues in the complex plane (returns the axes)."""
+        from ._figures import equilibrium
+
+        return equilibrium(self, ax)
 
 
 def equilibria(model: Balancer | Scene) -> list[Equilibrium]:
@@ -245,8 +264,8 @@ def _equilibrium(d: dict[str, Any], eta: np.ndarray | None = None) -> Equilibriu
     )
 
 
-@dataclass(frozen=True)
-class PeriodicSolution(LineSource):
+@dataclass(frozen=True, repr=False)
+class PeriodicSolution(Summarised, LineSource):
     """A periodic solution from harmonic balance (or a failed attempt: see ``status``).
 
     ``coeffs[j] = [a_0, a_1, b_1, ..., a_N, b_N]`` for coordinate ``j`` of
@@ -317,6 +336,31 @@ class PeriodicSolution(LineSource):
         c[n + 1:] = 0.5 * ((a_x + b_y) + 1j * (a_y - b_x))
         c[:n] = (0.5 * ((a_x - b_y) + 1j * (a_y + b_x)))[::-1]
         return k, c, float(spin), float(self.omega)
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        spin = f"Ω={self.balancer.Omega:.4g}"
+        if self.omega is None:
+            head = f"PeriodicSolution {self.type} {spin} {self.status} (N={self.N})"
+        else:
+            mod = "-" if self.max_modulus is None else f"{self.max_modulus:.3g}"
+            head = (f"PeriodicSolution {self.type} {spin} ω={self.omega:.4f} {self.stability} "
+                    f"|μ|max={mod} (N={self.N})")
+            if self.status != "converged":
+                head += f" {self.status}"
+        return head, [("type", self.type), ("status", self.status),
+                      ("Ω (spin)", self.balancer.Omega), ("ω (balls)", self.omega),
+                      ("stability", self.stability), ("|μ|max", self.max_modulus),
+                      ("|μ|max error", self.modulus_error), ("harmonics N", self.N),
+                      ("closure", self.closure), ("tail", self.tail),
+                      ("residual", self.residual), ("iterations", self.iterations)]
+
+    def plot(self, axes: Any = None) -> Any:
+        """Time series of the disk centre, its orbit in the ground frame and the ball
+        angles (three panels; ``axes``: three matplotlib axes, default a new figure;
+        returns the figure)."""
+        from ._figures import periodic_solution
+
+        return periodic_solution(self, axes)
 
     @property
     def converged(self) -> bool:

@@ -130,10 +130,10 @@ def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: st
     """Stable balanced region of a :func:`balance_map` in the ``(x, y)`` plane, filled.
     With ``max_whirl``, a stable state whose residual whirl exceeds it (springs at low
     speed hold the balls apart without balancing) is drawn apart, in grey."""
-    import matplotlib.pyplot as plt
+    from . import _style as style
 
     if ax is None:
-        _, ax = plt.subplots(figsize=(5, 4))
+        _, ax = style.pyplot().subplots(figsize=(5, 4))
     xs = np.unique(df[x].to_numpy())
     ys = np.unique(df[y].to_numpy())
     grid = np.full((ys.size, xs.size), np.nan)
@@ -146,8 +146,8 @@ def plot_balance_map(df: pl.DataFrame, x: str, y: str, ax: Any = None, label: st
     ax.contourf(xs, ys, grid, levels=[0.5, 1.5, 2.5], colors=["tab:green", "0.6"],
                 alpha=0.35)
     ax.contour(xs, ys, np.where(grid == 1.0, 1.0, 0.0), levels=[0.5], colors=["tab:green"])
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    style.axes_labels(ax, x, y)
+    style.caption(ax, style.fixed_caption(df, (x, y)))
     if label:
-        ax.set_title(label)
+        ax.set_title(label, pad=14)
     return ax

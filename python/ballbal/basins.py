@@ -44,6 +44,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
+from ._progress import Progress
 from .exceptions import ParameterError, ParameterTypeError, ScanInterrupted, ScanStoreError
 from .model import Balancer
 from .options import Execution
@@ -172,12 +173,27 @@ class Basins:
         return lines
 
     def __repr__(self) -> str:
-        return "\n".join(self._summary())
+        lines = self._summary()
+        if len(lines) > 6:  # a notebook's summary stays short: the orbits are in .orbits
+            lines = [*lines[:5], f"  ... {len(lines) - 5} more lines: see .orbits"]
+        return "\n".join(lines)
 
     def _repr_html_(self) -> str:
-        import html
+        from ._style import html_table
 
-        return "<pre>" + html.escape(repr(self)) + "</pre>"
+        rows: list[tuple[str, Any]] = [
+            (r["label"], f"{r['count']} ({r['fraction']:.1%} ± {r['standard_error']:.1%})")
+            for r in self.fractions.iter_rows(named=True)]
+        for o in self.orbits.head(10).iter_rows(named=True):
+            om = "-" if o["omega"] is None else f"{o['omega']:.6g}"
+            rows.append((f"orbit {o['orbit']}", f"{o['label']} windings ({o['winding1']}, "
+                         f"{o['winding2']}), {o['count']} starts, omega {om}, "
+                         f"{o['status']}, {o['stability']}"))
+        return html_table(self._summary()[0], rows)
+
+    def plot(self, ax: Any = None) -> Any:
+        """The basin map (:func:`plot_basins`); returns the axes."""
+        return plot_basins(self, ax=ax)
 
     @property
     def fractions(self) -> pl.DataFrame:
@@ -402,8 +418,9 @@ def basins(
     a :class:`~ballbal.exceptions.ScanInterrupted` warning, as :func:`ballbal.scan`
     does (with ``out`` they are also on disk, and the same call resumes);
     ``executor``: a ``concurrent.futures`` executor or Dask ``Client`` running the
-    chunks as tasks (``threads`` per task, default 1). None of it changes the
-    table.
+    chunks as tasks (``threads`` per task, default 1); ``progress``: True for a
+    progress bar over the starts (tqdm, notebook-aware) or a callable ``f(done,
+    total)``. None of it changes the table.
 
     ``orbits``: link every periodic start to its orbit (:attr:`Basins.orbits`, the
     table's ``orbit`` column; see :func:`_link_orbits`), solved with ``N`` harmonics
@@ -510,16 +527,22 @@ def basins(
     interrupted = False
     from .scan import _as_completed, _interrupted
 
+    meter: list[Progress] = []  # made once the finished chunks on disk are known
+
     def keep(c: int, cols: dict[str, Any]) -> None:
         df = frame(c, cols)
         if store is not None:
             store.write(c, df)
         parts[c] = df
+        for m in meter:
+            m.update(sizes[c])
 
     def work() -> None:
         nonlocal done, todo
         done = store.done(sizes) if store is not None else set()
         todo = [c for c in range(n_chunks) if c not in done]
+        meter.append(Progress(execution.progress, len(starts), "ballbal basins", "start",
+                              done=sum(sizes[c] for c in done)))
         if todo and execution.executor is not None:
             per_task = 1 if execution.threads is None else threads
             futures = {execution.executor.submit(
@@ -559,6 +582,8 @@ def basins(
                 stacklevel=2,
             )
     finally:
+        for m in meter:
+            m.close()
         if store is not None:
             store.close()
     df = (pl.concat([parts[c] for c in sorted(parts)], how="vertical") if parts
@@ -659,9 +684,11 @@ def _solve_orbit(model: Balancer | Scene, r: dict[str, Any], state: list[float],
 def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> Any:
     """A categorical map of the labels over the starts (matplotlib, imported here); the
     legend names the orbits each class is linked to (:attr:`Basins.orbits`)."""
-    import matplotlib.pyplot as plt
     from matplotlib.lines import Line2D
 
+    from . import _style as style
+
+    plt = style.pyplot()
     if not isinstance(result, Basins):
         raise ParameterTypeError("result", "must be a Basins (from ballbal.basins.basins), "
                                  f"got {type(result).__name__}", value=result)
@@ -675,14 +702,23 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
                "failed": "magenta"}
     t = result.table
     present = [lab for lab in LABELS if lab in set(t["label"].to_list())]
-    size = (250.0 / np.sqrt(max(t.height, 1))) ** 2  # squares that tile the map
+    # squares that tile the map: a cell of the grid each (random starts: of the grid of
+    # as many points)
+    side = max(1, round(math.sqrt(t.height)))
+    nx, ny = ((side, side) if result.random or t.height == 0
+              else (t["b1"].n_unique(), t["b2"].n_unique()))
+    ax.set_aspect("equal")
+    size = style.grid_marker_size(ax, nx, ny, fill=0.95, largest=math.inf)
     for lab in present:
         s = t.filter(pl.col("label") == lab)
         ax.scatter(s["b1"], s["b2"], s=size, c=colours[lab], edgecolors="0.6",
                    linewidths=0.2, marker="s")
-    ax.set_xlabel("b1 (rad)")
-    ax.set_ylabel("b2 (rad)")
-    ax.set_aspect("equal")
+    ax.set_xlabel(style.label("b1"))
+    ax.set_ylabel(style.label("b2"))
+    if not result.random and t.height:
+        style.pad_to_grid(ax, t["b1"].to_numpy(), t["b2"].to_numpy())
+    style.caption(ax, style.fixed_caption(result.model))
+
     def name(lab: str) -> str:
         # the orbits a class is linked to, with their windings
         o = result.orbits.filter(pl.col("label") == lab)
@@ -693,5 +729,5 @@ def plot_basins(result: Basins, *, ax: Any = None, title: str | None = None) -> 
                               label=name(lab)) for lab in present],
               loc="upper left", fontsize="small", framealpha=0.8)
     if title is not None:
-        ax.set_title(title)
+        ax.set_title(title, pad=14)
     return ax

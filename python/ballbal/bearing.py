@@ -50,6 +50,7 @@ from ._rotor import (
     rotor_equilibrium,
     simulate_rotor,
 )
+from ._style import Summarised
 from .exceptions import ParameterError, ParameterTypeError
 
 if TYPE_CHECKING:
@@ -143,8 +144,8 @@ class Dimensions:
         return f.pressure * self.pressure_scale(speed)
 
 
-@dataclass(frozen=True)
-class FilmForce:
+@dataclass(frozen=True, repr=False)
+class FilmForce(Summarised):
     """The film's force on the journal, nondimensional (module doc: units, conventions).
 
     ``fx, fy``: fixed frame, units ``F_S``; ``radial`` (positive towards the centre) and
@@ -171,6 +172,23 @@ class FilmForce:
     theta: npt.NDArray[np.float64] | None = None
     zeta: npt.NDArray[np.float64] | None = None
 
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        grid = ("no pressure field" if self.pressure is None
+                else "pressure field {}x{}".format(*self.pressure.shape))
+        head = (f"FilmForce ε={self.eccentricity:.4g} load={self.load:.4g} "
+                f"attitude={math.degrees(self.attitude):.1f}° S={self.sommerfeld:.4g} ({grid})")
+        return head, [("eccentricity e/c", self.eccentricity),
+                      ("F_x, F_y (F_S)", f"{self.fx:.4g}, {self.fy:.4g}"),
+                      ("radial, tangential (F_S)", f"{self.radial:.4g}, {self.tangential:.4g}"),
+                      ("attitude (deg)", math.degrees(self.attitude)),
+                      ("Sommerfeld S", self.sommerfeld), ("peak pressure", self.peak_pressure),
+                      ("minimum film h/c", self.min_film), ("field", grid)]
+
+    def plot(self, ax: Axes | None = None) -> Figure:
+        """The pressure field (:func:`plot_pressure`; needs ``field=True``); returns the
+        figure."""
+        return plot_pressure(self, ax=ax)
+
 
 def _film_force(name: str, f: Any) -> FilmForce:
     if not isinstance(f, FilmForce):
@@ -194,8 +212,8 @@ def film_force(bearing: Bearing, position: Any, velocity: Any = (0.0, 0.0), *,
     return FilmForce(load=math.hypot(d["fx"], d["fy"]), **d)
 
 
-@dataclass(frozen=True)
-class BearingEquilibrium:
+@dataclass(frozen=True, repr=False)
+class BearingEquilibrium(Summarised):
     """Static journal position under a load: ``position`` ``(x, y)`` (units ``c``),
     ``eccentricity``, ``attitude`` (radians from the load's direction to the journal's, in
     the direction of rotation), ``load`` ``(W_x, W_y)`` in ``F_S``, ``sommerfeld`` ``S = 1
@@ -207,6 +225,23 @@ class BearingEquilibrium:
     load: tuple[float, float]
     sommerfeld: float
     iterations: int
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        head = (f"BearingEquilibrium ε={self.eccentricity:.4g} "
+                f"attitude={math.degrees(self.attitude):.1f}° S={self.sommerfeld:.4g} "
+                f"at ({self.position[0]:.4g}, {self.position[1]:.4g})")
+        return head, [("position x, y (c)", f"{self.position[0]:.4g}, {self.position[1]:.4g}"),
+                      ("eccentricity e/c", self.eccentricity),
+                      ("attitude (deg)", math.degrees(self.attitude)),
+                      ("load W_x, W_y (F_S)", f"{self.load[0]:.4g}, {self.load[1]:.4g}"),
+                      ("Sommerfeld S", self.sommerfeld), ("Newton iterations", self.iterations)]
+
+    def plot(self, ax: Any = None) -> Any:
+        """The journal's position inside the clearance circle and the load's direction;
+        returns the axes."""
+        from ._figures import bearing_equilibrium
+
+        return bearing_equilibrium(self, ax)
 
 
 def _load(load: Any, dimensions: Dimensions | None, speed: float | None) -> tuple[float, float]:
@@ -261,17 +296,26 @@ def equilibrium(bearing: Bearing, load: Any, *, dimensions: Dimensions | None = 
     )
 
 
-@dataclass(frozen=True)
-class Coefficients:
+@dataclass(frozen=True, repr=False)
+class Coefficients(Summarised):
     """Linearised film at a static position, ``f(q0 + dq, dq') ~ f(q0) - K dq - C dq'``,
     ``[i, j]`` = force ``i`` per displacement (velocity) ``j``, ``x, y`` fixed frame:
     ``k`` in ``F_S / c``, ``c`` in ``F_S / (c w)``; ``k_si`` [N/m] and ``c_si`` [N s/m] when
-    dimensions and speed are given."""
+    dimensions and speed are given. No ``plot``: eight numbers, all in its summary."""
 
     k: npt.NDArray[np.float64]
     c: npt.NDArray[np.float64]
     k_si: npt.NDArray[np.float64] | None = None
     c_si: npt.NDArray[np.float64] | None = None
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        def m(a: Any) -> str:
+            return "[[{:.4g}, {:.4g}], [{:.4g}, {:.4g}]]".format(*np.asarray(a).ravel())
+        head = f"Coefficients K={m(self.k)} C={m(self.c)}"
+        rows: list[tuple[str, Any]] = [("K (F_S/c)", m(self.k)), ("C (F_S/(c ω))", m(self.c))]
+        if self.k_si is not None and self.c_si is not None:
+            rows += [("K (N/m)", m(self.k_si)), ("C (N s/m)", m(self.c_si))]
+        return head, rows
 
 
 def coefficients(bearing: Bearing, position: Any, *, dimensions: Dimensions | None = None,
@@ -292,8 +336,8 @@ def coefficients(bearing: Bearing, position: Any, *, dimensions: Dimensions | No
                         c_si=c * dims.damping_scale(speed))
 
 
-@dataclass(frozen=True)
-class Stability:
+@dataclass(frozen=True, repr=False)
+class Stability(Summarised):
     """Whirl threshold of a rigid rotor (mass ``M``, fixed frame, no balls) on the bearing
     at the equilibrium under the load ``W``.
 
@@ -308,6 +352,19 @@ class Stability:
     critical_mass: float
     equilibrium: BearingEquilibrium
     coefficients: Coefficients
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        head = (f"Stability threshold speed={self.threshold_speed:.4g} "
+                f"whirl ratio={self.whirl_ratio:.4g} critical mass={self.critical_mass:.4g} "
+                f"at ε={self.equilibrium.eccentricity:.4g}")
+        return head, [("threshold speed", self.threshold_speed),
+                      ("whirl ratio", self.whirl_ratio), ("critical mass", self.critical_mass),
+                      ("eccentricity e/c", self.equilibrium.eccentricity),
+                      ("Sommerfeld S", self.equilibrium.sommerfeld)]
+
+    def plot(self, ax: Any = None) -> Any:
+        """The equilibrium it was computed at (:meth:`BearingEquilibrium.plot`)."""
+        return self.equilibrium.plot(ax)
 
 
 def stability(bearing: Bearing, load: Any, *, dimensions: Dimensions | None = None,
@@ -357,8 +414,8 @@ def plot_pressure(force_or_bearing: FilmForce | Bearing, position: Any = None,
     fig.colorbar(cs, ax=ax, label="P = p c² / (μ ω R²)")
     phi = math.degrees(f.position_angle) % 360.0
     ax.axvline(phi, color="w", ls="--", lw=1.0, label=f"minimum film h/c = {f.min_film:.3g}")
-    ax.set_xlabel("θ [deg]")
-    ax.set_ylabel("ζ = z / R")
+    ax.set_xlabel(r"$\theta$ (deg)")
+    ax.set_ylabel(r"$z/R$")
     ax.set_title(f"ε = {f.eccentricity:.3g}, attitude {math.degrees(f.attitude):.1f}°, "
                  f"P_max = {f.peak_pressure:.3g}")
     ax.legend(loc="upper right", fontsize="small")

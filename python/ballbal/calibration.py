@@ -324,7 +324,8 @@ class Transition:
     model's stable band ends at the measured ``speed_rpm``, and ``low``/``high`` at the
     speeds ``speed_rpm -+ uncertainty_rpm`` (``None`` where the band cannot end there
     for any value in ``bracket``); ``status`` is ``"ok"`` or ``"unreachable"`` (then
-    ``value`` is None and ``reach_rpm`` gives the band ends at the bracket's ends)."""
+    ``value`` is None and ``reach_rpm`` gives the band ends at the bracket's ends). No
+    ``plot``: one value and its interval, all in its summary."""
 
     parameter: str
     speed_rpm: float
@@ -343,6 +344,14 @@ class Transition:
                 f"[{self.low if self.low is not None else float('nan'):.4g}, "
                 f"{self.high if self.high is not None else float('nan'):.4g}] "
                 f"for {self.speed_rpm:.0f} ± {self.uncertainty_rpm:g} rpm)")
+
+    def _repr_html_(self) -> str:
+        from ._style import html_table
+
+        return html_table(f"Transition of {self.parameter}", [
+            ("speed (rpm)", f"{self.speed_rpm:.0f} ± {self.uncertainty_rpm:g}"),
+            ("status", self.status), (self.parameter, self.value), ("low", self.low),
+            ("high", self.high)])
 
 
 def calibrate_transition(

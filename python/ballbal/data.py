@@ -26,6 +26,7 @@ import numpy as np
 import polars as pl
 
 from . import _check
+from ._style import Summarised
 from .exceptions import ParameterError, ParameterTypeError
 from .model import zeta_from_log_decrement
 
@@ -325,8 +326,8 @@ def leaf_spring_stiffness(modulus: float, width: float, thickness: float,
     return 17.0 * e * b * h**3 / (8.0 * l_**3)
 
 
-@dataclass(frozen=True)
-class LogDecrement:
+@dataclass(frozen=True, repr=False)
+class LogDecrement(Summarised):
     """A log-decrement fit: ``delta`` (the slope of ``ln x_i`` against peak number ``i``,
     negated), the damping ratio ``zeta = delta / sqrt(4 pi^2 + delta^2)``, the peaks used
     (index into the record, value) and the fit's residual standard deviation."""
@@ -336,6 +337,18 @@ class LogDecrement:
     peak_index: np.ndarray
     peak_value: np.ndarray
     residual: float
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        head = (f"LogDecrement δ={self.delta:.4g} ζ={self.zeta:.4g} from "
+                f"{len(self.peak_value)} peaks (residual {self.residual:.2g})")
+        return head, [("log decrement δ", self.delta), ("damping ratio ζ", self.zeta),
+                      ("peaks", len(self.peak_value)), ("fit residual", self.residual)]
+
+    def plot(self, ax: Any = None) -> Any:
+        """The peaks' logarithms and the fitted line; returns the axes."""
+        from ._figures import log_decrement
+
+        return log_decrement(self, ax)
 
 
 def log_decrement(signal: Sequence[float] | np.ndarray, *, n_peaks: int = 5) -> LogDecrement:

@@ -1,4 +1,6 @@
-"""Plots of scan tables (matplotlib, installed with the ``plot`` extra)."""
+"""Plots of scan tables (matplotlib, installed with the ``plot`` extra), in the style of
+:mod:`ballbal._style`: mathtext symbols with units on the axes, the fixed parameters
+over the map, markers sized to the grid."""
 
 from __future__ import annotations
 
@@ -7,16 +9,15 @@ from typing import Any
 import numpy as np
 import polars as pl
 
+from . import _style as style
+
 _MARK = {"stable": ("o", "tab:blue"), "unstable": ("x", "tab:red"),
          "undetermined": ("^", "tab:gray")}
 
 
 def _pyplot() -> Any:
-    try:
-        import matplotlib.pyplot as plt
-    except ImportError as e:  # pragma: no cover - depends on the install
-        raise ImportError("plotting needs matplotlib: pip install 'ballbal[plot]'") from e
-    return plt
+    """matplotlib's pyplot, or an ImportError naming the extra (:func:`_style.pyplot`)."""
+    return style.pyplot()
 
 
 def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = "R-R",
@@ -28,7 +29,8 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
     :class:`~ballbal.continuation` curves (``Curve`` objects whose tables have the columns
     ``x`` and ``y``) drawn over the map, with their codimension-two points (black stars
     for the confirmed ones; points whose multipliers reject or cannot decide the label,
-    ``status`` other than ``"confirmed"``, as hollow grey circles)."""
+    ``status`` other than ``"confirmed"``, as hollow grey circles). The parameters the
+    table holds fixed are written over the map; markers fill a share of one grid cell."""
     plt = _pyplot()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))
@@ -44,11 +46,13 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
         ax.contourf(xs, ys, stable, levels=[0.5, 1.5], colors=["#cfe8cf"])
     ax.plot([], [], "s", color="#cfe8cf", label=shade)
     sols = df.filter((pl.col("type") == type) & (pl.col("status") == "converged"))
+    size = style.grid_marker_size(ax, xs.size, ys.size)
     for verdict, (m, c) in _MARK.items():
         s = sols.filter(pl.col("stability") == verdict)
         if s.height:
-            ax.scatter(s[x], s[y], marker=m, color=c, s=28, label=f"{type} {verdict}",
+            ax.scatter(s[x], s[y], marker=m, color=c, s=size, label=f"{type} {verdict}",
                        facecolors="none" if m == "o" and verdict != "stable" else None)
+    style.pad_to_grid(ax, xs, ys)
     for cv in curves:
         t = cv.table
         for col in (x, y):
@@ -66,9 +70,9 @@ def scan_map(df: pl.DataFrame, *, x: str = "Omega", y: str = "eta", type: str = 
                 ax.plot(other[x], other[y], "o", ms=6, mfc="none", color="tab:gray")
         elif pts.height:
             ax.plot(pts[x], pts[y], "k*", ms=9)
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
-    ax.set_title(title or f"{type} solutions")
+    style.axes_labels(ax, x, y)
+    ax.set_title(title or f"{type} solutions", pad=14)
+    style.caption(ax, style.fixed_caption(df, (x, y)))
     ax.legend(loc="best", fontsize=8)
     return ax
 
@@ -84,9 +88,9 @@ def omega_curves(df: pl.DataFrame, *, x: str = "eta", by: str = "Omega",
         s = s.filter(pl.col("stability") == "stable")
     for v in sorted(s[by].unique().to_list()):
         part = s.filter(pl.col(by) == v).sort(x)
-        ax.plot(part[x], part["omega"], "o-", ms=3, label=f"{by} = {v:g}")
-    ax.set_xlabel(x)
-    ax.set_ylabel("omega")
-    ax.set_title(f"{type}: frequency of the ball motion")
+        ax.plot(part[x], part["omega"], "o-", ms=3, label=f"{style.symbol(by)} = {v:g}")
+    style.axes_labels(ax, x, "omega")
+    ax.set_title(f"{type}: frequency of the ball motion", pad=14)
+    style.caption(ax, style.fixed_caption(df, (x, by)))
     ax.legend(fontsize=7, ncol=2)
     return ax

@@ -34,6 +34,8 @@ import numpy as np
 import polars as pl
 
 from . import _check
+from ._style import Summarised
+from ._style import label as label_of
 from .exceptions import ParameterError, ParameterTypeError
 
 if TYPE_CHECKING:
@@ -196,8 +198,8 @@ def line_spectrum(
 # The vibration indicator
 
 
-@dataclass(frozen=True)
-class Vibration:
+@dataclass(frozen=True, repr=False)
+class Vibration(Summarised):
     """Statistics of ``|Z|``, ``|Z'|`` or ``|Z''|`` (``quantity``) over the motion.
 
     ``mean``, ``min``, ``max`` and ``rms`` in the units of :func:`line_spectrum`
@@ -206,7 +208,8 @@ class Vibration:
     ``exact``: from a periodic solution's coefficients (see :func:`vibration`), else from
     samples of a simulation; ``mean_error``: the last change of the mean as the samples
     were doubled (exact case) or ``nan``; ``samples``: how many values the statistics
-    took.
+    took. No ``plot``: four numbers, all in its summary (the orbit's own
+    :meth:`~ballbal.PeriodicSolution.plot` draws the motion).
     """
 
     quantity: str
@@ -217,6 +220,14 @@ class Vibration:
     exact: bool
     samples: int
     mean_error: float = float("nan")
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        how = "exact" if self.exact else "sampled"
+        head = (f"Vibration {self.quantity} mean={self.mean:.4g} min={self.min:.4g} "
+                f"max={self.max:.4g} rms={self.rms:.4g} ({how}, {self.samples} samples)")
+        return head, [("quantity", self.quantity), ("mean", self.mean), ("min", self.min),
+                      ("max", self.max), ("rms", self.rms), ("exact", self.exact),
+                      ("samples", self.samples), ("mean error", self.mean_error)]
 
 
 def _trig(C: np.ndarray, k: np.ndarray, s: float, d: int) -> complex:
@@ -780,7 +791,7 @@ def plot_spectrum(spectrum: pl.DataFrame, *, column: str = "frequency",
     else:
         ax.plot(f, a, lw=0.9)
     ax.axvline(0, color="0.8", lw=0.6)
-    ax.set_xlabel({"frequency": "frequency ratio", "frequency_rpm": "frequency (rpm)",
+    ax.set_xlabel({"frequency": label_of("frequency"), "frequency_rpm": "frequency (rpm)",
                    "frequency_hz": "frequency (Hz)"}.get(column, column))
     ax.set_ylabel(amplitude)
     if title:
@@ -819,7 +830,7 @@ def plot_waterfall(table: pl.DataFrame, *, name: str = "Omega", column: str = "f
             ax.vlines(f, sp, sp + gain * a, color="tab:blue", lw=1.2)
         else:
             ax.plot(f, sp + gain * a, color="tab:blue", lw=0.8)
-    ax.set_xlabel({"frequency": "frequency ratio", "frequency_rpm": "frequency (rpm)",
+    ax.set_xlabel({"frequency": label_of("frequency"), "frequency_rpm": "frequency (rpm)",
                    "frequency_hz": "frequency (Hz)"}.get(column, column))
-    ax.set_ylabel(name)
+    ax.set_ylabel(label_of(name))
     return ax

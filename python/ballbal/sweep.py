@@ -36,6 +36,8 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
+from ._progress import Progress, ProgressArg
+from ._style import Summarised, value_range
 from .basins import REST, ROTATING, BasinOptions
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
@@ -67,8 +69,8 @@ def carry_over(y: np.ndarray, omega_from: float, omega_to: float, n_balls: int,
     return y
 
 
-@dataclass(frozen=True)
-class Sweep:
+@dataclass(frozen=True, repr=False)
+class Sweep(Summarised):
     """The result of :func:`speed_sweep`: ``table`` (one row per step: ``step,
     direction, Omega, Omega_index`` (the speed's position on the ``speeds`` axis, for
     exact joins), ``label, omega`` (mean ball rate), ``period``, ``rotating``, and
@@ -99,12 +101,35 @@ class Sweep:
                  for (k, dirn, om), sp in zip(steps, self.spectra, strict=True)]
         return waterfall(parts)
 
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        span = value_range(self.table["Omega"])
+        dirs = "/".join(dict.fromkeys(self.table["direction"].to_list()))
+        hy = self.hysteresis
+        head = (f"Sweep Ω {span} {dirs}: {self.table.height} steps, up {_fmt(self.up)}, "
+                f"down {_fmt(self.down)}, hysteresis {_fmt(hy)}")
+        labels = self.table["label"].unique(maintain_order=True).to_list()
+        return head, [("speeds Ω", span), ("directions", dirs), ("steps", self.table.height),
+                      ("up (critical speed)", self.up), ("down (critical speed)", self.down),
+                      ("hysteresis up - down", hy), ("motions seen", ", ".join(labels)),
+                      ("spectra recorded", len(self.spectra))]
+
+    def plot(self, axes: Any = None) -> Any:
+        """The balls' mean rate and (when recorded) the vibration against the speed, up
+        and down, the transition speeds marked (the hysteresis); returns the figure."""
+        from ._figures import sweep
+
+        return sweep(self, axes)
+
     @property
     def hysteresis(self) -> float | None:
         """``up - down``: the width of the speed range where both motions are seen."""
         if self.up is None or self.down is None:
             return None
         return self.up - self.down
+
+
+def _fmt(v: float | None) -> str:
+    return "-" if v is None else f"{v:.4g}"
 
 
 def speed_sweep(
@@ -117,6 +142,7 @@ def speed_sweep(
     record: float | None = 100.0,
     y0: Sequence[float] | np.ndarray | None = None,
     options: BasinOptions | None = None,
+    progress: ProgressArg = False,
 ) -> Sweep:
     """Step the speed through ``speeds`` (ascending; ``(start, stop, step)`` with
     ``stop`` included, or explicit values, as every gridded function takes an axis) up,
@@ -134,6 +160,9 @@ def speed_sweep(
     any step runs): at most :data:`~ballbal._check.MAX_SWEEP_STEPS` steps, ``dwell``
     and ``record`` in ``(0, 1e6]``, ``|kick| <= pi``, and at most
     :data:`~ballbal._check.MAX_SAMPLES` recorded samples over the sweep.
+
+    ``progress``: True for a progress bar over the steps (tqdm, notebook-aware), or a
+    callable ``f(done_steps, total_steps)``.
     """
     from .analysis import simulate
     from .spectrum import ground_signal, signal_spectrum, vibration
@@ -185,26 +214,28 @@ def speed_sweep(
     prev = float(sp[path[0][0]])
     rows: list[dict[str, Any]] = []
     spectra: list[pl.DataFrame] = []
-    for k, (i, dirn) in enumerate(path):
-        om = float(sp[i])
-        y = carry_over(y, prev, om, n, d)
-        if kick and n >= 2:
-            y[d - n] += kick
-            y[d - n + 1] -= kick
-        m = model.replace(Omega=om)
-        cols, y = _native.classify_state(m, np.ascontiguousarray(y), o)
-        row: dict[str, Any] = {"step": k, "direction": dirn, "Omega": om, "Omega_index": i,
-                               "label": cols["label"][0], "omega": cols["omega"][0],
-                               "period": cols["period"][0]}
-        row["rotating"] = row["label"] in ROTATING
-        row["at_rest"] = row["label"] in REST
-        if record is not None:
-            rec = simulate(m, y, t_eval=np.linspace(0.0, record, int(record * 20) + 1),
-                           rtol=o.rtol, atol=o.atol)
-            row["vibration"] = vibration(rec).mean
-            spectra.append(signal_spectrum(ground_signal(rec), window="flattop"))
-        rows.append(row)
-        prev = om
+    with Progress(progress, len(path), "ballbal speed sweep") as bar:
+        for k, (i, dirn) in enumerate(path):
+            om = float(sp[i])
+            y = carry_over(y, prev, om, n, d)
+            if kick and n >= 2:
+                y[d - n] += kick
+                y[d - n + 1] -= kick
+            m = model.replace(Omega=om)
+            cols, y = _native.classify_state(m, np.ascontiguousarray(y), o)
+            row: dict[str, Any] = {"step": k, "direction": dirn, "Omega": om, "Omega_index": i,
+                                   "label": cols["label"][0], "omega": cols["omega"][0],
+                                   "period": cols["period"][0]}
+            row["rotating"] = row["label"] in ROTATING
+            row["at_rest"] = row["label"] in REST
+            if record is not None:
+                rec = simulate(m, y, t_eval=np.linspace(0.0, record, int(record * 20) + 1),
+                               rtol=o.rtol, atol=o.atol)
+                row["vibration"] = vibration(rec).mean
+                spectra.append(signal_spectrum(ground_signal(rec), window="flattop"))
+            rows.append(row)
+            prev = om
+            bar.update()
     table = pl.DataFrame(rows)
     return Sweep(table, *_transitions(table, direction), spectra=tuple(spectra))
 

@@ -11,6 +11,8 @@ import numpy as np
 import polars as pl
 
 from . import _check
+from ._progress import Progress, ProgressArg
+from ._style import Summarised
 from .analysis import simulate
 from .balance import balanced_state
 from .exceptions import NotAutonomousError, ParameterError
@@ -18,8 +20,8 @@ from .model import Balancer
 from .scene import Ramp, Scene, model_argument
 
 
-@dataclass(frozen=True)
-class DisturbanceResponse:
+@dataclass(frozen=True, repr=False)
+class DisturbanceResponse(Summarised):
     """``peak``: largest radial amplitude ``r = sqrt(x^2 + y^2)`` after the disturbance
     starts; ``settle_time``: time from the start of the disturbance after which ``r``
     stays within ``band`` of its final value (None if it never does before ``t_end``);
@@ -29,6 +31,25 @@ class DisturbanceResponse:
     settle_time: float | None
     final_r: float
     trajectory: pl.DataFrame
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        settle = "never" if self.settle_time is None else f"{self.settle_time:.4g}"
+        head = (f"DisturbanceResponse peak |Z|={self.peak:.4g} settles after {settle} "
+                f"final |Z|={self.final_r:.3g} ({self.trajectory.height} samples)")
+        return head, [("peak |Z| (e)", self.peak), ("settling time (1/ω_n)", self.settle_time),
+                      ("final |Z| (e)", self.final_r), ("samples", self.trajectory.height)]
+
+    def plot(self, ax: Any = None, *, start: float | None = None,
+             band: float | None = None) -> Any:
+        """``|Z|`` against time; given the disturbance's ``start`` and the ``band`` it was
+        measured with (:func:`disturbance_response`'s; the result does not keep them),
+        the settling band and the settling time marked too. Returns the axes."""
+        from ._figures import trajectory_radius
+
+        at = (None if self.settle_time is None or start is None
+              else _check.real("start", start) + self.settle_time)
+        return trajectory_radius(self.trajectory, ax, final=self.final_r, settle_at=at,
+                                 band=None if band is None else _check.real("band", band))
 
 
 def _balanced_start(model: Balancer | Scene) -> np.ndarray:
@@ -104,20 +125,26 @@ def track_damping_study(
     model: Balancer | Scene,
     zeta_b: Sequence[float],
     to: float,
+    *,
+    progress: ProgressArg = False,
     **kw: Any,
 ) -> pl.DataFrame:
     """Peak amplitude and settling time after the disturbance for each track damping,
     and [TwoBallStrength]'s combined index ``peak * s + settle_time`` with the scale ``s`` = mean
     settling time / mean peak (so both terms count alike); ``optimal`` marks its
     minimum. At most :data:`~ballbal._check.MAX_STUDY_VALUES` dampings (each a
-    simulation of ``t_end``)."""
+    simulation of ``t_end``). ``progress``: True for a progress bar over the dampings
+    (tqdm, notebook-aware), or a callable ``f(done, total)``."""
     rows = []
     model_argument("model", model)
     values = [zeta_b] if _check.is_real(zeta_b) else zeta_b
-    for zb in _check.vector("zeta_b", values, _check.MAX_STUDY_VALUES):
-        res = disturbance_response(model.replace(zeta_b=zb), to, **kw)
-        rows.append({"zeta_b": float(zb), "peak": res.peak, "settle_time": res.settle_time,
-                     "final_r": res.final_r})
+    dampings = _check.vector("zeta_b", values, _check.MAX_STUDY_VALUES)
+    with Progress(progress, dampings.size, "ballbal damping study") as bar:
+        for zb in dampings:
+            res = disturbance_response(model.replace(zeta_b=zb), to, **kw)
+            rows.append({"zeta_b": float(zb), "peak": res.peak, "settle_time": res.settle_time,
+                         "final_r": res.final_r})
+            bar.update()
     df = pl.DataFrame(rows, schema={"zeta_b": pl.Float64, "peak": pl.Float64,
                                     "settle_time": pl.Float64, "final_r": pl.Float64})
     ok = df.filter(pl.col("settle_time").is_not_null())
@@ -130,8 +157,8 @@ def track_damping_study(
     return df.with_columns(optimal=pl.Series([i == best for i in range(df.height)]))
 
 
-@dataclass(frozen=True)
-class RunUp:
+@dataclass(frozen=True, repr=False)
+class RunUp(Summarised):
     """A run-up transient: peak and final whirl ``hypot(x, y)`` (units of ``e``) and, for
     a tilting disk, peak and final tilt ``hypot(A, B)`` (units of ``e / r_t``; radians
     are these over ``delta``); ``peak_Omega`` is the spin at the peak whirl."""
@@ -142,6 +169,20 @@ class RunUp:
     peak_tilt: float
     final_tilt: float
     trajectory: pl.DataFrame
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        head = (f"RunUp peak whirl={self.peak_whirl:.4g} at Ω={self.peak_Omega:.4g}, final "
+                f"{self.final_whirl:.3g}; tilt peak {self.peak_tilt:.4g} final "
+                f"{self.final_tilt:.3g}")
+        return head, [("peak whirl (e)", self.peak_whirl), ("at Ω", self.peak_Omega),
+                      ("final whirl (e)", self.final_whirl), ("peak tilt", self.peak_tilt),
+                      ("final tilt", self.final_tilt), ("samples", self.trajectory.height)]
+
+    def plot(self, ax: Any = None) -> Any:
+        """The whirl ``|Z|`` against time; returns the axes."""
+        from ._figures import trajectory_radius
+
+        return trajectory_radius(self.trajectory, ax)
 
 
 def run_up(
