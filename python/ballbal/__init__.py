@@ -23,6 +23,7 @@ from .options import (
 )
 from .scan import flat, read_scan, scan, scan_meta
 from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene, to_bearing
+from .shaft import ShaftUnits, from_shaft_units
 from .spectrum import (
     Vibration,
     label_peaks,
@@ -55,6 +56,7 @@ __all__ = [
     "RunUp",
     "ScanOptions",
     "Scene",
+    "ShaftUnits",
     "Tilt",
     "Vibration",
     "__version__",
@@ -71,6 +73,7 @@ __all__ = [
     "exceptions",
     "flat",
     "from_disk_units",
+    "from_shaft_units",
     "label_peaks",
     "line_spectrum",
     "load_scene",
