@@ -183,7 +183,19 @@ def disk_units_bifurcations(out: pathlib.Path, stdout: str) -> list[pathlib.Path
     return [out / "disk_units_bifurcations.png"]
 
 
+def anisotropic_support(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # The Y mode of the frame is sqrt(k_y) f_n = 996 rpm by construction; the tap's
+    # spectrum must put a line there (bins of about 22 rpm), far above the isotropic one.
+    lines = dict(re.findall(r"(isotropic|anisotropic) frame: after the tap, (.*)", stdout))
+    got = {k: [float(x) for x in re.findall(r"at (\S+) rpm \((\S+) e\)", v)[1]]
+           for k, v in lines.items()}
+    assert abs(got["anisotropic"][0] - 996.0) < 0.02 * 996.0, got
+    assert got["anisotropic"][1] > 10 * got["isotropic"][1], got
+    return [out / "anisotropic_support.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "anisotropic_support.py": anisotropic_support,
     "disk_units_bifurcations.py": disk_units_bifurcations,
     "grooved_bearing_rotor.py": grooved_bearing_rotor,
     "accuracy_cost.py": accuracy_cost,

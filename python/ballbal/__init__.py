@@ -22,7 +22,16 @@ from .options import (
     ScanOptions,
 )
 from .scan import flat, read_scan, scan, scan_meta
-from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene, to_bearing
+from .scene import (
+    AnisotropicSupport,
+    BearingSupport,
+    Impulse,
+    Ramp,
+    Scene,
+    Tilt,
+    load_scene,
+    to_bearing,
+)
 from .shaft import ShaftUnits, from_shaft_units
 from .spectrum import (
     Vibration,
@@ -40,6 +49,7 @@ from .transient import (
 )
 
 __all__ = [
+    "AnisotropicSupport",
     "Balancer",
     "BearingSupport",
     "DisturbanceResponse",
