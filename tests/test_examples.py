@@ -194,7 +194,24 @@ def anisotropic_support(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "anisotropic_support.png"]
 
 
+def design_chart(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Each row: the varied value, eta, natural frequency, critical speed, ratio, status.
+    # Balls that cannot cancel the imbalance (2 eta <= 1) have no critical speed; the
+    # others balance only above the natural frequency.
+    rows = re.findall(r"│\s*(\S+)\s*┆\s*(\S+)\s*┆\s*(\S+)\s*┆\s*(\S+)\s*┆\s*(\S+)\s*┆"
+                      r"\s*(\w+)\s*│", stdout)
+    rows = [r for r in rows if re.fullmatch(r"[\d.]+", r[1])]  # not the headers
+    assert len(rows) >= 8, stdout
+    for _, eta, fn, crit, _, status in rows:
+        if status == "no_balance":
+            assert 2 * float(eta) <= 1 and crit == "null"
+        else:
+            assert status == "ok" and float(crit) > float(fn)
+    return [out / "design_chart.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "design_chart.py": design_chart,
     "anisotropic_support.py": anisotropic_support,
     "disk_units_bifurcations.py": disk_units_bifurcations,
     "grooved_bearing_rotor.py": grooved_bearing_rotor,

@@ -1,6 +1,16 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
-from . import basins, bearing, calibration, continuation, data, exceptions, rig, sweep
+from . import (
+    basins,
+    bearing,
+    calibration,
+    continuation,
+    data,
+    design,
+    exceptions,
+    rig,
+    sweep,
+)
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -80,6 +90,7 @@ __all__ = [
     "disturbance_response",
     "equilibria",
     "data",
+    "design",
     "exceptions",
     "flat",
     "from_disk_units",
