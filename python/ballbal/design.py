@@ -140,7 +140,7 @@ def critical_speed_chart(
                               other_mass=other_mass)
         wn = 1.0 / b.Omega  # spin 1 rad/s is Omega = 1 / w_n
         status, om = _lowest_stable_speed(b, spin_grid / wn)
-        crit = None if status != "ok" else om * wn * _RPM
+        crit = om * wn * _RPM if status == "ok" and om is not None else None
         rows.append({vary: float(v), "eta": b.eta[0], "natural_frequency_rpm": wn * _RPM,
                      "critical_speed_rpm": crit,
                      "critical_ratio": None if crit is None else crit / (wn * _RPM),
