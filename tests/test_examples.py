@@ -210,7 +210,21 @@ def design_chart(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "design_chart.png"]
 
 
+def shaft_units_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Rezaee et al. (2017): without track damping the balancer cannot balance; with it,
+    # only above the critical speed (omega_bar = 1 / sqrt(1 + 2 m_bar) = 0.99 on the
+    # Jeffcott rotor); light balls (m_bar < eps_bar / 2 = 0.005) have no balance at all.
+    found = dict(re.findall(r"(fig\. \d: [^:]+): lam 0\.1: stable balance from omega_bar (\S+)",
+                            stdout))
+    assert len(found) == 2 and all(0.99 < float(v) < 2.0 for v in found.values()), found
+    assert len(re.findall(r"lam 0\.0: stable balance from omega_bar None", stdout)) == 2
+    light = re.search(r"no balance for m_bar < eps_bar / 2: \[(.*)\]", stdout).group(1)
+    assert light and all(float(m) < 0.005 for m in light.split(",")), light
+    return [out / "shaft_units_maps.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "shaft_units_maps.py": shaft_units_maps,
     "design_chart.py": design_chart,
     "anisotropic_support.py": anisotropic_support,
     "disk_units_bifurcations.py": disk_units_bifurcations,

@@ -108,3 +108,21 @@ def test_bad_physical_input_names_the_parameter():
         ShaftUnits.from_physical(E=-1.0, I=1e-9, a=0.1, b=0.1, M=1.0, m=0.01, R=0.03,
                                  eps=1e-4, omega=100.0)
     assert e.value.parameter == "E"
+
+
+def test_balance_map_in_the_papers_axes():
+    """Each row's verdict is that of the scene converted at its own (omega_bar, lam)."""
+    kw = dict(zeta_r=0.1, a=4.0, b=6.0, j_t=0.3, j_z=0.5)
+    su = ShaftUnits(1.0, 0.01, 0.01, 0.1, 0.1, **kw)
+    df = su.balance_map([0.8, 2.0, 3.0], [0.0, 0.1, 0.3])
+    assert df.height == 9
+    assert sorted(set(df["omega_bar"])) == [0.8, 2.0, 3.0]
+    assert sorted(set(df["lam"])) == pytest.approx([0.0, 0.1, 0.3], abs=1e-15)
+    for row in df.iter_rows(named=True):
+        eq = ballbal.balanced_state(from_shaft_units(row["omega_bar"], 0.01, 0.01,
+                                                     row["lam"], 0.1, **kw))
+        assert eq.stability == row["stability"], row
+    assert set(df.filter(df["lam"] == 0.0)["stability"]) == {"unstable"}
+    with pytest.raises(ParameterError) as e:
+        su.balance_map([-1.0, 1.0])
+    assert e.value.parameter == "omega_bar"

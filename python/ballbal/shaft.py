@@ -40,7 +40,11 @@ tilt damping is destabilising above the tilt critical speed and ballbal's is not
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, fields
+
+import numpy as np
+import polars as pl
 
 from . import _check
 from .exceptions import ParameterError
@@ -126,6 +130,37 @@ class ShaftUnits:
         # k_d over M omega0^2 = k0, ballbal's over k = k0 q / (a b)
         return Scene(balancer=bal, tilt=tilt, springs=self.k_d * a * b / q,
                      spring_layout="chain")
+
+    def balance_map(
+        self,
+        omega_bar: Sequence[float] | np.ndarray | tuple[float, float, float] | str,
+        lam: Sequence[float] | np.ndarray | tuple[float, float, float] | str | None = None,
+    ) -> pl.DataFrame:
+        """The balanced state's stability (:func:`ballbal.balance_map`) over the paper's
+        axes: spins ``omega_bar`` and, if given, track dampings ``lam`` (else this one's),
+        the other parameters this one's (the paper's figs 3 and 4; for its fig. 5, one map
+        per ``m_bar``). Both map linearly onto ballbal's ``Omega = s omega_bar`` and
+        ``zeta_b = s lam / 2``; the table gains columns ``omega_bar`` and ``lam``."""
+        from .balance import balance_map
+
+        s = self.scale
+        om = _check.axis("omega_bar", omega_bar, _check.MAX_MAP_POINTS)
+        axes: dict[str, np.ndarray] = {"Omega": s * om}
+        if lam is not None:
+            axes["zeta_b"] = s * _check.axis("lam", lam, _check.MAX_MAP_POINTS) / 2
+        for name, v in (("omega_bar", om), ("lam", axes.get("zeta_b"))):
+            if v is not None and np.any(v < 0):
+                raise ParameterError(name, "every value must be >= 0", allowed="[0, inf)",
+                                     value=float(np.min(v)))
+        df = balance_map(self.scene, **axes)
+        # the caller's values, by position (Omega / s would not give them back exactly)
+        cols = [pl.Series("omega_bar", om[df["Omega_index"].to_numpy()])]
+        if lam is not None:
+            lams = 2 * axes["zeta_b"] / s
+            cols.append(pl.Series("lam", lams[df["zeta_b_index"].to_numpy()]))
+        else:
+            cols.append(pl.Series("lam", np.full(df.height, self.lam)))
+        return df.with_columns(cols)
 
     @classmethod
     def from_physical(
