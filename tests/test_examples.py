@@ -183,7 +183,50 @@ def disk_units_bifurcations(out: pathlib.Path, stdout: str) -> list[pathlib.Path
     return [out / "disk_units_bifurcations.png"]
 
 
+def anisotropic_support(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # The Y mode of the frame is sqrt(k_y) f_n = 996 rpm by construction; the tap's
+    # spectrum must put a line there (bins of about 22 rpm), far above the isotropic one.
+    lines = dict(re.findall(r"(isotropic|anisotropic) frame: after the tap, (.*)", stdout))
+    got = {k: [float(x) for x in re.findall(r"at (\S+) rpm \((\S+) e\)", v)[1]]
+           for k, v in lines.items()}
+    assert abs(got["anisotropic"][0] - 996.0) < 0.02 * 996.0, got
+    assert got["anisotropic"][1] > 10 * got["isotropic"][1], got
+    return [out / "anisotropic_support.png"]
+
+
+def design_chart(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Each row: the varied value, eta, natural frequency, critical speed, ratio, status.
+    # Balls that cannot cancel the imbalance (2 eta <= 1) have no critical speed; the
+    # others balance only above the natural frequency.
+    rows = re.findall(r"│\s*(\S+)\s*┆\s*(\S+)\s*┆\s*(\S+)\s*┆\s*(\S+)\s*┆\s*(\S+)\s*┆"
+                      r"\s*(\w+)\s*│", stdout)
+    rows = [r for r in rows if re.fullmatch(r"[\d.]+", r[1])]  # not the headers
+    assert len(rows) >= 8, stdout
+    for _, eta, fn, crit, _, status in rows:
+        if status == "no_balance":
+            assert 2 * float(eta) <= 1 and crit == "null"
+        else:
+            assert status == "ok" and float(crit) > float(fn)
+    return [out / "design_chart.png"]
+
+
+def shaft_units_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Rezaee et al. (2017): without track damping the balancer cannot balance; with it,
+    # only above the critical speed (omega_bar = 1 / sqrt(1 + 2 m_bar) = 0.99 on the
+    # Jeffcott rotor); light balls (m_bar < eps_bar / 2 = 0.005) have no balance at all.
+    found = dict(re.findall(r"(fig\. \d: [^:]+): lam 0\.1: stable balance from omega_bar (\S+)",
+                            stdout))
+    assert len(found) == 2 and all(0.99 < float(v) < 2.0 for v in found.values()), found
+    assert len(re.findall(r"lam 0\.0: stable balance from omega_bar None", stdout)) == 2
+    light = re.search(r"no balance for m_bar < eps_bar / 2: \[(.*)\]", stdout).group(1)
+    assert light and all(float(m) < 0.005 for m in light.split(",")), light
+    return [out / "shaft_units_maps.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "shaft_units_maps.py": shaft_units_maps,
+    "design_chart.py": design_chart,
+    "anisotropic_support.py": anisotropic_support,
     "disk_units_bifurcations.py": disk_units_bifurcations,
     "grooved_bearing_rotor.py": grooved_bearing_rotor,
     "accuracy_cost.py": accuracy_cost,

@@ -1,6 +1,16 @@
 """ballbal: nonlinear dynamics of automatic ball balancers, on a Rust core."""
 
-from . import basins, bearing, calibration, continuation, data, exceptions, rig, sweep
+from . import (
+    basins,
+    bearing,
+    calibration,
+    continuation,
+    data,
+    design,
+    exceptions,
+    rig,
+    sweep,
+)
 from ._native import __version__
 from .accuracy import accuracy_cost, plot_accuracy_cost
 from .analysis import (
@@ -22,7 +32,17 @@ from .options import (
     ScanOptions,
 )
 from .scan import flat, read_scan, scan, scan_meta
-from .scene import BearingSupport, Impulse, Ramp, Scene, Tilt, load_scene, to_bearing
+from .scene import (
+    AnisotropicSupport,
+    BearingSupport,
+    Impulse,
+    Ramp,
+    Scene,
+    Tilt,
+    load_scene,
+    to_bearing,
+)
+from .shaft import ShaftUnits, from_shaft_units
 from .spectrum import (
     Vibration,
     label_peaks,
@@ -39,6 +59,7 @@ from .transient import (
 )
 
 __all__ = [
+    "AnisotropicSupport",
     "Balancer",
     "BearingSupport",
     "DisturbanceResponse",
@@ -55,6 +76,7 @@ __all__ = [
     "RunUp",
     "ScanOptions",
     "Scene",
+    "ShaftUnits",
     "Tilt",
     "Vibration",
     "__version__",
@@ -68,9 +90,11 @@ __all__ = [
     "disturbance_response",
     "equilibria",
     "data",
+    "design",
     "exceptions",
     "flat",
     "from_disk_units",
+    "from_shaft_units",
     "label_peaks",
     "line_spectrum",
     "load_scene",

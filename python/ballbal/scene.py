@@ -34,6 +34,10 @@ Converting a spring–damper scene keeps the numbers but not their meaning: a ra
 :meth:`BearingSupport.reference_frequency`); :func:`to_bearing` converts a spring–damper
 scene and returns what changed (``Omega`` and ``zeta_b`` times ``w_n / w_ref``, ``zeta``
 to 0).
+``support`` may instead be an :class:`AnisotropicSupport`: a ground-fixed spring–damper
+whose stiffness and damping differ between the ground axes X and Y (a rig's frame; a
+second support resonance at ``sqrt(k_y) w_n``); it makes the scene time-periodic (effect
+``"anisotropic_support"``) unless both axes are equal.
 A plain bearing, grooves on the journal or narrow-groove theory keep the scene
 autonomous; resolved grooves (``model="finite"``) on the stationary sleeve make it
 time-periodic (effect ``"grooved_sleeve"``): simulation only.
@@ -48,7 +52,8 @@ omitted), ``[ramp] to, start,
 duration``, ``[gravity] g``, ``[impulse] amplitude, t0, sharpness, angle``, ``[tilt] a,
 b, j_t, j_z, zeta_r``, ``[bearing] rho, length_ratio, cavitation, model, grid`` with an
 optional ``[bearing.grooves] count, angle, depth_ratio, width_ratio, grooved_length,
-side``. Unknown keys and tables are errors.
+side``, or ``[anisotropic_support] k_x, k_y, zeta_x, zeta_y`` (the dampings optional).
+Unknown keys and tables are errors.
 """
 
 from __future__ import annotations
@@ -223,6 +228,54 @@ class BearingSupport:
         return Scene(balancer=bal, support=cls(bearing, ecc / dimensions.clearance))
 
 
+#: Largest stiffness of an anisotropic support's axis over the ``k`` of ``w_n`` (the core's
+#: bound: beyond it the support's period is far below the model's time unit).
+MAX_AXIS_STIFFNESS = 1e4
+
+
+@dataclass(frozen=True)
+class AnisotropicSupport:
+    """A support fixed to the ground, unequal in the ground axes ``X`` and ``Y`` (a rig's
+    plate or frame stiffer one way than the other): the disk centre feels
+    ``-(k_x X + 2 zeta_x X', k_y Y + 2 zeta_y Y')`` in place of the isotropic ``-(X + 2
+    zeta X')``.
+
+    ``k_x, k_y``: stiffness over the ``k`` of ``w_n`` (in ``(0, 1e4]``; 1 is the isotropic
+    support's); ``zeta_x, zeta_y``: damping ratios ``c / (2 M w_n)`` (>= 0), None for the
+    balancer's ``zeta``. Without spin the disk has the two natural frequencies
+    ``sqrt(k_x)``, ``sqrt(k_y)`` (units of ``w_n``, balls of negligible mass), so a rig
+    with one resonance at ``w_n`` and a second at ``w_2`` has ``k_y = (w_2 / w_n)^2``.
+    Seen from the rotating disk the unequal axes turn, so the scene depends on time
+    (effect ``"anisotropic_support"``): simulation, spectra and run-ups, not equilibria,
+    periodic solutions or scans. With equal axes it is the isotropic support.
+    """
+
+    k_x: float = 1.0
+    k_y: float = 1.0
+    zeta_x: float | None = None
+    zeta_y: float | None = None
+
+    def __post_init__(self) -> None:
+        for k in ("k_x", "k_y"):
+            object.__setattr__(self, k, _check.real(f"support.{k}", getattr(self, k), 0.0,
+                                                    MAX_AXIS_STIFFNESS, lo_open=True))
+        for k in ("zeta_x", "zeta_y"):
+            v = getattr(self, k)
+            if v is not None:
+                object.__setattr__(self, k, _check.real(f"support.{k}", v, 0.0, finite=True))
+        _core_check(support=self)
+
+    def dampings(self, zeta: float) -> tuple[float, float]:
+        """``(zeta_x, zeta_y)`` with a None taken as the balancer's ``zeta``."""
+        return (zeta if self.zeta_x is None else self.zeta_x,
+                zeta if self.zeta_y is None else self.zeta_y)
+
+    def natural_frequencies(self) -> tuple[float, float]:
+        """``(sqrt(k_x), sqrt(k_y))``: the undamped frequencies of the disk on this
+        support without spin and with balls of negligible mass, in units of ``w_n``."""
+        return (math.sqrt(self.k_x), math.sqrt(self.k_y))
+
+
 def to_bearing(scene: Scene, support: BearingSupport, *,
                natural_over_reference: float) -> tuple[Scene, dict[str, tuple[Any, Any]]]:
     """The same machine with its spring–damper replaced by ``support``, and what changed.
@@ -263,7 +316,7 @@ class Scene:
     impulse: Impulse | None = None
     tilt: Tilt | None = None
     spring_layout: str = "ring"
-    support: BearingSupport | None = None
+    support: BearingSupport | AnisotropicSupport | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.balancer, Balancer):
@@ -276,11 +329,12 @@ class Scene:
         if not isinstance(self.spring_layout, str) or self.spring_layout not in ("ring", "chain"):
             raise ParameterError("spring_layout", f"must be 'ring' or 'chain', "
                                  f"got {self.spring_layout!r:.60}", allowed="ring, chain")
-        for name, kind in (("ramp", Ramp), ("impulse", Impulse), ("tilt", Tilt),
-                           ("support", BearingSupport)):
+        for name, kinds in (("ramp", (Ramp,)), ("impulse", (Impulse,)), ("tilt", (Tilt,)),
+                            ("support", (BearingSupport, AnisotropicSupport))):
             v = getattr(self, name)
-            if v is not None and not isinstance(v, kind):
-                raise ParameterTypeError(name, f"must be a {kind.__name__} or None, got "
+            if v is not None and not isinstance(v, kinds):
+                shown = " or ".join(k.__name__ for k in kinds)
+                raise ParameterTypeError(name, f"must be a {shown} or None, got "
                                          f"{type(v).__name__}")
         # the effects' ranges and what they ask of the rest (a support needs Omega > 0
         # and a planar disk), checked once, in the core, when the scene is made
@@ -321,7 +375,7 @@ class Scene:
             changes["balancer"] = self.balancer.replace(**bal).validate()
         if "rho" in changes:
             rho = changes.pop("rho")
-            if self.support is None:
+            if not isinstance(self.support, BearingSupport):
                 raise ParameterError("rho", "the scene has no bearing support to change")
             changes["support"] = replace(self.support, rho=rho)
         if tl:
@@ -345,7 +399,11 @@ class Scene:
             return "gravity"
         if self.impulse is not None:
             return "impulse"
-        if self.support is not None:
+        if isinstance(self.support, AnisotropicSupport):
+            s = self.support
+            if s.k_x != s.k_y or len(set(s.dampings(self.balancer.zeta))) > 1:
+                return "anisotropic_support"
+        elif self.support is not None:
             return self.support.time_dependence
         return None
 
@@ -367,7 +425,10 @@ class Scene:
             d["impulse"] = asdict(self.impulse)
         if self.tilt is not None:
             d["tilt"] = asdict(self.tilt)
-        if self.support is not None:
+        if isinstance(self.support, AnisotropicSupport):
+            d["anisotropic_support"] = {k: v for k, v in asdict(self.support).items()
+                                        if v is not None}
+        elif self.support is not None:
             bearing = self.support.bearing
             t: dict[str, Any] = {"rho": self.support.rho,
                                  "length_ratio": bearing.length_ratio,
@@ -412,10 +473,11 @@ def _toml_value(v: Any) -> str:
 _TABLES = {"springs": {"stiffness", "layout"}, "ramp": {"to", "start", "duration"},
            "gravity": {"g"}, "impulse": {"amplitude", "t0", "sharpness", "angle"},
            "tilt": {"a", "b", "j_t", "j_z", "zeta_r"},
-           "bearing": {"rho", "length_ratio", "grooves", "cavitation", "model", "grid"}}
+           "bearing": {"rho", "length_ratio", "grooves", "cavitation", "model", "grid"},
+           "anisotropic_support": {"k_x", "k_y", "zeta_x", "zeta_y"}}
 _REQUIRED = {"springs": {"stiffness"}, "ramp": {"to"}, "gravity": {"g"},
              "impulse": {"amplitude", "t0", "sharpness"}, "tilt": {"a", "b", "j_t", "j_z"},
-             "bearing": {"rho"}}
+             "bearing": {"rho"}, "anisotropic_support": {"k_x", "k_y"}}
 _GROOVE_KEYS = {f.name for f in fields(Grooves)}
 #: A scene file is a few lines; anything much longer is the wrong file.
 MAX_SCENE_BYTES = 1 << 20
@@ -486,7 +548,14 @@ def scene_from_dict(d: dict[str, Any], where: str = "scene") -> Scene:
         if missing:
             raise ParameterError(f"{t}.{missing[0]}", f"{where}: [{t}] needs "
                                  f"{', '.join(missing)}")
-    support = _support_from_dict(d["bearing"], where) if "bearing" in d else None
+    support: BearingSupport | AnisotropicSupport | None = None
+    if "bearing" in d:
+        if "anisotropic_support" in d:
+            raise ParameterError("anisotropic_support", f"{where}: a scene has one support, "
+                                 "[bearing] or [anisotropic_support], not both")
+        support = _support_from_dict(d["bearing"], where)
+    elif "anisotropic_support" in d:
+        support = AnisotropicSupport(**d["anisotropic_support"])
     try:
         return Scene(
             balancer=b,

@@ -18,6 +18,15 @@ only its rate jumps). Hence, with ``D = Omega_a - Omega_b``::
 (at the perfect balance, ``x = y = 0`` and the balls at rest on the disk, the balls
 keep their absolute speed and so slip by ``D`` relative to the new disk speed).
 
+A tilting disk (:class:`ballbal.Tilt`) also keeps the ground-frame motion of its axis:
+its Euler tilts ``alpha = A / delta``, ``beta = B / delta`` are continuous, and of the
+disk's angular velocity the two components across the axis (body ``x, y``:
+``alpha' cos beta - Omega cos alpha sin beta`` and ``beta' + Omega sin alpha``), so::
+
+    A' -> A' - D delta cos(alpha) tan(beta),    B' -> B' + D delta sin(alpha)
+
+(to first order ``A' - D B`` and ``B' + D A``, as for ``x, y``).
+
 The symmetry-breaking kick
 --------------------------
 Merged balls (``b1 = b2``) stay merged for ever in a simulation of identical balls (the
@@ -39,9 +48,9 @@ from . import _check, _native
 from ._progress import Progress, ProgressArg
 from ._style import Summarised, value_range
 from .basins import REST, ROTATING, BasinOptions
-from .exceptions import ParameterError, ParameterTypeError
+from .exceptions import NotAutonomousError, ParameterError, ParameterTypeError
 from .model import Balancer
-from .scene import model_argument
+from .scene import Scene, model_argument
 
 #: Longest ``dwell`` (and ``record``): the basins' classifier's longest ``t_end``
 #: (``BasinOptions``, checked in the core), which a step's dwell is.
@@ -49,10 +58,12 @@ MAX_DWELL = 1e6
 
 
 def carry_over(y: np.ndarray, omega_from: float, omega_to: float, n_balls: int,
-               d: int) -> np.ndarray:
+               d: int, *, delta: float | None = None) -> np.ndarray:
     """The rotating-frame state after a speed step from ``omega_from`` to ``omega_to``
     with the ground-frame state continuous (see the module's description); ``y`` has
-    ``2 d`` values (``d`` coordinates, the last ``n_balls`` of them the balls')."""
+    ``2 d`` values (``d`` coordinates, the last ``n_balls`` of them the balls'). A
+    tilting disk's state (``x, y, A, B``, then the balls) needs its ``delta`` (the
+    tilts' scale), which carries ``A', B'`` over too."""
     d = _check.integer("d", d, 3, _check.MAX_BALLS + 4)
     n_balls = _check.integer("n_balls", n_balls, 1, d - 2)
     y = _check.vector("y", y, 2 * d).copy()
@@ -66,6 +77,14 @@ def carry_over(y: np.ndarray, omega_from: float, omega_to: float, n_balls: int,
     y[d] -= dd * yy
     y[d + 1] += dd * x
     y[2 * d - n_balls:] += dd
+    if delta is not None:
+        delta = _check.real("delta", delta, 0.0, lo_open=True, finite=True)
+        if d != n_balls + 4:
+            raise ParameterError("d", f"a tilting disk has d = n_balls + 4 = {n_balls + 4} "
+                                 f"coordinates, got {d}")
+        alpha, beta = y[2] / delta, y[3] / delta
+        y[d + 2] -= dd * delta * np.cos(alpha) * np.tan(beta)
+        y[d + 3] += dd * delta * np.sin(alpha)
     return y
 
 
@@ -133,7 +152,7 @@ def _fmt(v: float | None) -> str:
 
 
 def speed_sweep(
-    model: Balancer,
+    model: Balancer | Scene,
     speeds: Sequence[float] | np.ndarray | tuple[float, float, float] | str,
     *,
     dwell: float = 1000.0,
@@ -150,10 +169,14 @@ def speed_sweep(
     time units at each step, and label the motion at each (the basins' classifier over
     the last ``options.window`` of the dwell).
 
-    ``y0``: the state at the first step (default: at rest in the ground frame, the balls
-    together at angle 0.3 of the disk, as a rig is started). ``kick``: see the module's
-    description. ``record``: simulate that long more after each step's dwell, without
-    changing the state carried on, for the vibration indicator
+    ``model``: a balancer or an autonomous scene (ball springs, a tilting disk, a bearing
+    or an anisotropic support with equal axes; a ramp, gravity, an impulse or unequal
+    support axes are an error naming the effect: the sweep is its own speed change).
+
+    ``y0``: the state at the first step (default: at rest in the ground frame, the disk
+    flat, the balls together at angle 0.3 of the disk, as a rig is started). ``kick``:
+    see the module's description. ``record``: simulate that long more after each step's
+    dwell, without changing the state carried on, for the vibration indicator
     (:func:`ballbal.spectrum.vibration`); ``None`` skips it.
 
     Bounds (a :class:`~ballbal.exceptions.ParameterError` naming the argument, before
@@ -168,8 +191,16 @@ def speed_sweep(
     from .spectrum import ground_signal, signal_spectrum, vibration
 
     model_argument("model", model)
-    if not isinstance(model, Balancer):
-        raise ParameterTypeError("model", "speed sweeps take a Balancer", value=model)
+    if not isinstance(model, (Balancer, Scene)):
+        raise ParameterTypeError("model", "speed sweeps take a Balancer or a Scene",
+                                 value=model)
+    if isinstance(model, Scene) and model.time_dependence is not None:
+        raise NotAutonomousError(
+            model.time_dependence,
+            f"speed_sweep: the sweep sets the speed of each step, so the scene must be "
+            f"autonomous, but it has '{model.time_dependence}'")
+    tilt_delta = (model.balancer.delta if isinstance(model, Scene) and model.tilt is not None
+                  else None)
     if not isinstance(direction, str) or direction not in ("up-down", "up", "down"):
         raise ParameterError("direction", f"must be 'up-down', 'up' or 'down', got "
                              f"{direction!r:.60}", allowed="up-down, up, down")
@@ -217,7 +248,7 @@ def speed_sweep(
     with Progress(progress, len(path), "ballbal speed sweep") as bar:
         for k, (i, dirn) in enumerate(path):
             om = float(sp[i])
-            y = carry_over(y, prev, om, n, d)
+            y = carry_over(y, prev, om, n, d, delta=tilt_delta)
             if kick and n >= 2:
                 y[d - n] += kick
                 y[d - n + 1] -= kick

@@ -13,7 +13,7 @@ import polars as pl
 from . import _check
 from ._progress import Progress, ProgressArg
 from ._style import Summarised
-from .analysis import simulate
+from .analysis import capacities, equilibria, simulate
 from .balance import balanced_state
 from .exceptions import NotAutonomousError, ParameterError
 from .model import Balancer
@@ -53,19 +53,35 @@ class DisturbanceResponse(Summarised):
 
 
 def _balanced_start(model: Balancer | Scene) -> np.ndarray:
-    """The stable balanced state at the starting speed, where the disturbance begins."""
+    """The steady state at the starting speed, where the disturbance begins: the stable
+    balanced state; or, when the balls cannot cancel the imbalance (total capacity
+    ``sum eta_i <= 1``, seed 001's light-ball cases), the stable equilibrium in which they
+    settle against it (of several, the one leaving the least imbalance), or at exactly
+    the capacity the perfect balance, marginal as it is."""
     if isinstance(model, Scene) and model.time_dependence is not None:
         raise NotAutonomousError(
             model.time_dependence,
             f"disturbance_response: the disturbance brings its own spin change, so the "
             f"scene must be autonomous, but it has '{model.time_dependence}'")
     e = balanced_state(model)
-    if e is None or e.stability != "stable":
+    if e is not None and e.stability == "stable":
+        return np.asarray(e.q, dtype=float)
+    if float(np.sum(capacities(model))) <= 1.0 + 1e-12:
+        found = equilibria(model)
+        stable = [q for q in found if q.stability == "stable"]
+        if stable:
+            return np.asarray(min(stable, key=lambda q: q.residual_imbalance).q, dtype=float)
+        if e is not None and e.stability == "marginal":
+            return np.asarray(e.q, dtype=float)
         raise ParameterError(
-            "model", f"the balanced state must exist and be stable at the starting speed "
-            f"Omega = {model.Omega} (eta >= 1/2 and above the resonance), so that the "
-            "disturbance starts from rest")
-    return np.asarray(e.q, dtype=float)
+            "model", f"the balls are under capacity (sum eta = {np.sum(capacities(model))}"
+            f" <= 1) and no equilibrium is stable at the starting speed Omega = "
+            f"{model.Omega}, so the disturbance cannot start from rest")
+    raise ParameterError(
+        "model", f"the balanced state must be stable at the starting speed "
+        f"Omega = {model.Omega} (above the resonance), so that the "
+        "disturbance starts from rest (with sum eta <= 1 it starts where the balls "
+        "settle against the imbalance)")
 
 
 def disturbance_response(
@@ -79,7 +95,9 @@ def disturbance_response(
     dt: float = 0.1,
     rtol: float = 1e-8,
 ) -> DisturbanceResponse:
-    """Start at the stable perfect balance at ``model.Omega``, change the spin to
+    """Start at the stable perfect balance at ``model.Omega`` (balls under capacity,
+    ``sum eta_i <= 1``: at the stable equilibrium where they settle against the
+    imbalance, seed 001's light-ball cases), change the spin to
     ``to`` linearly over ``duration`` from ``start`` ([TwoBallStrength]: 100 rad/s in 0.11 s), and
     measure the radial vibration. ``band`` is in units of the eccentricity ``e``.
 

@@ -7,7 +7,7 @@ use crate::errors::CoreResult;
 use ballbal_core::floquet::{FloquetMethod, FloquetOptions, HillTarget};
 use ballbal_core::hb::HbOptions;
 use ballbal_core::model::components::{JournalSupport, SupportFilm};
-use ballbal_core::model::scene::{Impulse, Ramp, Tilt};
+use ballbal_core::model::scene::{AnisotropicAxes, Impulse, Ramp, Tilt};
 use ballbal_core::periodic::{AutoHarmonics, GuessOptions, PeriodicOptions};
 use ballbal_core::{Dynamics, Error, Planar, Scene, SpringLayout};
 use numpy::PyReadonlyArray1;
@@ -63,6 +63,23 @@ struct SupportArgs {
     rho: f64,
 }
 
+/// `ballbal.AnisotropicSupport`'s fields (a `None` damping is the balancer's `zeta`).
+#[derive(FromPyObject)]
+struct AnisotropicArgs {
+    k_x: f64,
+    k_y: f64,
+    zeta_x: Option<f64>,
+    zeta_y: Option<f64>,
+}
+
+/// The scene's `support`: a journal bearing or an anisotropic spring–damper (tried in
+/// that order: only the bearing has `bearing`).
+#[derive(FromPyObject)]
+enum SupportKind {
+    Bearing(SupportArgs),
+    Anisotropic(AnisotropicArgs),
+}
+
 /// `ballbal.Scene`'s fields.
 #[derive(FromPyObject)]
 pub struct SceneArgs {
@@ -73,7 +90,7 @@ pub struct SceneArgs {
     impulse: Option<ImpulseArgs>,
     tilt: Option<TiltArgs>,
     spring_layout: String,
-    support: Option<SupportArgs>,
+    support: Option<SupportKind>,
 }
 
 /// What every analysis takes first. A scene is tried first: a balancer has no
@@ -163,17 +180,22 @@ impl SceneArgs {
             }),
         )
         .map(|s| s.with_spring_layout(layout))?
-        .with_bearing(
-            self.support
-                .as_ref()
-                .map(|b| -> Result<JournalSupport, Error> {
-                    Ok(JournalSupport {
-                        film: SupportFilm::Reynolds(b.bearing.to_core()?),
-                        rho: b.rho,
-                    })
-                })
-                .transpose()?,
-        )
+        .with_bearing(match &self.support {
+            Some(SupportKind::Bearing(b)) => Some(JournalSupport {
+                film: SupportFilm::Reynolds(b.bearing.to_core()?),
+                rho: b.rho,
+            }),
+            _ => None,
+        })?
+        .with_anisotropic_support(match &self.support {
+            Some(SupportKind::Anisotropic(a)) => Some(AnisotropicAxes {
+                k_x: a.k_x,
+                k_y: a.k_y,
+                zeta_x: a.zeta_x,
+                zeta_y: a.zeta_y,
+            }),
+            _ => None,
+        })
     }
 }
 

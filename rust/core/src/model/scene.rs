@@ -51,9 +51,9 @@ use crate::error::{Error, Result};
 use crate::model::assembly::{Assembly, PlanarAssembly};
 use crate::model::component::{Component, Composed, Drive};
 use crate::model::components::{
-    no_bearing, BallSprings, BearingSupport, FreeBalls, FusedPlanar, FusedTilting, Gravity,
-    IsotropicSupport, JournalSupport, PlanarDisk, SolverPool, SupportFilm, TiltingBalls,
-    TiltingDisk,
+    no_bearing, AnisotropicSupport, BallSprings, BearingSupport, FreeBalls, FusedPlanar,
+    FusedTilting, Gravity, IsotropicSupport, JournalSupport, PlanarDisk, SolverPool, SupportFilm,
+    TiltingBalls, TiltingDisk,
 };
 use crate::model::params::{key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
 use crate::model::tilt_terms::RotorConsts;
@@ -119,6 +119,49 @@ pub struct Ramp {
     pub duration: f64,
 }
 
+/// The description of a ground-fixed support unequal in X and Y
+/// ([`AnisotropicSupport`]): stiffnesses over the `k` of `w_n`, damping ratios
+/// `c / (2 M w_n)`; a damping left `None` is the balancer's `zeta` (so that a scan of
+/// `zeta` moves it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AnisotropicAxes {
+    pub k_x: f64,
+    pub k_y: f64,
+    pub zeta_x: Option<f64>,
+    pub zeta_y: Option<f64>,
+}
+
+/// Largest stiffness ratio of an axis to the `k` of `w_n`: beyond it the time unit is
+/// the wrong one for the support (its period far below the integrator's natural step).
+pub const MAX_AXIS_STIFFNESS: f64 = 1e4;
+
+impl AnisotropicAxes {
+    fn validate(&self) -> Result<()> {
+        for (name, k) in [("support.k_x", self.k_x), ("support.k_y", self.k_y)] {
+            crate::error::check_range(name, k, 0.0, true, MAX_AXIS_STIFFNESS, false)?;
+        }
+        for (name, z) in [
+            ("support.zeta_x", self.zeta_x),
+            ("support.zeta_y", self.zeta_y),
+        ] {
+            if let Some(z) = z {
+                ParamId::Zeta.check_named(name, z)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The component, a `None` damping taken as `zeta`.
+    pub fn support(&self, zeta: f64) -> AnisotropicSupport {
+        AnisotropicSupport {
+            k_x: self.k_x,
+            k_y: self.k_y,
+            zeta_x: self.zeta_x.unwrap_or(zeta),
+            zeta_y: self.zeta_y.unwrap_or(zeta),
+        }
+    }
+}
+
 /// A scene: a description (the public fields) and the model assembled from exactly the
 /// components it switches on (built once, by [`Scene::new`], [`Scene::set`] and the
 /// `with_*` methods; a field changed in place is not seen by the dynamics until
@@ -138,6 +181,9 @@ pub struct Scene {
     /// The journal-bearing support (`None`: the spring–damper); set with
     /// [`Scene::with_bearing`].
     pub bearing: Option<JournalSupport>,
+    /// A ground-fixed support unequal in X and Y in place of the isotropic one
+    /// (`None`: the isotropic spring–damper); set with [`Scene::with_anisotropic_support`].
+    pub anisotropic: Option<AnisotropicAxes>,
     model: Assembly,
     /// The bearing's film solvers, kept across reassembly while the film is unchanged.
     pool: Option<Arc<SolverPool>>,
@@ -154,6 +200,7 @@ impl PartialEq for Scene {
             && self.impulse == o.impulse
             && self.tilt == o.tilt
             && self.bearing == o.bearing
+            && self.anisotropic == o.anisotropic
     }
 }
 
@@ -213,6 +260,7 @@ impl Scene {
             impulse,
             tilt,
             bearing: None,
+            anisotropic: None,
             pool: None,
         };
         s.reassemble();
@@ -233,6 +281,23 @@ impl Scene {
             Self::check_bearing_spin(&self.planar)?;
         }
         self.bearing = bearing;
+        self.reassemble();
+        Ok(self)
+    }
+
+    /// The same scene on a ground-fixed support unequal in X and Y (`None`: back on the
+    /// isotropic spring–damper). Not with a journal bearing (that is the support).
+    pub fn with_anisotropic_support(mut self, axes: Option<AnisotropicAxes>) -> Result<Self> {
+        if let Some(a) = &axes {
+            a.validate()?;
+            if self.bearing.is_some() {
+                return Err(Error::param(
+                    "support",
+                    "a scene has one support: a journal bearing or an anisotropic spring–damper",
+                ));
+            }
+        }
+        self.anisotropic = axes;
         self.reassemble();
         Ok(self)
     }
@@ -302,6 +367,32 @@ impl Scene {
             );
             return;
         }
+        let anisotropic = self.anisotropic.as_ref().map(|a| a.support(p.zeta));
+        if let (Some(support), None) = (&anisotropic, &self.tilt) {
+            let mut parts: Vec<Arc<dyn Component>> = vec![
+                Arc::new(PlanarDisk { mu: p.mu }),
+                Arc::new(FreeBalls {
+                    zeta_b: p.zeta_b.clone(),
+                    delta: p.delta,
+                }),
+                Arc::new(support.clone()),
+            ];
+            if let Some(s) = springs {
+                parts.push(Arc::new(s));
+            }
+            if let Some(f) = &self.impulse {
+                parts.push(Arc::new(f.clone()));
+            }
+            if self.gravity != 0.0 {
+                parts.push(Arc::new(Gravity { g: self.gravity }));
+            }
+            self.model = Assembly::Composed(
+                Composed::new(Layout::planar(n), drive, m, parts)
+                    .with_planar_mass(p)
+                    .with_modulo_turns(self.springs == 0.0),
+            );
+            return;
+        }
         let Some(consts) = self.rotor_consts() else {
             // the planar balancer's fused code, the effects dispatched statically, summed
             // in the order springs, load, gravity
@@ -323,7 +414,10 @@ impl Scene {
                     zeta_b: p.zeta_b.clone(),
                 },
             }),
-            Arc::new(IsotropicSupport { zeta: p.zeta }),
+            match anisotropic {
+                Some(a) => Arc::new(a),
+                None => Arc::new(IsotropicSupport { zeta: p.zeta }),
+            },
         ];
         if let Some(s) = springs {
             parts.push(Arc::new(s));
@@ -405,7 +499,8 @@ impl Scene {
             .with_spring_layout(self.spring_layout);
         // a copy whose film is unchanged shares the solvers (results do not depend on them)
         out.pool = pool;
-        out.with_bearing(s.bearing)
+        out.with_bearing(s.bearing)?
+            .with_anisotropic_support(s.anisotropic)
     }
 
     /// Sets one parameter in place and reassembles, without revalidating (continuation's
@@ -759,6 +854,98 @@ mod tests {
         let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
         let a = [0.05, -0.3, 0.2, -0.1, 0.2, 0.6, -0.1];
         check_jacobians(&all_effects(Some(tilt())), &q, &v, &a);
+    }
+
+    fn anisotropic() -> Option<AnisotropicAxes> {
+        Some(AnisotropicAxes {
+            k_x: 0.7,
+            k_y: 2.3,
+            zeta_x: Some(0.11),
+            zeta_y: None,
+        })
+    }
+
+    #[test]
+    fn anisotropic_jacobians_match_finite_differences() {
+        let (q, v, a) = state();
+        let s = all_effects(None)
+            .with_anisotropic_support(anisotropic())
+            .unwrap();
+        check_jacobians(&s, &q, &v, &a);
+        let q = [0.3, -0.2, 0.8, -0.6, 0.7, -1.9, 2.4];
+        let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
+        let a = [0.05, -0.3, 0.2, -0.1, 0.2, 0.6, -0.1];
+        let s = all_effects(Some(tilt()))
+            .with_anisotropic_support(anisotropic())
+            .unwrap();
+        check_jacobians(&s, &q, &v, &a);
+    }
+
+    #[test]
+    fn anisotropic_support_is_the_ground_force_turned_into_the_disk() {
+        // the support rows less the isotropic scene's (spring 1, damping zeta) are the
+        // ground force -(k_x X + 2 z_x X', k_y Y + 2 z_y Y') rotated into the disk frame,
+        // less the isotropic one; written here from the ground-frame position and velocity
+        let p = planar();
+        let (q, v, a) = state();
+        let plain = Scene::new(p.clone(), 0.0, None, 0.0, None, None).unwrap();
+        let aniso = plain
+            .clone()
+            .with_anisotropic_support(anisotropic())
+            .unwrap();
+        assert_eq!(
+            aniso.time_dependence().as_deref(),
+            Some("anisotropic_support")
+        );
+        let t = 0.9;
+        let (mut r0, mut r1) = ([0.0; 5], [0.0; 5]);
+        plain.residual(t, &q, &v, &a, &mut r0);
+        aniso.residual(t, &q, &v, &a, &mut r1);
+        let (om, th) = (p.omega_s, p.omega_s * t);
+        let (sn, cs) = th.sin_cos();
+        let (x, y) = (q[0], q[1]);
+        let (vx, vy) = (v[0] - om * y, v[1] + om * x);
+        let (gx, gy) = (cs * x - sn * y, sn * x + cs * y);
+        let (gvx, gvy) = (cs * vx - sn * vy, sn * vx + cs * vy);
+        let (fx, fy) = (0.7 * gx + 2.0 * 0.11 * gvx, 2.3 * gy + 2.0 * p.zeta * gvy);
+        let (rx, ry) = (cs * fx + sn * fy, -sn * fx + cs * fy);
+        let iso = (x + 2.0 * p.zeta * vx, y + 2.0 * p.zeta * vy);
+        assert!((r1[0] - r0[0] - (rx - iso.0)).abs() < 1e-12);
+        assert!((r1[1] - r0[1] - (ry - iso.1)).abs() < 1e-12);
+        for i in 2..5 {
+            assert!((r1[i] - r0[i]).abs() < 1e-12 * (1.0 + r0[i].abs()));
+        }
+        // equal axes: autonomous, and with unit stiffness the isotropic support
+        let unit = plain
+            .clone()
+            .with_anisotropic_support(Some(AnisotropicAxes {
+                k_x: 1.0,
+                k_y: 1.0,
+                zeta_x: None,
+                zeta_y: None,
+            }))
+            .unwrap();
+        assert_eq!(unit.time_dependence(), None);
+        let mut r2 = [0.0; 5];
+        unit.residual(t, &q, &v, &a, &mut r2);
+        for i in 0..5 {
+            assert!((r2[i] - r0[i]).abs() < 1e-12 * (1.0 + r0[i].abs()));
+        }
+    }
+
+    #[test]
+    fn anisotropic_axes_out_of_range_are_named() {
+        let bad = AnisotropicAxes {
+            k_x: 0.0,
+            k_y: 1.0,
+            zeta_x: None,
+            zeta_y: None,
+        };
+        let e = Scene::new(planar(), 0.0, None, 0.0, None, None)
+            .unwrap()
+            .with_anisotropic_support(Some(bad))
+            .unwrap_err();
+        assert!(e.to_string().contains("support.k_x"), "{e}");
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //!   translating mass), [`TiltingDisk`] (a disk tilting on a flexible shaft, generated
 //!   from its Lagrangian by `scripts/derive_tilt.py`);
 //! * support: [`IsotropicSupport`] (the spring–damper `k x + c x'` on the disk centre),
+//!   [`AnisotropicSupport`] (a ground-fixed spring–damper, unequal in X and Y),
 //!   [`BearingSupport`] (a journal bearing's film, [`JournalSupport`]);
 //! * balls: [`FreeBalls`] on a planar disk, [`TiltingBalls`] on a tilting one, and the
 //!   coupling [`BallSprings`] (ring or chain);
@@ -25,4 +26,4 @@ pub use bearing_support::{no_bearing, BearingSupport, JournalSupport, SolverPool
 pub use fused::{FusedPlanar, FusedTilting};
 pub use loads::{Gravity, Impulse};
 pub use rotor::{PlanarDisk, TiltingDisk};
-pub use support::IsotropicSupport;
+pub use support::{AnisotropicSupport, IsotropicSupport};
