@@ -14,6 +14,7 @@ from .balance import balance_map, balanced_state, plot_balance_map
 from .exceptions import ScanInterrupted
 from .model import Balancer, from_disk_units, zeta_from_log_decrement
 from .options import (
+    Collocation,
     Execution,
     Floquet,
     GuessSearch,
@@ -41,6 +42,7 @@ from .transient import (
 __all__ = [
     "Balancer",
     "BearingSupport",
+    "Collocation",
     "DisturbanceResponse",
     "Equilibrium",
     "Execution",

@@ -68,13 +68,14 @@ pub struct CollocPeriodic {
 /// `periodic()`'s result by `method`: `hb` (harmonic balance's result, already computed
 /// by the caller) unchanged for [`Method::Hb`] and, under [`Method::Auto`], wherever
 /// harmonic balance certified its series ([`hb_refused`] says where not). Otherwise the
-/// orbit by collocation from `hb`'s series (or, where it has none, from a simulated
-/// start); under `Auto` a collocation solve that fails its certificates leaves `hb`'s
-/// result as it was.
+/// orbit by collocation from the user's `guess` (all its harmonics), then `hb`'s series
+/// (or, where neither converges, from a simulated start); under `Auto` a collocation
+/// solve that fails its certificates leaves `hb`'s result as it was.
 pub fn by_method<D: Dynamics + ?Sized>(
     p: &D,
     ball_winding: &[f64],
     hb: Periodic,
+    guess: Option<&HbSolution>,
     method: Method,
     copts: &CollocOptions,
     opts: &PeriodicOptions,
@@ -84,52 +85,61 @@ pub fn by_method<D: Dynamics + ?Sized>(
         Method::Auto if !hb_refused(&hb) => return (hb, None),
         _ => {}
     }
-    let c = collocation_periodic(p, ball_winding, Some(&hb.sol), copts, opts);
+    let starts: Vec<&HbSolution> = guess.into_iter().chain([&hb.sol]).collect();
+    let c = collocation_periodic(p, ball_winding, &starts, copts, opts);
     if method == Method::Auto && c.periodic.sol.status != Status::Converged {
         return (hb, None);
     }
     (c.periodic, c.orbit)
 }
 
-/// Whether harmonic balance's result says its series cannot hold the orbit at the
-/// harmonics it had: refused by the tail or closure certificate, or `N = "auto"` short of
-/// its target at `N_max`. A series that did not converge (no start, diverged) is
-/// refused too: collocation gets its own start then.
+/// Whether harmonic balance's own certificates say its series cannot hold the orbit at
+/// the harmonics it had: a converged series refused by the tail or closure certificate,
+/// or `N = "auto"` short of its target at `N_max`. A solve that found no start or
+/// diverged is not handed over: the simulated starts it had are the ones collocation
+/// would get (`method = "collocation"` still tries them).
 pub fn hb_refused(r: &Periodic) -> bool {
     match r.sol.status {
         Status::Converged => r.target_met == Some(false),
-        // An equilibrium or a repeated orbit is a finding, not a failure of the series.
-        Status::Equilibrium | Status::Repeated => false,
-        _ => true,
+        Status::Truncated | Status::NotClosed => true,
+        _ => false,
     }
 }
 
 /// A periodic orbit of the pattern with windings `ball_winding` by collocation, from the
-/// series `start` when it has a finite frequency, otherwise (or when Newton fails from it)
-/// from the model's simulated starts, certified by [`certify_orbit`].
+/// first of the series `starts` (with a finite frequency) from which Newton converges,
+/// otherwise from the model's simulated starts, certified by [`certify_orbit`].
 pub fn collocation_periodic<D: Dynamics + ?Sized>(
     p: &D,
     ball_winding: &[f64],
-    start: Option<&HbSolution>,
+    starts: &[&HbSolution],
     copts: &CollocOptions,
     opts: &PeriodicOptions,
 ) -> CollocPeriodic {
-    let usable = |s: &&HbSolution| {
+    let usable = |s: &HbSolution| {
         s.omega.is_finite() && s.omega > 0.0 && s.coeffs.iter().all(|c| c.is_finite())
     };
+    let start = starts.last().copied();
     let mut tried: Option<CollocSolution> = None;
-    if let Some(s) = start.filter(usable) {
+    for s in starts.iter().filter(|s| usable(s)) {
         match solve(p, &CollocOrbit::from_hb(s, copts.ntst, copts.ncol), copts) {
             Ok(sol) if sol.status == CollocStatus::Converged => {
                 return certify_orbit(p, sol, opts);
             }
-            Ok(sol) => tried = Some(sol),
+            Ok(sol) => {
+                tried.get_or_insert(sol);
+            }
             Err(e) => return failed(p, ball_winding, start, None, Some(e.to_string())),
         }
     }
     // A simulated start: the attractor's series fitted with many harmonics, so that the
-    // slow phase and the jump of a long-period orbit survive the fit.
-    if ball_winding.iter().all(|w| w.abs() <= 1.0) && !crate::cancel::cancelled() {
+    // slow phase and the jump of a long-period orbit survive the fit. Not where the
+    // harmonic-balance search found no start: its simulations were these.
+    let searched_in_vain = start.is_some_and(|s| s.status == Status::NoGuess);
+    if ball_winding.iter().all(|w| w.abs() <= 1.0)
+        && !searched_in_vain
+        && !crate::cancel::cancelled()
+    {
         let rotating: Vec<bool> = ball_winding.iter().map(|w| *w != 0.0).collect();
         for y0 in initial_states(p) {
             if crate::cancel::cancelled() {
@@ -361,10 +371,10 @@ mod tests {
         let hb = periodic(&p, &[true, true], None, &o);
         assert_eq!(hb.sol.status, Status::Converged);
         let c = CollocOptions::default();
-        let (kept, orbit) = by_method(&p, &[-1.0, -1.0], hb.clone(), Method::Auto, &c, &o);
+        let (kept, orbit) = by_method(&p, &[-1.0, -1.0], hb.clone(), None, Method::Auto, &c, &o);
         assert!(orbit.is_none());
         assert_eq!(kept.sol.omega, hb.sol.omega);
-        let (col, orbit) = by_method(&p, &[-1.0, -1.0], hb, Method::Collocation, &c, &o);
+        let (col, orbit) = by_method(&p, &[-1.0, -1.0], hb, None, Method::Collocation, &c, &o);
         assert!(orbit.is_some());
         assert_eq!(col.sol.status, Status::Converged);
         let fine = PeriodicOptions {
@@ -397,7 +407,7 @@ mod tests {
         let hb = periodic(&p, &[true, true], None, &o);
         assert!(hb_refused(&hb), "{:?}", hb.sol.status);
         let c = CollocOptions::default();
-        let (r, orbit) = by_method(&p, &[-1.0, -1.0], hb, Method::Auto, &c, &o);
+        let (r, orbit) = by_method(&p, &[-1.0, -1.0], hb, None, Method::Auto, &c, &o);
         assert!(orbit.is_some());
         assert_eq!(r.sol.status, Status::Converged);
         assert!(r.sol.period() > 300.0, "{}", r.sol.period());
