@@ -149,6 +149,24 @@ def test_auto_switches_between_omega_1_2_and_the_slow_end():
     assert methods[1.2] == "hb" and methods[0.92] == "collocation"
 
 
+def test_a_guess_carries_auto_collocation_past_the_simulated_search():
+    """Below Omega ~0.918 the simulated search sees no whole period; from the orbit at
+    0.92 as guess, "auto" continues by collocation (harmonic balance's solve from the
+    guess is refused or diverges). The periods follow the saddle-node-on-invariant-circle
+    law T ~ C (Omega - Omega*)^(-1/2): two of them put the end within 3e-4 of AUTO-07p's
+    Omega* = 0.917140455 (issue 33; the law's next term is what is left)."""
+    p92 = ballbal.periodic(balancer(0.92), "R-R")
+    assert p92.method == "collocation" and p92.converged
+    p918 = ballbal.periodic(balancer(0.918), "R-R", guess=p92)
+    assert p918.method == "collocation" and p918.converged
+    p9175 = ballbal.periodic(balancer(0.9175), "R-R", guess=p918)
+    assert p9175.method == "collocation" and p9175.converged
+    assert p92.period < p918.period < p9175.period
+    (w1, t1), (w2, t2) = (0.918, p918.period), (0.9175, p9175.period)
+    end = (t2**2 * w2 - t1**2 * w1) / (t2**2 - t1**2)
+    assert abs(end - 0.917140455) < 3e-4, end
+
+
 def test_bad_collocation_options_are_refused_by_name():
     for kw, name in [({"ntst": 1}, "ntst"), ({"ntst": 10_001}, "ntst"), ({"ncol": 0}, "ncol"),
                      ({"ncol": 8}, "ncol"), ({"tol": float("nan")}, "tol"),

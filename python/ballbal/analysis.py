@@ -504,7 +504,8 @@ def periodic(
     started from harmonic balance's series (the search below, or ``guess``) and, where
     that solve fails, from simulated starts. ``"auto"`` (default): harmonic balance, and
     collocation where harmonic balance's own certificates refuse its series (``truncated``,
-    ``not_closed``, or ``N="auto"`` short of its target): near the infinite-period end of a
+    ``not_closed``, or ``N="auto"`` short of its target) or, from a ``guess``, where its
+    Newton solve fails (collocation then starts from the guess): near the infinite-period end of a
     rotating branch, whose orbits linger in a slow phase and jump through the rest, a
     series needs ever more harmonics, a mesh that crowds into the jump does not. A result
     harmonic balance certified is returned as before; a collocation solve that fails its

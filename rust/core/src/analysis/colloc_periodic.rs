@@ -82,7 +82,7 @@ pub fn by_method<D: Dynamics + ?Sized>(
 ) -> (Periodic, Option<CollocOrbit>) {
     match method {
         Method::Hb => return (hb, None),
-        Method::Auto if !hb_refused(&hb) => return (hb, None),
+        Method::Auto if !hb_refused(&hb, guess.is_some()) => return (hb, None),
         _ => {}
     }
     let starts: Vec<&HbSolution> = guess.into_iter().chain([&hb.sol]).collect();
@@ -95,13 +95,17 @@ pub fn by_method<D: Dynamics + ?Sized>(
 
 /// Whether harmonic balance's own certificates say its series cannot hold the orbit at
 /// the harmonics it had: a converged series refused by the tail or closure certificate,
-/// or `N = "auto"` short of its target at `N_max`. A solve that found no start or
-/// diverged is not handed over: the simulated starts it had are the ones collocation
+/// or `N = "auto"` short of its target at `N_max`; and, from a user's guess (`guessed`),
+/// a Newton solve that failed (near the infinite-period end a series of the neighbour's
+/// harmonics diverges where collocation from the same guess converges: Omega 0.9175 from
+/// the orbit at 0.92 on the merged R-R branch). Without a guess, a search that found no
+/// start or diverged is not handed over: its simulated starts are the ones collocation
 /// would get (`method = "collocation"` still tries them).
-pub fn hb_refused(r: &Periodic) -> bool {
+pub fn hb_refused(r: &Periodic, guessed: bool) -> bool {
     match r.sol.status {
         Status::Converged => r.target_met == Some(false),
         Status::Truncated | Status::NotClosed => true,
+        Status::Diverged | Status::Singular | Status::MaxIterations => guessed,
         _ => false,
     }
 }
@@ -405,7 +409,7 @@ mod tests {
         let p = balancer(0.93);
         let o = opts();
         let hb = periodic(&p, &[true, true], None, &o);
-        assert!(hb_refused(&hb), "{:?}", hb.sol.status);
+        assert!(hb_refused(&hb, false), "{:?}", hb.sol.status);
         let c = CollocOptions::default();
         let (r, orbit) = by_method(&p, &[-1.0, -1.0], hb, None, Method::Auto, &c, &o);
         assert!(orbit.is_some());
