@@ -35,6 +35,7 @@ __all__ = [
     "validate_bearing", "validate_balancer", "validate_harmonic_balance", "validate_floquet",
     "validate_guess", "validate_periodic_options", "validate_continuation",
     "validate_basin_options", "validate_collocation", "collocation_states",
+    "collocation_follow",
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
@@ -65,6 +66,12 @@ def collocation_states(
     mesh: npt.NDArray[np.float64], states: npt.NDArray[np.float64], period: float,
     winding: list[float], t: npt.NDArray[np.float64],
 ) -> npt.NDArray[np.float64]: ...
+# Natural continuation of a collocation orbit: lists param, period, mesh_error; ntst
+def collocation_follow(
+    model: Balancer | Scene, parameter: str, mesh: npt.NDArray[np.float64],
+    states: npt.NDArray[np.float64], period: float, winding: list[float], target: float,
+    step: float, min_step: float, options: Collocation,
+) -> dict[str, Any]: ...
 # Film forces (rust/py/src/bearing.rs): dicts of floats, arrays where named.
 def bearing_force(
     bearing: Bearing, position: tuple[float, float], velocity: tuple[float, float],
