@@ -10,7 +10,9 @@ ballbal's side, per NTST (one thread, medians of ``--repeat`` runs, default 3): 
 matched run 1.2 -> 0.93 (natural continuation of the collocation orbit, no multipliers)
 and its periods at 0.95 and 0.93 against the same orbits re-solved on a mesh four times
 as fine; the downward run to the end (steps halved until below 1e-13): its reach and
-time. AUTO's side runs the anchor's ``run_auto.py`` (``../shared/anchors/auto07p`` or
+time (and the last orbit's mesh error indicator, the largest ``h^(NCOL+1)
+|y^(NCOL+1)|``: above ~0.1 that orbit is no longer resolved). Wall times on a shared
+machine are noisy. AUTO's side runs the anchor's ``run_auto.py`` (``../shared/anchors/auto07p`` or
 ``--anchor``) and prints its summary as it comes.
 """
 
@@ -90,7 +92,8 @@ def main() -> None:
         print(f"NTST {ntst:4d}: 1.2 -> 0.93 {t_matched:6.3f} s ({len(br['param'])} points), "
               f"period error 0.95 {errs[0]:+.1e}, 0.93 {errs[1]:+.1e}; down to the end "
               f"{t_down:6.3f} s ({len(down['param'])} points), reach {reach:.1e} "
-              f"(T {down['period'][-1]:.3e})", flush=True)
+              f"(T {down['period'][-1]:.3e}, mesh indicator {down['mesh_error'][-1]:.1e})",
+              flush=True)
     if "AUTO_DIR" not in os.environ:
         print("AUTO-07p: not run (set AUTO_DIR to a built AUTO-07p source tree)")
         return
