@@ -51,9 +51,13 @@ impl Method {
 pub const FITTED_HARMONICS: usize = 32;
 
 /// Largest closure ([`piecewise_closure`]) of a collocation orbit; above it the result
-/// is `NotClosed`. Measured on the merged R-R branch (`mu 0.2, zeta 0.05, zeta_b 0.1,
-/// delta 50`): converged orbits at NTST 20 to 100 close to 1e-9..1e-6 between Omega
-/// 1.2 and 0.92; a mesh too coarse for the orbit shows as 1e-3 and more.
+/// is `NotClosed`. Measured 2026-11-28 on the merged R-R branch (`mu 0.2, zeta 0.05,
+/// zeta_b 0.1, delta 50, eta (1, 1)`) at Omega 1.2, 0.95, 0.93, 0.92, NCOL 4: NTST 50
+/// and 100 close to 2e-11..7e-7 (periods within 2e-12 of each other); NTST 20 to
+/// 2.5e-8..7.6e-5 (0.92, period off by 9e-9), NTST 4 to 10 to 2.1e-4..0.1 (periods off by
+/// 4e-8..1e-3; 1.2 at NTST 10: 3.8e-6, period off by 9e-10). The bound separates the
+/// meshes that resolve these orbits to ~1e-8 in the period from those that do not;
+/// NTST 20 near Omega 0.92 is within a factor 1.3 of it.
 pub const COLLOC_MAX_CLOSURE: f64 = 1e-4;
 
 /// A collocation result in `periodic()`'s form: the certified [`Periodic`] (its series
