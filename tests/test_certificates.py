@@ -54,7 +54,8 @@ def test_continuation_into_the_branch_end_gives_orbits_or_says_not_converged(N):
     omegas.insert(omegas.index(0.9), 0.915)
     closed, refused = 0, 0
     for W in omegas:
-        s = ballbal.periodic(b.replace(Omega=W), "R-R", N=N, guess=prev)
+        # Harmonic balance's certificates under test: no collocation where they refuse.
+        s = ballbal.periodic(b.replace(Omega=W), "R-R", N=N, guess=prev, method="hb")
         check_verdict(s)
         if s.converged:
             assert simulated_closure(s) < 0.3, (W, s.omega)
@@ -74,7 +75,7 @@ def test_not_closed_series_is_no_orbit_by_simulation():
     b = ballbal.Balancer(**REPRO, Omega=1.0, eta=(1.0, 1.0))
     prev = ballbal.periodic(b, "R-R", N=8)
     for W in (0.98, 0.96, 0.94, 0.92):
-        prev = ballbal.periodic(b.replace(Omega=W), "R-R", N=8, guess=prev)
+        prev = ballbal.periodic(b.replace(Omega=W), "R-R", N=8, guess=prev, method="hb")
     assert prev.status == "not_closed"
     assert simulated_closure(prev) > 1.0
 
@@ -221,7 +222,7 @@ def test_random_continuation_paths_are_certified(p):
         if dw != 0.0:
             if s.omega is None:
                 break
-            s = ballbal.periodic(b.replace(Omega=W), "R-R", N=p["N"], guess=s)
+            s = ballbal.periodic(b.replace(Omega=W), "R-R", N=p["N"], guess=s, method="hb")
         check_verdict(s)
         if s.status in ("not_closed", "truncated"):
             assert s.stability == "undetermined"

@@ -24,6 +24,7 @@ from .balance import balance_map, balanced_state, plot_balance_map
 from .exceptions import ScanInterrupted
 from .model import Balancer, from_disk_units, zeta_from_log_decrement
 from .options import (
+    Collocation,
     Execution,
     Floquet,
     GuessSearch,
@@ -62,6 +63,7 @@ __all__ = [
     "AnisotropicSupport",
     "Balancer",
     "BearingSupport",
+    "Collocation",
     "DisturbanceResponse",
     "Equilibrium",
     "Execution",

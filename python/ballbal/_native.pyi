@@ -14,7 +14,14 @@ from ._rotor import RotorOnBearing
 from .basins import BasinOptions
 from .bearing import Bearing
 from .model import Balancer
-from .options import Floquet, GuessSearch, HarmonicBalance, PeriodicOptions, ScanOptions
+from .options import (
+    Collocation,
+    Floquet,
+    GuessSearch,
+    HarmonicBalance,
+    PeriodicOptions,
+    ScanOptions,
+)
 from .scene import Scene
 
 __all__ = [
@@ -27,7 +34,8 @@ __all__ = [
     "parameters", "parameter_keys", "check_axes", "scan_schema",
     "validate_bearing", "validate_balancer", "validate_harmonic_balance", "validate_floquet",
     "validate_guess", "validate_periodic_options", "validate_continuation",
-    "validate_basin_options",
+    "validate_basin_options", "validate_collocation", "collocation_states",
+    "collocation_follow",
     "validate_rotor", "rotor_equilibrium", "rotor_from_dimensions", "simulate_rotor",
     "bearing_force", "bearing_equilibrium", "bearing_coefficients", "bearing_stability",
     "basins", "attractor_series", "classify_state",
@@ -52,6 +60,18 @@ def validate_guess(options: GuessSearch) -> None: ...
 def validate_periodic_options(options: PeriodicOptions | ScanOptions) -> None: ...
 def validate_continuation(options: Continuation) -> None: ...
 def validate_basin_options(options: BasinOptions) -> None: ...
+def validate_collocation(options: Collocation) -> None: ...
+# A collocation orbit's states (rust/py/src/collocation.rs): shape (len(t), 2 d)
+def collocation_states(
+    mesh: npt.NDArray[np.float64], states: npt.NDArray[np.float64], period: float,
+    winding: list[float], t: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]: ...
+# Natural continuation of a collocation orbit: lists param, period, mesh_error; ntst
+def collocation_follow(
+    model: Balancer | Scene, parameter: str, mesh: npt.NDArray[np.float64],
+    states: npt.NDArray[np.float64], period: float, winding: list[float], target: float,
+    step: float, min_step: float, options: Collocation,
+) -> dict[str, Any]: ...
 # Film forces (rust/py/src/bearing.rs): dicts of floats, arrays where named.
 def bearing_force(
     bearing: Bearing, position: tuple[float, float], velocity: tuple[float, float],
@@ -92,6 +112,7 @@ def periodic(
     guess: tuple[float, npt.NDArray[np.float64]] | None = None,
     windings: list[int] | None = None,
     homotopy: tuple[list[tuple[str, float]], bool] | None = None,
+    method: str = "hb", collocation: Collocation | None = None,
 ) -> dict[str, Any]: ...
 def orbit_closure(
     model: Balancer | Scene, omega: float, coeffs: npt.NDArray[np.float64],

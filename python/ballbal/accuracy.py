@@ -136,18 +136,19 @@ def accuracy_cost(
     tight = PeriodicOptions(harmonic_balance=HarmonicBalance(tol=1e-12, step_tol=1e-10),
                             floquet=Floquet(rtol=1e-11, atol=1e-13, hill=False))
     if guess is None:
-        start = periodic(model, pattern, N=8, options=no_hill)
+        start = periodic(model, pattern, N=8, options=no_hill, method="hb")
         if not start.converged:
             raise ParameterError("pattern", f"no {pattern} solution found at this point by "
                              f"simulation (status {start.status}); pass guess=")
         guess = start
-    ref = periodic(model, pattern, N=reference_N, guess=guess, options=tight)
+    ref = periodic(model, pattern, N=reference_N, guess=guess, options=tight, method="hb")
     if not ref.converged or ref.multipliers is None:
         raise ParameterError("reference_N", f"the N = {reference_N} solve did not converge "
                          f"(status {ref.status})")
     closure = ref.verify(rtol=1e-11, atol=1e-13)
     near_b = model.replace(Omega=model.Omega - neighbour)
-    near = periodic(near_b, pattern, N=reference_N, guess=ref, options=no_hill)
+    near = periodic(near_b, pattern, N=reference_N, guess=ref, options=no_hill,
+                    method="hb")
     warm = near if near.converged else ref
 
     settings: list[tuple[str, float, dict[str, Any]]] = []
@@ -171,8 +172,10 @@ def accuracy_cost(
             times = []
             for _ in range(repeats):
                 t0 = time.perf_counter()
-                # The truncation under study, not one the verdict's bound refined.
-                s = periodic(model, pattern, guess=warm, options=_study_options(kw))
+                # The truncation under study, not one the verdict's bound refined, nor
+                # collocation where the series is refused.
+                s = periodic(model, pattern, guess=warm, options=_study_options(kw),
+                             method="hb")
                 times.append(time.perf_counter() - t0)
             ok = s.converged and s.multipliers is not None
             errors: dict[str, float | None] = dict.fromkeys(

@@ -13,7 +13,14 @@ from . import _check, _native
 from ._style import Summarised
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
-from .options import PERIODIC_DEFAULTS, PeriodicOptions, refuses_keywords, with_harmonics
+from .options import (
+    COLLOCATION_DEFAULTS,
+    PERIODIC_DEFAULTS,
+    Collocation,
+    PeriodicOptions,
+    refuses_keywords,
+    with_harmonics,
+)
 from .scene import Scene, model_argument
 from .spectrum import LineSource, Vibration, line_spectrum, vibration
 
@@ -266,11 +273,16 @@ def _equilibrium(d: dict[str, Any], eta: np.ndarray | None = None) -> Equilibriu
 
 @dataclass(frozen=True, repr=False)
 class PeriodicSolution(Summarised, LineSource):
-    """A periodic solution from harmonic balance (or a failed attempt: see ``status``).
+    """A periodic solution from harmonic balance or collocation (or a failed attempt: see
+    ``status``); ``method`` says which (``"hb"``, ``"collocation"``).
 
     ``coeffs[j] = [a_0, a_1, b_1, ..., a_N, b_N]`` for coordinate ``j`` of
     ``(x, y, b_1..b_n)``; ``q_j(tau) = a_0 + sum a_m cos(m tau) + b_m sin(m tau) + w_j tau``,
-    ``tau = omega t``, with ``winding[j] = -1`` for a rotating ball.
+    ``tau = omega t``, with ``winding[j] = -1`` for a rotating ball. For a collocation
+    orbit the series is fitted to the orbit (``N = 32`` harmonics, from 148 samples per
+    period; its ``tail`` says how well it holds the orbit) and serves the spectrum, the
+    vibration measures and as a start for other solves; ``time_history`` and ``state``
+    evaluate the collocation polynomials themselves (``mesh``, ``mesh_states``).
 
     Certificates (see :func:`periodic`): ``closure`` (the series' ODE defect integrated
     over one period), ``tail`` (highest harmonic relative to the motion),
@@ -316,6 +328,14 @@ class PeriodicSolution(Summarised, LineSource):
     #: about the frequency's.
     omega_error: float | None = None
     info: dict[str, Any] = field(default_factory=dict)
+    #: ``"hb"`` (harmonic balance) or ``"collocation"``.
+    method: str = "hb"
+    #: Collocation only: the mesh points in scaled time ``t / T`` (``NTST + 1``, 0 to 1).
+    mesh: np.ndarray | None = None
+    #: Collocation only: the first-order states ``(q, q')`` at the ``NCOL`` equally spaced
+    #: points of every mesh interval and the last mesh point, shape
+    #: ``(NTST NCOL + 1, 2 d)`` (rotating angles unwrapped).
+    mesh_states: np.ndarray | None = None
 
     def _displacement_lines(self, Omega: float | None,  # noqa: N803
                             name: str) -> tuple[np.ndarray, np.ndarray, float, float]:
@@ -339,18 +359,23 @@ class PeriodicSolution(Summarised, LineSource):
 
     def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
         spin = f"Ω={self.balancer.Omega:.4g}"
+        if self.method == "collocation" and self.mesh is not None:
+            how = f"collocation, {len(self.mesh) - 1} intervals"
+        else:
+            how = f"N={self.N}"
         if self.omega is None:
-            head = f"PeriodicSolution {self.type} {spin} {self.status} (N={self.N})"
+            head = f"PeriodicSolution {self.type} {spin} {self.status} ({how})"
         else:
             mod = "-" if self.max_modulus is None else f"{self.max_modulus:.3g}"
             head = (f"PeriodicSolution {self.type} {spin} ω={self.omega:.4f} {self.stability} "
-                    f"|μ|max={mod} (N={self.N})")
+                    f"|μ|max={mod} ({how})")
             if self.status != "converged":
                 head += f" {self.status}"
         return head, [("type", self.type), ("status", self.status),
                       ("Ω (spin)", self.balancer.Omega), ("ω (balls)", self.omega),
                       ("stability", self.stability), ("|μ|max", self.max_modulus),
-                      ("|μ|max error", self.modulus_error), ("harmonics N", self.N),
+                      ("|μ|max error", self.modulus_error), ("method", self.method),
+                      ("harmonics N", self.N),
                       ("closure", self.closure), ("tail", self.tail),
                       ("residual", self.residual), ("iterations", self.iterations)]
 
@@ -388,6 +413,12 @@ class PeriodicSolution(Summarised, LineSource):
             raise ValueError(f"no orbit: the solve did not converge (status {self.status})")
         tt = (np.linspace(0, self.period, 201) if t is None
               else _check.vector("t", t, _check.MAX_SAMPLES))
+        if self.method == "collocation" and self.mesh is not None and self.mesh_states is not None:
+            y = _native.collocation_states(
+                self.mesh, np.ascontiguousarray(self.mesh_states.ravel()), self.period,
+                [float(w) for w in self.winding], np.ascontiguousarray(tt, dtype=np.float64))
+            names = _state_names(self.balancer)
+            return pl.DataFrame({"t": tt, **{names[j]: y[:, j] for j in range(y.shape[1])}})
         tau = self.omega * tt
         m = np.arange(1, self.N + 1)
         cols: dict[str, Any] = {"t": tt}
@@ -434,6 +465,16 @@ class PeriodicSolution(Summarised, LineSource):
         the largest distance from where the orbit says the motion should be."""
         if self.omega is None:
             raise ValueError(f"nothing to verify: status {self.status}")
+        if self.method == "collocation":
+            # From the collocation orbit's own state (the fitted series is not the orbit).
+            y0 = np.ascontiguousarray(self.state(0.0), dtype=np.float64)
+            y, *_ = _native.simulate(self.balancer, y0, 0.0, np.array([self.period]),
+                                     _check.real("rtol", rtol), [_check.real("atol", atol)],
+                                     10_000_000)
+            d = len(self.winding)
+            target = y0.copy()
+            target[:d] += 2 * np.pi * np.asarray(self.winding)
+            return float(np.max(np.abs(np.asarray(y)[0] - target)))
         return _native.orbit_closure(
             self.balancer, self.omega, np.ascontiguousarray(self.coeffs.ravel()),
             [float(w) for w in self.winding], _check.real("rtol", rtol),
@@ -499,9 +540,33 @@ def periodic(
     guess: PeriodicSolution | tuple[float, np.ndarray] | None = None,
     windings: Sequence[int] | None = None,
     homotopy: bool | dict[str, float] | Sequence[tuple[str, float]] | None = None,
+    method: Literal["hb", "collocation", "auto"] = "auto",
+    collocation: Collocation | None = None,
 ) -> PeriodicSolution:
     """Periodic solution of a ball pattern (``"R-R"``, ``"O-O"``, ``"R-O"``, ... one letter
-    per ball) by Newton–IHB with ``N`` harmonics, and its Floquet multipliers.
+    per ball) by Newton–IHB with ``N`` harmonics (or by collocation, see ``method``), and
+    its Floquet multipliers.
+
+    ``method``: the discretisation. ``"hb"``: harmonic balance only. ``"collocation"``:
+    orthogonal collocation on an adaptive mesh (``collocation``, a
+    :class:`~ballbal.Collocation`; default :data:`ballbal.options.COLLOCATION_DEFAULTS`),
+    started from harmonic balance's series (the search below, or ``guess``) and, where
+    that solve fails, from simulated starts. ``"auto"`` (default): harmonic balance, and
+    collocation where harmonic balance's own certificates refuse its series (``truncated``,
+    ``not_closed``, or ``N="auto"`` short of its target) or, from a ``guess``, where its
+    Newton solve fails (collocation then starts from the guess): near the infinite-period end of a
+    rotating branch, whose orbits linger in a slow phase and jump through the rest, a
+    series needs ever more harmonics, a mesh that crowds into the jump does not. A result
+    harmonic balance certified is returned as before; a collocation solve that fails its
+    certificates leaves harmonic balance's result. ``result.method`` says which.
+    A collocation orbit is certified as a series is: ``closure`` is the largest distance
+    between the orbit and the model integrated (Dormand–Prince, rtol 1e-10) over each mesh
+    interval from the orbit's state at its start (above 1e-4: ``not_closed``); its
+    multipliers are the discretised monodromy's (AUTO-07p's), ``modulus_error`` twice the
+    leading non-trivial modulus' difference to the monodromy integrated along the orbit at
+    ``Floquet.rtol`` plus that one's trivial error, and the verdict needs ``max_modulus``
+    farther than it from 1 (otherwise ``undetermined``). Hill's method and the merged
+    balls' ``separation_error`` are harmonic balance's only; ``omega_error`` is None.
 
     ``options``: a :class:`~ballbal.PeriodicOptions` (harmonic balance, Floquet, guess
     search, certificates; default :data:`ballbal.options.PERIODIC_DEFAULTS`); the option
@@ -612,6 +677,9 @@ def periodic(
     options = _check.option("options", options, PeriodicOptions, PERIODIC_DEFAULTS,
                             "ballbal.PeriodicOptions")
     options = with_harmonics(options, N)
+    _check.string("method", method)
+    copts = _check.option("collocation", collocation, Collocation, COLLOCATION_DEFAULTS,
+                          "ballbal.Collocation")
     wind = None if windings is None else _windings(windings)
     go: float | None = None
     gc: np.ndarray | None = None
@@ -640,7 +708,8 @@ def periodic(
     elif homotopy is not False:
         starts = (_homotopy(model, homotopy), True)
     d = _native.periodic(model, pattern, options,
-                         None if go is None or gc is None else (go, gc), wind, starts)
+                         None if go is None or gc is None else (go, gc), wind, starts,
+                         method, copts)
     out = _solution(model, d)
     out.info["guess_source"] = d["guess_source"]
     return out
@@ -663,4 +732,5 @@ def _solution(model: Balancer | Scene, d: dict[str, Any]) -> PeriodicSolution:
         pivot_ratio=d["pivot_ratio"], closure=d["closure"],
         separation_error=d["separation_error"],
         info={"floquet_error": d["floquet_error"], "last_omega": d["last_omega"]},
+        method=d.get("method", "hb"), mesh=d.get("mesh"), mesh_states=d.get("mesh_states"),
     )

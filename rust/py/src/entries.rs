@@ -3,14 +3,17 @@
 //! model once, chooses planar or scene once ([`dispatch!`]) and runs the core off the
 //! GIL.
 
+use crate::collocation::CollocArgs;
 use crate::convert::{dispatch, slice, Model, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::{guarded, run_polled};
 use crate::tables::{equilibrium_dict, scan_columns, solution_dict, Columns};
+use ballbal_core::analysis::colloc_periodic::{by_method, Method};
 use ballbal_core::analysis::constructed::periodic_discover;
 use ballbal_core::analysis::homotopy::source_of;
 use ballbal_core::equilibria::equilibria as core_equilibria;
 use ballbal_core::hb::{HbSolution, Status};
+use ballbal_core::numerics::collocation::CollocOptions;
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{
     closure_error, parse_solution_type, parse_windings, periodic_searched, require_autonomous,
@@ -247,7 +250,8 @@ pub(crate) fn start(m: &Model, ball_winding: &[f64], w: f64, c: &[f64]) -> PyRes
 /// starts (`analysis::constructed`) or after; the dict's `guess_source` says how it
 /// was found.
 #[pyfunction]
-#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None))]
+#[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None, method="hb", collocation=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn periodic<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -256,10 +260,17 @@ pub fn periodic<'py>(
     guess: Option<(f64, PyReadonlyArray1<'py, f64>)>,
     windings: Option<Vec<i64>>,
     homotopy: Option<(Vec<(String, f64)>, bool)>,
+    method: &str,
+    collocation: Option<CollocArgs>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = autonomous(&model, false, "periodic")?;
     let ball_winding = parse_windings(pattern, windings.as_deref(), m.n_balls()).py()?;
     let opts = options.to_core_for(&m)?;
+    let method = Method::parse(method).py()?;
+    let copts = match &collocation {
+        Some(c) => c.to_core()?,
+        None => CollocOptions::default(),
+    };
     let guess = match &guess {
         Some((w, c)) => Some(start(&m, &ball_winding, *w, slice(c, "guess")?)?),
         None => None,
@@ -269,17 +280,42 @@ pub fn periodic<'py>(
         Some((starts, false)) => (None, Some(starts.as_slice())),
         None => (None, None),
     };
-    let (r, source) = guarded(py, || {
+    let (r, orbit, source) = guarded(py, || {
         dispatch!(&m, d => {
             stiff_guess(d, guess.is_none(), &opts)?;
-            Ok(match &guess {
+            let (hb, source) = match &guess {
                 None => periodic_discover(d, &ball_winding, first, last, &opts),
                 Some(g) => (periodic_searched(d, &ball_winding, Some(g), &opts), source_of(true)),
-            })
+            };
+            let (r, orbit) = by_method(d, &ball_winding, hb, guess.as_ref(), method, &copts, &opts);
+            Ok((r, orbit, source))
         })
     })?;
+    let bounded = r
+        .floquet
+        .as_ref()
+        .is_some_and(|f| f.modulus_error.is_some());
     let out = solution_dict(py, r, m.n_balls())?;
     out.set_item("guess_source", source)?;
+    match orbit {
+        Some(o) => {
+            out.set_item("method", "collocation")?;
+            if bounded {
+                out.set_item(
+                    "modulus_error_source",
+                    format!("NTST {} collocation vs integrated", o.ntst()),
+                )?;
+            }
+            out.set_item("ntst", o.ntst())?;
+            out.set_item("mesh", PyArray1::from_vec(py, o.mesh))?;
+            let rows = o.u.len() / o.n;
+            out.set_item(
+                "mesh_states",
+                PyArray1::from_vec(py, o.u).reshape([rows, o.n])?,
+            )?;
+        }
+        None => out.set_item("method", "hb")?,
+    }
     Ok(out)
 }
 

@@ -8,6 +8,7 @@
 mod basins;
 mod bearing;
 mod checks;
+mod collocation;
 mod continuation;
 mod convert;
 mod entries;
@@ -83,6 +84,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tables::scan_schema, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::validate_bearing, m)?)?;
     checks::register(m)?;
+    collocation::register(m)?;
     rotor::register(m)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_force, m)?)?;
     m.add_function(wrap_pyfunction!(bearing::bearing_equilibrium, m)?)?;

@@ -4,6 +4,7 @@
 pub mod attractors;
 pub mod balanced;
 pub mod basins;
+pub mod colloc_periodic;
 pub mod constructed;
 pub mod equilibria;
 pub mod family;
