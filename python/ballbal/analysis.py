@@ -367,7 +367,7 @@ class PeriodicSolution(Summarised, LineSource):
             head = f"PeriodicSolution {self.type} {spin} {self.status} ({how})"
         else:
             mod = "-" if self.max_modulus is None else f"{self.max_modulus:.3g}"
-            head = (f"PeriodicSolution {self.type} {spin} ω={self.omega:.4f} {self.stability} "
+            head = (f"PeriodicSolution {self.type} {spin} ω={self.omega:.5g} {self.stability} "
                     f"|μ|max={mod} ({how})")
             if self.status != "converged":
                 head += f" {self.status}"
