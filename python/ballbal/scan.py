@@ -28,6 +28,7 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
+from ._progress import Progress
 from .exceptions import (
     InternalError,
     ParameterError,
@@ -666,33 +667,6 @@ class _Store:
         return [self.file(c) for c in sorted(chunks)]
 
 
-class _Progress:
-    def __init__(self, progress: bool | Callable[[int, int], Any], total: int,
-                 done: int) -> None:
-        self.total, self.done, self.bar, self.fn = total, done, None, None
-        if callable(progress):
-            self.fn = progress
-        elif progress:
-            try:
-                from tqdm.auto import tqdm
-
-                self.bar = tqdm(total=total, initial=done, unit="pt", desc="ballbal scan")
-            except ImportError:
-                self.fn = lambda d, t: print(f"\rballbal scan: {d}/{t} points", end="",
-                                             file=sys.stderr, flush=True)
-
-    def update(self, n: int) -> None:
-        self.done += n
-        if self.bar is not None:
-            self.bar.update(n)
-        if self.fn is not None:
-            self.fn(self.done, self.total)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
 def _interrupted(work: Callable[[], None]) -> bool:
     """Runs ``work()``; True if Ctrl-C stopped it. One Ctrl-C can arrive twice: when it
     lands while polars writes a chunk, polars raises a KeyboardInterrupt of its own and
@@ -943,7 +917,8 @@ def _run(job: _Job, store: _Store | None, executor: Any, threads: int | None,
     finished &= set(range(n))
     todo = [c for c in range(n) if c not in finished]
     total = sum(job.points(c) for c in range(n))
-    bar = _Progress(progress, total, sum(job.points(c) for c in finished))
+    bar = Progress(progress, total, "ballbal scan", unit="pt",
+                   done=sum(job.points(c) for c in finished))
 
     def keep(c: int, df: pl.DataFrame) -> None:
         if store is not None:
