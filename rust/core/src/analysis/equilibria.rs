@@ -532,6 +532,11 @@ pub fn newton_least_squares<P: Problem + ?Sized>(prob: &mut P, q0: &[f64]) -> Op
     // now instead of after all 60 iterations (most of a many-ball spring search's time).
     let mut history: Vec<f64> = Vec::with_capacity(60);
     for _ in 0..60 {
+        // One start of a 64-ball spring search runs up to 60 SVDs of 66 x 66 (a few
+        // tenths of a second on a loaded machine): Ctrl-C is answered between them.
+        if crate::cancel::cancelled() {
+            return None;
+        }
         prob.residual(&q, p, &mut r).ok()?;
         let rn = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         if !rn.is_finite() {
