@@ -261,18 +261,14 @@ fn scan_chunk<D: Family>(
     let t = std::time::Instant::now();
     // A gap seed at rest counts as one run for every type it was asked for, a gap
     // whirl start as one of its own type.
+    let missing_at = |p: usize| &gaps[gaps.binary_search_by_key(&p, |g| g.0).unwrap()].1;
     let whirls: Vec<(usize, usize, usize)> = whirls
         .into_iter()
         .filter(|w| w.1 < np)
-        .chain(
-            gaps.iter()
-                .flat_map(|(p, ks)| ks.iter().map(move |&k| (*p, k, 0))),
-        )
-        .chain(
-            gap_starts
-                .iter()
-                .filter_map(|&(p, w)| w.map(|(k, j)| (p, k, j))),
-        )
+        .chain(gap_starts.iter().flat_map(|&(p, w)| match w {
+            None => missing_at(p).iter().map(|&k| (p, k, 0)).collect::<Vec<_>>(),
+            Some((k, j)) => vec![(p, k, j)],
+        }))
         .collect();
     let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &whirls, &pb);
     profile::serial(profile::ROWS, t.elapsed());
