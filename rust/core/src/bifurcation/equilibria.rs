@@ -27,7 +27,7 @@
 
 use crate::analysis::equilibria::{analyse_model, wrap, Equilibrium, EquilibriumKind};
 use crate::bifurcation::event::{check_stop_events, Event};
-use crate::continuation::arclength::{point_at, ArcOptions, ArcPoint, ArcStop};
+use crate::continuation::arclength::{bordered, point_at, ArcOptions, ArcPoint, ArcStop};
 use crate::continuation::curves::{
     both_halves, curve_half, join_halves, CurveHook, Extended, TwoParameter,
 };
@@ -257,22 +257,8 @@ impl<'a, D: Dynamics + Clone> EqSystem<'a, D> {
 
     /// The bordered determinant `det [[F_x, F_p], [t^T]]` (one parameter).
     fn bordered_det(&mut self, x: &[f64], p: f64, t: &[f64]) -> Result<f64> {
-        let n = self.n();
-        let (mut r, mut j) = (vec![0.0; n], vec![0.0; n * n]);
-        self.eval_jac(x, &[p], &mut r, &mut j)?;
-        let mut fp = vec![0.0; n];
-        Problem::jac_p(self, x, p, &mut fp)?;
-        let m = DMatrix::from_fn(n + 1, n + 1, |i, k| {
-            if i < n {
-                if k < n {
-                    j[i * n + k]
-                } else {
-                    fp[i]
-                }
-            } else {
-                t[k]
-            }
-        });
+        let y: Vec<f64> = x.iter().copied().chain([p]).collect();
+        let (m, _) = bordered(self, &y, t)?;
         Ok(m.lu().determinant())
     }
 }

@@ -31,6 +31,7 @@
 //! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
 
 use crate::bifurcation::event::{check_stop_events, Event};
+use crate::continuation::arclength::bordered;
 use crate::continuation::curves::join_halves;
 use crate::continuation::{
     self, ArcOptions, ArcPoint, ArcStop, Controls, Declared, Level, Spectrum, Start,
@@ -40,7 +41,6 @@ use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
 use crate::numerics::problem::{ModelAt, Parametric, Problem};
 use crate::periodic::{finish_on_branch, multipliers_on_branch, Periodic, PeriodicOptions};
-use nalgebra::DMatrix;
 
 /// Settings of [`periodic_branch`].
 #[derive(Debug, Clone)]
@@ -290,20 +290,9 @@ impl<D: Parametric> Ctx<'_, D> {
 /// value stays in range).
 fn bordered_det<P: Problem + ?Sized>(prob: &mut P, pt: &ArcPoint, w: &[f64]) -> Result<f64> {
     let n = prob.size();
-    let (mut r, mut jac, mut fp) = (vec![0.0; n], vec![0.0; n * n], vec![0.0; n]);
-    prob.jac_x(&pt.x, pt.p, &mut r, &mut jac)?;
-    prob.jac_p(&pt.x, pt.p, &mut fp)?;
-    let mut m = DMatrix::from_fn(n + 1, n + 1, |i, j| {
-        if i < n {
-            if j < n {
-                jac[i * n + j]
-            } else {
-                fp[i]
-            }
-        } else {
-            w[j] * pt.tangent[j]
-        }
-    });
+    let y: Vec<f64> = pt.x.iter().copied().chain([pt.p]).collect();
+    let row: Vec<f64> = w.iter().zip(&pt.tangent).map(|(w, t)| w * t).collect();
+    let (mut m, _) = bordered(prob, &y, &row)?;
     for i in 0..=n {
         let s = (0..=n).fold(0.0f64, |a, j| a.max(m[(i, j)].abs()));
         if s > 0.0 {

@@ -190,8 +190,9 @@ fn max_abs(v: &[f64]) -> f64 {
     )
 }
 
-/// The bordered matrix `[[F_x, F_p], [row^T]]` and `F` at `y = (x, p)`.
-fn bordered<P: Problem + ?Sized>(
+/// The bordered matrix `[[F_x, F_p], [row^T]]` and `F` at `y = (x, p)`; branch-point
+/// tests take its determinant.
+pub(crate) fn bordered<P: Problem + ?Sized>(
     problem: &mut P,
     y: &[f64],
     row: &[f64],
