@@ -241,7 +241,7 @@ fn scan_chunk<D: Family>(
     let gaps = seeding::gap_tasks(spec, &geo, np, &sols, &pb, &lattice);
     let gap_starts = seeding::gap_starts(spec, &params, &geo, &gaps, &seeded);
     let mut frontier = vec![];
-    for (p, f) in seeding::run_gap_seeds(spec, &params, &gaps, &gap_starts, starts[0], cancel) {
+    for (p, f) in seeding::run_gap_seeds(spec, &params, &gap_starts, starts[0], cancel) {
         if waves::admit(&sols[p], f.pattern, &f.key) {
             sols[p].push(f);
             frontier.push((p, sols[p].len() - 1));
@@ -261,13 +261,13 @@ fn scan_chunk<D: Family>(
     let t = std::time::Instant::now();
     // A gap seed at rest counts as one run for every type it was asked for, a gap
     // whirl start as one of its own type.
-    let missing_at = |p: usize| &gaps[gaps.binary_search_by_key(&p, |g| g.0).unwrap()].1;
     let whirls: Vec<(usize, usize, usize)> = whirls
         .into_iter()
         .filter(|w| w.1 < np)
-        .chain(gap_starts.iter().flat_map(|&(p, w)| match w {
-            None => missing_at(p).iter().map(|&k| (p, k, 0)).collect::<Vec<_>>(),
-            Some((k, j)) => vec![(p, k, j)],
+        .chain(gap_starts.iter().flat_map(|g| {
+            g.types
+                .iter()
+                .map(move |&k| (g.point, k, g.whirl.unwrap_or(0)))
         }))
         .collect();
     let rows = rows::rows(&geo, np, &sols, &tally, &tasks, &whirls, &pb);

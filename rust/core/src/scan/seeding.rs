@@ -401,11 +401,19 @@ pub(super) fn gap_tasks<D: Family>(
         .collect()
 }
 
-/// The simulated starts of the gap seeds ([`gap_tasks`]), as (point, start): the start
-/// at rest (`None`) for all the point's missing types, except at the stability
-/// boundary's points, which started from rest already; and at the points of even index
-/// along every axis (every point on a 1-D grid) the first whirl start of each missing
-/// type that has them (`Some((type, 0))`, [`whirl_starts_of`]), for that type alone.
+/// One simulated start of the gap seeds: at `point`, accepted only as one of `types`;
+/// from rest (`whirl` None) or from that whirl start of its one type.
+pub(super) struct GapStart {
+    pub point: usize,
+    pub types: Vec<usize>,
+    pub whirl: Option<usize>,
+}
+
+/// The simulated starts of the gap seeds ([`gap_tasks`]): the start at rest for all the
+/// point's missing types, except at the stability boundary's points, which started from
+/// rest already; and at the points of even index along every axis (every point on a
+/// 1-D grid) the first whirl start of each missing type that has them
+/// ([`whirl_starts_of`]), for that type alone.
 /// Without the whirl starts a stable R-O band away from the seed lattice was found only
 /// where continuation from a lattice point's whirl start reached it: a scan in blocks
 /// of 3 eta values listed 13 fewer stable R-O rows than the same grid in one block (mu
@@ -418,7 +426,7 @@ pub(super) fn gap_starts<D: Family>(
     geo: &Local,
     gaps: &[(usize, Vec<usize>)],
     seeded: &[usize],
-) -> Vec<(usize, Option<(usize, usize)>)> {
+) -> Vec<GapStart> {
     let stride = if spec.names.len() == 1 { 1 } else { 2 };
     gaps.iter()
         .flat_map(|(p, missing)| {
@@ -428,8 +436,16 @@ pub(super) fn gap_starts<D: Family>(
                 .filter(move |&&k| {
                     whirling && !whirl_starts_of(&params[*p], &spec.patterns[k]).is_empty()
                 })
-                .map(move |&k| (*p, Some((k, 0))));
-            let at_rest = seeded.binary_search(p).is_err().then_some((*p, None));
+                .map(move |&k| GapStart {
+                    point: *p,
+                    types: vec![k],
+                    whirl: Some(0),
+                });
+            let at_rest = seeded.binary_search(p).is_err().then(|| GapStart {
+                point: *p,
+                types: missing.clone(),
+                whirl: None,
+            });
             at_rest.into_iter().chain(whirls)
         })
         .collect()
@@ -442,20 +458,16 @@ pub(super) fn gap_starts<D: Family>(
 pub(super) fn run_gap_seeds<D: Family>(
     spec: &ScanSpec<'_, D>,
     params: &[D],
-    gaps: &[(usize, Vec<usize>)],
-    starts: &[(usize, Option<(usize, usize)>)],
+    starts: &[GapStart],
     start: usize,
     cancel: &AtomicBool,
 ) -> Vec<(usize, Found)> {
     let t = Instant::now();
-    let missing_at = |p: usize| -> &[usize] {
-        let i = gaps.binary_search_by_key(&p, |g| g.0).unwrap();
-        &gaps[i].1
-    };
     let (found, times): (Vec<Option<(usize, Found)>>, Vec<profile::Task>) = starts
         .par_iter()
         .with_max_len(1)
-        .map(|&(p, whirl)| {
+        .map(|g| {
+            let p = g.point;
             profile::timed(|| {
                 if cancel.load(Ordering::Relaxed) {
                     return None;
@@ -463,7 +475,7 @@ pub(super) fn run_gap_seeds<D: Family>(
                 let t = Instant::now();
                 let model = &params[p];
                 let captures = captures_at(model);
-                let (y0, only) = match whirl {
+                let y0 = match g.whirl {
                     None => {
                         // Identical balls started together stay together for ever
                         // (merged balls are an invariant set): such a start settles on
@@ -477,14 +489,12 @@ pub(super) fn run_gap_seeds<D: Family>(
                         for (k, i) in balls.enumerate() {
                             y0[i] += 1e-3 * (k as f64 - mid);
                         }
-                        (y0, missing_at(p).to_vec())
+                        y0
                     }
-                    Some((k, j)) => (
-                        whirl_starts_of(model, &spec.patterns[k])[j].clone(),
-                        vec![k],
-                    ),
+                    Some(j) => whirl_starts_of(model, &spec.patterns[g.types[0]])[j].clone(),
                 };
-                let (k, sol, key) = simulated_candidate(spec, model, &y0, &captures, Some(&only))?;
+                let (k, sol, key) =
+                    simulated_candidate(spec, model, &y0, &captures, Some(&g.types))?;
                 count(work::FINISH);
                 let res = finish(model, sol, &spec.opts);
                 (res.sol.status == Status::Converged).then(|| {
