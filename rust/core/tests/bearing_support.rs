@@ -10,6 +10,7 @@ use ballbal_core::model::bearing::{
 };
 use ballbal_core::model::components::{JournalSupport, SupportFilm};
 use ballbal_core::model::Dynamics;
+use ballbal_core::model::Jacobians;
 use ballbal_core::ode::Options;
 use ballbal_core::periodic::{guess_from_state, require_autonomous, GuessOptions};
 use ballbal_core::simulate::simulate;
@@ -77,7 +78,7 @@ fn a_linear_film_is_the_spring_damper_support() {
     assert!(rel_err(&r1, &r2) < 1e-13, "{r1:?} {r2:?}");
     let jac = |m: &dyn Dynamics| {
         let (mut k, mut c, mut mm) = (vec![0.0; 16], vec![0.0; 16], vec![0.0; 16]);
-        m.jacobians(0.7, &Q, &V, &A, &mut k, &mut c, &mut mm);
+        m.jacobians(0.7, &Q, &V, &A, Jacobians::new(&mut k, &mut c, &mut mm));
         [k, c, mm]
     };
     for (a, b) in jac(&want).iter().zip(&jac(&got)) {
@@ -129,7 +130,7 @@ fn a_linear_film_is_the_spring_damper_support() {
 fn check_jacobians(s: &Scene, t: f64, tol: f64) {
     let d = s.ndof();
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
-    s.jacobians(t, &Q, &V, &A, &mut k, &mut c, &mut m);
+    s.jacobians(t, &Q, &V, &A, Jacobians::new(&mut k, &mut c, &mut m));
     let h = 1e-6;
     for (which, jac) in [(0, &k), (1, &c)] {
         for j in 0..d {

@@ -102,9 +102,12 @@ fn columns<'py>(py: Python<'py>, rows: &[Outcome], n: usize) -> PyResult<Bound<'
 /// the thread count) and calls `on_chunk(c, columns)` with the GIL as each chunk
 /// finishes. Ctrl-C cancels the work and raises `KeyboardInterrupt`; chunks finished
 /// before are handed over.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, starts, options, threads, chunk, chunks, on_chunk))]
-#[allow(clippy::too_many_arguments)]
 pub fn basins(
     py: Python<'_>,
     model: ModelArgs,
@@ -176,9 +179,12 @@ type Series<'py> = (f64, Bound<'py, PyArray1<f64>>, Vec<bool>);
 /// basin class converges to. With `rotating` (which balls rotate) the period is
 /// measured over `turns` whole turns of the first rotating ball
 /// (`attractors::guess_with_turns`: an orbit of several turns per period).
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, y0, n_harm, settle, window, rtol, atol, rotating=None, turns=1))]
-#[allow(clippy::too_many_arguments)]
 pub fn attractor_series<'py>(
     py: Python<'py>,
     model: ModelArgs,

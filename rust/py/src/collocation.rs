@@ -127,8 +127,11 @@ fn orbit_mesh_ok(mesh: &[f64]) -> bool {
 /// `step`, halved on failure, until `target` or a step below `min_step` (an
 /// infinite-period end). Returns lists `param`, `period`, `mesh_error` (the final mesh's
 /// error indicator) per point, and `ntst`.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 pub fn collocation_follow<'py>(
     py: Python<'py>,
     model: ModelArgs,

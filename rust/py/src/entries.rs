@@ -47,9 +47,12 @@ type Simulated<'py> = (
 
 /// Integrates from `y0` and returns `(y, theta, accepted_steps, rejected_steps,
 /// rhs_evals)`, `y` of shape `(len(t_eval), 2 d)`, `theta` the disk's angle at `t_eval`.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, y0, t0, t_eval, rtol, atol, max_steps))]
-#[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -249,9 +252,12 @@ pub(crate) fn start(m: &Model, ball_winding: &[f64], w: f64, c: &[f64]) -> PyRes
 /// orbit here (`analysis::homotopy`), and whether to try them before the constructed
 /// starts (`analysis::constructed`) or after; the dict's `guess_source` says how it
 /// was found.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, pattern, options, guess=None, windings=None, homotopy=None, method="hb", collocation=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn periodic<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -379,9 +385,12 @@ pub fn orbit_closure(
 /// thread) for every finished chunk as soon as it is done; Ctrl-C cancels the remaining
 /// work, hands over the chunks that still finish, and then raises `KeyboardInterrupt`.
 /// A scene is scanned as a scene even with every effect off (an axis may switch one on).
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, names, values, patterns, options, chunk, threads, chunks, on_chunk))]
-#[allow(clippy::too_many_arguments)]
 pub fn scan(
     py: Python<'_>,
     model: ModelArgs,

@@ -147,7 +147,6 @@ fn run_branch<D: Parametric>(
     })
 }
 
-#[allow(clippy::too_many_arguments)]
 fn run_switch<D: Parametric>(
     d: &D,
     seed: Option<&DiskUnitsArgs>,
@@ -167,14 +166,13 @@ fn run_switch<D: Parametric>(
     })
 }
 
-#[allow(clippy::too_many_arguments)]
+/// `start`: the event's equilibrium and its value of the first parameter.
 fn run_curve<D: Parametric>(
     d: &D,
     seed: Option<&DiskUnitsArgs>,
     kind: CurveKind,
     names: (&str, &str),
-    q: &[f64],
-    p1: f64,
+    (q, p1): (&[f64], f64),
     together: bool,
     opts: &EqOptions,
 ) -> Result<EqCurve> {
@@ -264,9 +262,12 @@ fn curve_dict(py: Python<'_>, c: EqCurve) -> PyResult<Bound<'_, PyDict>> {
 /// A branch of equilibria from `q` (the model's equilibrium of kind `kind`) in
 /// `parameter` over `range`, with user points at the parameter values `at`, stopping at
 /// the first event named in `stop`: a dict of `points`, `events` and `stop`.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, parameter, q, kind, range, options, both=false, disk_units=None, at=None, stop=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn equilibrium_branch<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -292,9 +293,12 @@ pub fn equilibrium_branch<'py>(
 }
 
 /// The other branch through a branch point `(x, p)` reached along `tangent`.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, parameter, x, p, tangent, range, options, disk_units=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn equilibrium_switch<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -319,9 +323,12 @@ pub fn equilibrium_switch<'py>(
 /// `"branch_point"`: the pitchfork curve; or an alias `Event::parse` reads) through the event
 /// `(q, p1)` in `(parameter, parameter2)`, `range` bounding `parameter2`; `together`:
 /// on the balls-together subspace.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options, disk_units=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn equilibrium_curve<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -353,7 +360,7 @@ pub fn equilibrium_curve<'py>(
     let opts = options_checked(&m, &options, range)?;
     let c = guarded(
         py,
-        || dispatch!(&m, d => run_curve(d, disk_units.as_ref(), k, (&parameter, &parameter2), &q, p1, together, &opts)),
+        || dispatch!(&m, d => run_curve(d, disk_units.as_ref(), k, (&parameter, &parameter2), (&q, p1), together, &opts)),
     )?;
     curve_dict(py, c)
 }

@@ -10,9 +10,12 @@ use pyo3::types::PyDict;
 
 /// Columns of the groove study (one entry per point, `angle` slowest), see
 /// `ballbal._groove_study.groove_study`.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (bearing, angle, depth_ratio, width_ratio, length_ratio, count, eccentricity, threads=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn groove_study<'py>(
     py: Python<'py>,
     bearing: BearingArgs,

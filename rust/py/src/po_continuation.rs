@@ -50,9 +50,12 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
 /// with user points at the parameter values `at`, stopping at the first event named in
 /// `stop` or where the period reaches `stop_period`; returns `{"points": [dict],
 /// "events": [dict], "stop": str}`.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false, at=None, stop=None, stop_period=None))]
-#[allow(clippy::too_many_arguments)]
 pub fn periodic_branch<'py>(
     py: Python<'py>,
     model: ModelArgs,

@@ -24,9 +24,12 @@ use pyo3::types::PyDict;
 /// `neimark_sacker` curve's points carry `"theta"`, the critical pair's angle; each special point its
 /// multiplier certificate (`"status"`, `"gap"`, `"residual"`, `"own_residual"`,
 /// `"error"`).
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, kind, parameter, parameter2, start, range, range1, continuation, options, locate_tol))]
-#[allow(clippy::too_many_arguments)]
 pub fn periodic_curve<'py>(
     py: Python<'py>,
     model: ModelArgs,

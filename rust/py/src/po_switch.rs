@@ -24,9 +24,12 @@ fn out<'py>(py: Python<'py>, s: Switched, n_balls: usize) -> PyResult<Out<'py>> 
 /// The first solution of the branch leaving the periodic solution `(omega, coeffs,
 /// winding)` at a period doubling (`kind = "period_doubling"`) or branch point
 /// (`"branch_point"`; the core's `Event::parse` reads AUTO's `PD`, `BP` too).
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (model, parameter, omega, coeffs, winding, kind, amplitude, options))]
-#[allow(clippy::too_many_arguments)]
 pub fn switch_periodic<'py>(
     py: Python<'py>,
     model: ModelArgs,

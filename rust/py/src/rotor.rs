@@ -71,9 +71,12 @@ pub fn rotor_equilibrium(py: Python<'_>, rotor: RotorArgs) -> PyResult<(f64, f64
 }
 
 /// `(mass_parameter, gravity, unbalance)` from lab quantities (SI), the core's conversion.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (bearing, radius, length, clearance, viscosity, mass, speed, unbalance, g))]
-#[allow(clippy::too_many_arguments)]
 pub fn rotor_from_dimensions(
     bearing: BearingArgs,
     radius: f64,
@@ -94,9 +97,12 @@ pub fn rotor_from_dimensions(
 /// Simulates from `x0 = (x, y, x', y')` at `t0` with rows at `t_eval`; returns a dict of
 /// arrays (`tau`, `state` (rows x 4), `force` (rows x 4: fx, fy, radial, tangential)) and
 /// the run's outcome, end time, contact time, step counts and message.
+#[allow(
+    clippy::too_many_arguments,
+    reason = "a #[pyfunction]'s arguments are the Python call's keywords"
+)]
 #[pyfunction]
 #[pyo3(signature = (rotor, x0, t0, t_eval, rtol, atol, max_steps, eps_contact, stiff_steps, method, factor_reuse))]
-#[allow(clippy::too_many_arguments)]
 pub fn simulate_rotor<'py>(
     py: Python<'py>,
     rotor: RotorArgs,

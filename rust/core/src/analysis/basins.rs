@@ -449,7 +449,7 @@ impl EarlyStop {
         let n = d - o;
         let k0 = self.probe.t.partition_point(|&s| s < t - self.check);
         let win = self.probe.from(k0);
-        let cand = label_window(win, PROBE_DT, y, t, n, d, o, opts);
+        let cand = label_window(win, PROBE_DT, y, t, d, o, opts);
         let runs = if self.prev_label == Some(cand.label) {
             self.runs + 1
         } else {
@@ -484,7 +484,7 @@ impl EarlyStop {
         if !clear && n == 2 && t >= opts.window && cand.pattern == "R-R" {
             let k1 = self.probe.t.partition_point(|&s| s < t - opts.window);
             let long = self.probe.from(k1);
-            let whole = label_window(long, PROBE_DT, y, t, n, d, o, opts);
+            let whole = label_window(long, PROBE_DT, y, t, d, o, opts);
             self.torus_runs = if whole.label == Label::SeparatedRR {
                 self.torus_runs + 1
             } else {
@@ -792,7 +792,6 @@ fn judge<D: Dynamics + ?Sized>(
         DT,
         &y_end,
         t_stop,
-        n,
         d,
         o,
         opts,
@@ -820,18 +819,18 @@ fn rest_outcome(y: &[f64], t_stop: f64, n: usize, opts: &BasinOptions) -> Outcom
     }
 }
 
-#[allow(clippy::too_many_arguments)]
 /// The label of the motion sampled in `samples` (at least 4 of them), ending in `y_end`.
 fn label_window(
     samples: Window<'_>,
     dt: f64,
     y_end: &[f64],
     t_stop: f64,
-    n: usize,
     d: usize,
     o: usize,
     opts: &BasinOptions,
 ) -> Outcome {
+    // the balls' angles are the state's last coordinates, from `o` on
+    let n = d - o;
     let rest = |y: &[f64]| rest_outcome(y, t_stop, n, opts);
     let y_end = y_end.to_vec();
     let m = samples.len();

@@ -9,6 +9,7 @@
 //! Any other ball set is solved numerically from many starts.
 
 use crate::linalg::{eigenvalues, state_matrix};
+use crate::model::Jacobians;
 use crate::model::{Dynamics, Planar};
 use crate::numerics::problem::{At, ModelAt, Problem};
 use nalgebra::{DMatrix, DVector};
@@ -164,8 +165,8 @@ impl<D: Dynamics + ?Sized> Problem for EquilibriumProblem<'_, D> {
     fn jacobian(&mut self, x: &[f64], p: f64, jac: &mut [f64]) -> crate::Result<()> {
         let (z, c, m) = (&self.z, &mut self.c, &mut self.m);
         match self.models.at(p)? {
-            At::Base(model) => model.jacobians(0.0, x, z, z, jac, c, m),
-            At::Varied(model) => model.jacobians(0.0, x, z, z, jac, c, m),
+            At::Base(model) => model.jacobians(0.0, x, z, z, Jacobians::new(jac, c, m)),
+            At::Varied(model) => model.jacobians(0.0, x, z, z, Jacobians::new(jac, c, m)),
         }
         Ok(())
     }
@@ -261,7 +262,7 @@ fn spectrum<D: Dynamics + ?Sized>(
     let d = p.ndof();
     let z = vec![0.0; d];
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
-    p.jacobians(0.0, q, &z, &z, &mut k, &mut c, &mut m);
+    p.jacobians(0.0, q, &z, &z, Jacobians::new(&mut k, &mut c, &mut m));
     let mut a = vec![0.0; 4 * d * d];
     let mut col = vec![0.0; 2 * d * d];
     state_matrix(p, 0.0, q, &k, &c, &mut col, &mut a);
@@ -1356,7 +1357,7 @@ mod tests {
         let d = 5;
         let z = vec![0.0; d];
         let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
-        p.jacobians(0.0, &q, &z, &z, &mut k, &mut c, &mut m);
+        p.jacobians(0.0, &q, &z, &z, Jacobians::new(&mut k, &mut c, &mut m));
         let mut a = vec![0.0; 4 * d * d];
         let mut col = vec![0.0; 2 * d * d];
         state_matrix(&p, 0.0, &q, &k, &c, &mut col, &mut a);

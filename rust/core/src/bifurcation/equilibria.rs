@@ -35,6 +35,7 @@ use crate::continuation::{self, Controls, Declared, Spectrum, Start};
 use crate::error::{Error, Result};
 use crate::linalg::{eigenvalues, state_matrix};
 use crate::model::disk_units::DiskUnits;
+use crate::model::Jacobians;
 use crate::model::{Dynamics, Planar};
 use crate::numerics::problem::{Parametric, Problem};
 use nalgebra::DMatrix;
@@ -171,7 +172,7 @@ impl<'a, D: Dynamics + Clone> EqSystem<'a, D> {
         let z = vec![0.0; d];
         let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
         self.model(ps)?
-            .jacobians(0.0, q, &z, &z, &mut k, &mut c, &mut m);
+            .jacobians(0.0, q, &z, &z, Jacobians::new(&mut k, &mut c, &mut m));
         Ok((k, c, m))
     }
 

@@ -26,6 +26,7 @@ use crate::error::{Error, Result};
 use crate::floquet::{merged_pair, monodromy, FloquetOptions};
 use crate::hb::{default_samples, fit_coefficients, HbProblem, HbSolution, Status};
 use crate::linalg::{eigenvalues, lu_solve};
+use crate::model::Jacobians;
 use crate::model::{first_order_rhs, Dynamics};
 use crate::numerics::problem::{ModelAt, Parametric};
 use crate::ode::{solve_at, Options};
@@ -133,7 +134,7 @@ fn variational_series<D: Dynamics + ?Sized>(
     let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| {
         sol.eval_rates(om * t, &mut q, &mut v, &mut a);
-        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        model.jacobians(t, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
         // xi'' = -M^-1 (K xi + C xi')
         let mut f: Vec<f64> = (0..d)
             .map(|i| {

@@ -5,6 +5,7 @@
 use super::component::{Component, Composed, Ctx, Drive};
 use super::components::{BallSprings, FusedPlanar, Gravity, Impulse};
 use super::{Dynamics, Layout};
+use crate::model::Jacobians;
 
 /// The planar disk, isotropic support and free balls ([`FusedPlanar`]) with the effects
 /// a scene switches on, each an `Option` set at assembly: the same components as a
@@ -78,23 +79,16 @@ impl Dynamics for PlanarAssembly {
     }
 
     #[inline]
-    fn jacobians(
-        &self,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn jacobians(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         let cx = self.ctx(t);
-        self.core.set_jacobians(&cx, q, v, a, k, c, m);
+        self.core
+            .set_jacobians(&cx, q, v, a, Jacobians::new(k, c, m));
         if let Some(s) = &self.springs {
-            s.add_jacobians(&cx, q, v, a, k, c, m);
+            s.add_jacobians(&cx, q, v, a, Jacobians::new(k, c, m));
         }
         if let Some(g) = &self.gravity {
-            g.add_jacobians(&cx, q, v, a, k, c, m);
+            g.add_jacobians(&cx, q, v, a, Jacobians::new(k, c, m));
         }
     }
 
@@ -164,17 +158,9 @@ impl Dynamics for Assembly {
         dispatch!(self, m => m.residual(t, q, v, a, out))
     }
     #[inline]
-    fn jacobians(
-        &self,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        mm: &mut [f64],
-    ) {
-        dispatch!(self, m => m.jacobians(t, q, v, a, k, c, mm))
+    fn jacobians(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m: mm } = jac;
+        dispatch!(self, m => m.jacobians(t, q, v, a, Jacobians::new(k, c, mm)))
     }
     #[inline]
     fn solve_mass(&self, t: f64, q: &[f64], rhs: &mut [f64]) {

@@ -11,6 +11,7 @@
 //! solver sees.
 
 use super::{Dynamics, Layout, ParamId, Planar};
+use crate::model::Jacobians;
 use nalgebra::DMatrix;
 use std::fmt::Debug;
 use std::sync::Arc;
@@ -81,17 +82,8 @@ pub trait Component: Send + Sync + Debug {
     }
     /// Adds its terms of `K, C, M` (row-major `d x d`). Default: central differences of
     /// [`Self::add_residual`].
-    #[allow(clippy::too_many_arguments)]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         fd_add_jacobians(
             |q, v, a, out| self.add_residual(cx, q, v, a, out),
             q,
@@ -103,22 +95,13 @@ pub trait Component: Send + Sync + Debug {
         );
     }
     /// Writes its terms of `K, C, M` (see [`Self::set_residual`]).
-    #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn set_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn set_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         k.fill(0.0);
         c.fill(0.0);
         m.fill(0.0);
-        self.add_jacobians(cx, q, v, a, k, c, m);
+        self.add_jacobians(cx, q, v, a, Jacobians::new(k, c, m));
     }
     /// Adds its terms of `M` alone (it must depend on `q` only). Default: from
     /// [`Self::add_jacobians`] at `v = a = 0`.
@@ -129,7 +112,7 @@ pub trait Component: Send + Sync + Debug {
         let d = q.len();
         let z = vec![0.0; d];
         let (mut k, mut c) = (vec![0.0; d * d], vec![0.0; d * d]);
-        self.add_jacobians(cx, q, &z, &z, &mut k, &mut c, m);
+        self.add_jacobians(cx, q, &z, &z, Jacobians::new(&mut k, &mut c, m));
     }
 }
 
@@ -142,7 +125,6 @@ fn fd_step(x: f64) -> f64 {
 
 /// Adds the central-difference Jacobians of `f` (which adds a residual into its last
 /// argument) with respect to `q`, `v` and `a` to `k`, `c`, `m`: `6 d` evaluations.
-#[allow(clippy::too_many_arguments)]
 pub fn fd_add_jacobians<F>(
     mut f: F,
     q: &[f64],
@@ -254,17 +236,7 @@ impl Component for Drive {
     }
     /// The drive has no terms of its own: the spin it sets enters the others' terms.
     fn add_residual(&self, _: &Ctx, _: &[f64], _: &[f64], _: &[f64], _: &mut [f64]) {}
-    fn add_jacobians(
-        &self,
-        _: &Ctx,
-        _: &[f64],
-        _: &[f64],
-        _: &[f64],
-        _: &mut [f64],
-        _: &mut [f64],
-        _: &mut [f64],
-    ) {
-    }
+    fn add_jacobians(&self, _: &Ctx, _: &[f64], _: &[f64], _: &[f64], _: Jacobians<'_>) {}
 }
 
 /// Largest `d` whose mass matrix is factored on the stack.
@@ -408,25 +380,17 @@ impl Dynamics for Composed {
         }
     }
 
-    fn jacobians(
-        &self,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn jacobians(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         let cx = self.ctx(t);
         let Some((first, rest)) = self.parts.split_first() else {
             k.fill(0.0);
             c.fill(0.0);
             return m.fill(0.0);
         };
-        first.set_jacobians(&cx, q, v, a, k, c, m);
+        first.set_jacobians(&cx, q, v, a, Jacobians::new(k, c, m));
         for p in rest {
-            p.add_jacobians(&cx, q, v, a, k, c, m);
+            p.add_jacobians(&cx, q, v, a, Jacobians::new(k, c, m));
         }
     }
 
@@ -514,7 +478,7 @@ mod tests {
         k.fill(7.0);
         c.fill(7.0);
         m.fill(7.0);
-        model.jacobians(t, q, v, a, &mut k, &mut c, &mut m);
+        model.jacobians(t, q, v, a, Jacobians::new(&mut k, &mut c, &mut m));
         [k, c, m]
     }
 
@@ -714,9 +678,7 @@ mod tests {
             &[0.5, -2.0],
             &[0.0; 2],
             &[0.0; 2],
-            &mut k,
-            &mut c,
-            &mut m,
+            Jacobians::new(&mut k, &mut c, &mut m),
         );
         let want_k = [3.0 * 0.25, 0.0, 0.0, 3.0 * 4.0];
         assert!(rel_err(&want_k, &k) < 1e-9, "{k:?}");

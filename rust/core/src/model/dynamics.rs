@@ -14,6 +14,22 @@
 use super::component::fd_add_jacobians;
 use super::Layout;
 
+/// Where a model writes (or adds) the three Jacobians of its residual `F(t, q, v, a)`,
+/// each row-major `d x d`: `k = dF/dq`, `c = dF/dv`, `m = dF/da`. One argument rather
+/// than three, so that the outputs travel together through components and assemblies.
+pub struct Jacobians<'a> {
+    pub k: &'a mut [f64],
+    pub c: &'a mut [f64],
+    pub m: &'a mut [f64],
+}
+
+impl<'a> Jacobians<'a> {
+    #[inline(always)]
+    pub fn new(k: &'a mut [f64], c: &'a mut [f64], m: &'a mut [f64]) -> Self {
+        Jacobians { k, c, m }
+    }
+}
+
 /// The dynamics interface shared by every analysis.
 pub trait Dynamics: Send + Sync {
     /// Number of generalised coordinates `d`.
@@ -23,17 +39,8 @@ pub trait Dynamics: Send + Sync {
     /// Row-major `d x d` Jacobians `K = dF/dq`, `C = dF/dv`, `M = dF/da` at `(t, q, v, a)`.
     /// Default: central differences of [`Self::residual`] (steps scaled to each
     /// variable), for a model without analytic derivatives; `6 d` residuals per call.
-    #[allow(clippy::too_many_arguments)]
-    fn jacobians(
-        &self,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn jacobians(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         k.fill(0.0);
         c.fill(0.0);
         m.fill(0.0);

@@ -21,7 +21,7 @@ pub mod tilt_terms;
 
 pub use component::{Component, Composed, Ctx, Drive, Spin};
 pub use disk_units::DiskUnits;
-pub use dynamics::{first_order_rhs, Dynamics};
+pub use dynamics::{first_order_rhs, Dynamics, Jacobians};
 pub use layout::Layout;
 pub use params::{ParamId, ParamRef};
 pub use planar::Planar;

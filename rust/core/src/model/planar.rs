@@ -4,6 +4,7 @@
 use super::params::{ball_name, key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
 use super::Dynamics;
 use crate::error::{Error, Result};
+use crate::model::Jacobians;
 
 /// Planar n-ball automatic balancer on an isotropic spring–damper support.
 #[derive(Debug, Clone, PartialEq)]
@@ -253,38 +254,19 @@ impl Planar {
     }
 
     /// [`Dynamics::jacobians`] at spin `om`.
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub fn jacobians_at(
-        &self,
-        om: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        self.jacobians_impl::<false>(om, q, v, a, k, c, m);
+    pub fn jacobians_at(&self, om: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
+        self.jacobians_impl::<false>(om, q, v, a, Jacobians::new(k, c, m));
     }
 
     /// Adds [`Self::jacobians_at`] to `k`, `c`, `m`.
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub fn add_jacobians_at(
-        &self,
-        om: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        self.jacobians_impl::<true>(om, q, v, a, k, c, m);
+    pub fn add_jacobians_at(&self, om: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
+        self.jacobians_impl::<true>(om, q, v, a, Jacobians::new(k, c, m));
     }
 
-    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn jacobians_impl<const ADD: bool>(
         &self,
@@ -292,10 +274,9 @@ impl Planar {
         q: &[f64],
         v: &[f64],
         a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
+        jac: Jacobians<'_>,
     ) {
+        let Jacobians { k, c, m } = jac;
         let d = self.ndof();
         if !ADD {
             k.fill(0.0);
@@ -437,17 +418,9 @@ impl Dynamics for Planar {
         });
     }
 
-    fn jacobians(
-        &self,
-        _t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        self.jacobians_at(self.omega_s, q, v, a, k, c, m);
+    fn jacobians(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
+        self.jacobians_at(self.omega_s, q, v, a, Jacobians::new(k, c, m));
     }
 
     fn base_spin(&self) -> f64 {
@@ -514,7 +487,13 @@ mod tests {
         let p = sample();
         let q = [0.3, -0.2, 0.7, -1.9];
         let (mut k, mut c, mut m) = (vec![0.0; 16], vec![0.0; 16], vec![0.0; 16]);
-        p.jacobians(0.0, &q, &[0.0; 4], &[0.0; 4], &mut k, &mut c, &mut m);
+        p.jacobians(
+            0.0,
+            &q,
+            &[0.0; 4],
+            &[0.0; 4],
+            Jacobians::new(&mut k, &mut c, &mut m),
+        );
         let z = [0.4, -1.0, 2.0, 0.25];
         let mut r = [0.0; 4];
         for i in 0..4 {
@@ -539,7 +518,7 @@ mod tests {
         let a = [0.5, -0.3, 0.2, 0.9];
         let d = 4;
         let (mut k, mut c, mut m) = (vec![0.0; 16], vec![0.0; 16], vec![0.0; 16]);
-        p.jacobians(0.0, &q, &v, &a, &mut k, &mut c, &mut m);
+        p.jacobians(0.0, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
         let h = 1e-6;
         for (which, jac) in [(0, &k), (1, &c), (2, &m)] {
             for col in 0..d {

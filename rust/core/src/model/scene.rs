@@ -57,6 +57,7 @@ use crate::model::components::{
 };
 use crate::model::params::{key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
 use crate::model::tilt_terms::RotorConsts;
+use crate::model::Jacobians;
 use crate::model::{Dynamics, Layout, Planar};
 use std::sync::Arc;
 
@@ -657,17 +658,9 @@ impl Dynamics for Scene {
     }
 
     #[inline]
-    fn jacobians(
-        &self,
-        t: f64,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        self.model.jacobians(t, q, v, a, k, c, m)
+    fn jacobians(&self, t: f64, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
+        self.model.jacobians(t, q, v, a, Jacobians::new(k, c, m))
     }
 
     #[inline]
@@ -772,7 +765,7 @@ mod tests {
         let t = 0.8;
         let d = s.ndof();
         let (mut k, mut c, mut m) = (vec![0.0; d * d], vec![0.0; d * d], vec![0.0; d * d]);
-        s.jacobians(t, q, v, a, &mut k, &mut c, &mut m);
+        s.jacobians(t, q, v, a, Jacobians::new(&mut k, &mut c, &mut m));
         let h = 1e-5;
         for (which, jac) in [(0, &k), (1, &c), (2, &m)] {
             for j in 0..d {
@@ -954,7 +947,7 @@ mod tests {
         let q = [0.3, -0.2, 0.8, -0.6, 0.7, -1.9, 2.4];
         let v = [0.1, 0.4, -0.3, 0.5, -1.2, 0.3, 0.2];
         let (mut k, mut c, mut m) = (vec![0.0; 49], vec![0.0; 49], vec![0.0; 49]);
-        s.jacobians(0.8, &q, &v, &v, &mut k, &mut c, &mut m);
+        s.jacobians(0.8, &q, &v, &v, Jacobians::new(&mut k, &mut c, &mut m));
         let Assembly::Composed(model) = &s.model else {
             panic!("a tilting scene is a composed model")
         };

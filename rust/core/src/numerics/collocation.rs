@@ -37,6 +37,7 @@ use crate::error::{Error, Result};
 use crate::hb::HbSolution;
 use crate::linalg::{eigenvalues, lu_solve, state_matrix};
 use crate::model::Dynamics;
+use crate::model::Jacobians;
 use crate::numerics::floquet::judge;
 use crate::numerics::ode::{Dopri5, Options};
 use crate::numerics::problem::{At, ModelAt, Parametric, Problem};
@@ -500,7 +501,13 @@ impl Rhs {
         f[..d].copy_from_slice(v);
         f[d..].copy_from_slice(&self.a);
         if let Some(jac) = jac {
-            model.jacobians(0.0, q, v, &self.a, &mut self.k, &mut self.c, &mut self.m);
+            model.jacobians(
+                0.0,
+                q,
+                v,
+                &self.a,
+                Jacobians::new(&mut self.k, &mut self.c, &mut self.m),
+            );
             state_matrix(model, 0.0, q, &self.k, &self.c, &mut self.cols, jac);
         }
     }

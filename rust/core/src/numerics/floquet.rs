@@ -10,6 +10,7 @@ use crate::error::Result;
 use crate::hb::HbSolution;
 use crate::linalg::eigenvalues;
 use crate::model::Dynamics;
+use crate::model::Jacobians;
 use crate::ode::{Dopri5, Options};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -227,7 +228,7 @@ pub fn monodromy<D: Dynamics + ?Sized>(
     let mut cols = vec![0.0; 2 * d * d];
     let rhs = |t: f64, y: &[f64], dy: &mut [f64]| {
         sol.eval_rates(om * t, &mut q, &mut v, &mut a);
-        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        model.jacobians(t, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
         // Bottom half of A = [-M^-1 K, -M^-1 C], as 2d columns of length d.
         for j in 0..d {
             for i in 0..d {
@@ -272,7 +273,7 @@ fn orbit_state_matrix<'a, D: Dynamics + ?Sized>(
     let mut cols = vec![0.0; 2 * d * d];
     move |t: f64, out: &mut [f64]| {
         sol.eval_rates(om * t, &mut q, &mut v, &mut a);
-        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        model.jacobians(t, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
         crate::linalg::state_matrix(model, t, &q, &k, &c, &mut cols, out);
     }
 }
@@ -534,7 +535,7 @@ pub fn separation_error<D: Dynamics + ?Sized>(
         let tau = 2.0 * std::f64::consts::PI * p as f64 / s as f64;
         sol.eval_rates(tau, &mut q, &mut v, &mut a);
         let t = tau / om;
-        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        model.jacobians(t, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
         // C e, then M^-1 (C e), then its component along e.
         let mut ce: Vec<f64> = (0..d)
             .map(|row| r * (c[row * d + i] - c[row * d + j]))
@@ -591,7 +592,7 @@ pub fn hill_multipliers_dense<D: Dynamics + ?Sized>(
         let tau = 2.0 * std::f64::consts::PI * j as f64 / s as f64;
         sol.eval_rates(tau, &mut q, &mut v, &mut a);
         let t = tau / om;
-        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        model.jacobians(t, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
         crate::linalg::state_matrix(model, t, &q, &k, &c, &mut cols, &mut amat);
         for (ki, kk) in (-2 * h..=2 * h).enumerate() {
             let (sn, cs) = (-(kk as f64) * tau).sin_cos();
@@ -912,7 +913,7 @@ fn state_matrix_harmonics<D: Dynamics + ?Sized>(
         let tau = 2.0 * std::f64::consts::PI * j as f64 / samples as f64;
         sol.eval_rates(tau, &mut q, &mut v, &mut a);
         let t = tau / om;
-        model.jacobians(t, &q, &v, &a, &mut k, &mut c, &mut m);
+        model.jacobians(t, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
         crate::linalg::state_matrix(model, t, &q, &k, &c, &mut cols, &mut amat);
         for (kk, block) in coef.chunks_exact_mut(nn).enumerate() {
             let (sn, cs) = turn[(kk * j) % samples];

@@ -12,6 +12,7 @@
 use crate::continuation::Secant;
 use crate::linalg::LuWork;
 use crate::model::Dynamics;
+use crate::model::Jacobians;
 use crate::numerics::problem::{At, ModelAt, Problem};
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -780,7 +781,7 @@ impl<'a, D: Dynamics + ?Sized> HbSystem<'a, D> {
                 let q = &self.q[i * d..(i + 1) * d];
                 let (kk, rest) = self.kcm[i * 3 * dd..(i + 1) * 3 * dd].split_at_mut(dd);
                 let (cc, mm) = rest.split_at_mut(dd);
-                model.jacobians(t, q, &v, &a, kk, cc, mm);
+                model.jacobians(t, q, &v, &a, Jacobians::new(kk, cc, mm));
             }
         });
         timed(Stage::Projection, || {
@@ -1395,16 +1396,8 @@ mod tests {
         fn residual(&self, _t: f64, q: &[f64], v: &[f64], a: &[f64], out: &mut [f64]) {
             out[0] = a[0] - self.0 * (1.0 - q[0] * q[0]) * v[0] + q[0];
         }
-        fn jacobians(
-            &self,
-            _t: f64,
-            q: &[f64],
-            v: &[f64],
-            _a: &[f64],
-            k: &mut [f64],
-            c: &mut [f64],
-            m: &mut [f64],
-        ) {
+        fn jacobians(&self, _t: f64, q: &[f64], v: &[f64], _a: &[f64], jac: Jacobians<'_>) {
+            let Jacobians { k, c, m } = jac;
             k[0] = 2.0 * self.0 * q[0] * v[0] + 1.0;
             c[0] = -self.0 * (1.0 - q[0] * q[0]);
             m[0] = 1.0;
@@ -1642,7 +1635,7 @@ mod tests {
         for i in 0..s {
             let t = 2.0 * PI * i as f64 / s as f64;
             sol.eval_rates(t, &mut q, &mut v, &mut a);
-            model.jacobians(t / om, &q, &v, &a, &mut k, &mut c, &mut m);
+            model.jacobians(t / om, &q, &v, &a, Jacobians::new(&mut k, &mut c, &mut m));
             let (mut qt, mut qtt) = (vec![0.0; d], vec![0.0; d]);
             sol.eval(t, &mut q, &mut qt, &mut qtt);
             for r in 0..l {

@@ -6,6 +6,7 @@
 use super::PoCurveKind;
 use crate::error::{Error, Result};
 use crate::hb::{eval_series_sc, HbSolution, HbSystem, Status};
+use crate::model::Jacobians;
 use crate::numerics::problem::Parametric;
 use nalgebra::{Complex, DMatrix, DVector};
 use std::f64::consts::PI;
@@ -286,7 +287,13 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 v[j] = om * qt[j];
                 a[j] = om * om * qtt[j];
             }
-            m.jacobians(tau / om, &q, &v, &a, &mut kk, &mut cc, &mut mm);
+            m.jacobians(
+                tau / om,
+                &q,
+                &v,
+                &a,
+                Jacobians::new(&mut kk, &mut cc, &mut mm),
+            );
             for j in 0..d {
                 for k in 0..d {
                     let o = j * d + k;
@@ -667,9 +674,11 @@ impl<'a, D: Parametric> PoSystem<'a, D> {
                 &q,
                 &v,
                 &a,
-                &mut out.k[o..o + d * d],
-                &mut out.cc[o..o + d * d],
-                &mut out.mm[o..o + d * d],
+                Jacobians::new(
+                    &mut out.k[o..o + d * d],
+                    &mut out.cc[o..o + d * d],
+                    &mut out.mm[o..o + d * d],
+                ),
             );
             for r in o..o + d * d {
                 out.c[r] = om * out.cc[r];

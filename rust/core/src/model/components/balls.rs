@@ -1,5 +1,6 @@
 use crate::model::component::{Component, Ctx};
 use crate::model::tilt_terms::{ball_jacobians, ball_mass, ball_residual, RotorConsts};
+use crate::model::Jacobians;
 use crate::model::{Layout, ParamId};
 use std::f64::consts::PI;
 
@@ -47,16 +48,8 @@ impl Component for FreeBalls {
         out[y] += fy;
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         let l = cx.layout;
         let (x, y, d) = (l.x, l.y, cx.ndof());
         let (om, dom, dl) = (cx.spin.om, cx.spin.dom, self.delta);
@@ -159,16 +152,8 @@ impl Component for TiltingBalls {
         }
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         let l = &cx.layout;
         let spin = cx.spin.tuple();
         let (mut bk, mut bc, mut bm) = ([0.0; 25], [0.0; 25], [0.0; 25]);
@@ -271,16 +256,8 @@ impl Component for BallSprings {
         }
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        _q: &[f64],
-        _v: &[f64],
-        _a: &[f64],
-        k: &mut [f64],
-        _c: &mut [f64],
-        _m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, _q: &[f64], _v: &[f64], _a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c: _c, m: _m } = jac;
         let l = &cx.layout;
         let (n, o, d) = (l.n_balls, l.first_ball, l.ndof());
         let kd = self.kd;

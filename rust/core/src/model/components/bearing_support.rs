@@ -33,6 +33,7 @@
 use crate::error::{check_range, Error, Result};
 use crate::model::bearing::{Bearing, FilmModel, FilmSolver, GrooveSide, JournalState};
 use crate::model::component::{Component, Ctx};
+use crate::model::Jacobians;
 use crate::model::{Layout, ParamId};
 use std::fmt;
 use std::sync::{Arc, Mutex};
@@ -287,16 +288,8 @@ impl Component for BearingSupport {
         out[ix] += 2.0 * z * (v[ix] - om * q[iy]) - fx;
         out[iy] += 2.0 * z * (v[iy] + om * q[ix]) - fy;
     }
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        _a: &[f64],
-        k: &mut [f64],
-        cm: &mut [f64],
-        _m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], _a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c: cm, m: _m } = jac;
         let (ix, iy, d) = (cx.layout.x, cx.layout.y, cx.ndof());
         let (st, c, s, _) = self.state(cx, q, v);
         let om = cx.spin.om;

@@ -1,4 +1,5 @@
 use crate::model::component::{Component, Ctx};
+use crate::model::Jacobians;
 use crate::model::{Layout, ParamId, Planar};
 
 /// [`super::PlanarDisk`] + [`super::IsotropicSupport`] + [`super::FreeBalls`] in one
@@ -38,31 +39,17 @@ impl Component for FusedPlanar {
         self.inertia_and_ramp(cx, q, a, out);
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        self.planar.add_jacobians_at(cx.spin.om, q, v, a, k, c, m);
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
+        self.planar
+            .add_jacobians_at(cx.spin.om, q, v, a, Jacobians::new(k, c, m));
         self.ramp_jacobian(cx, q, k);
     }
     #[inline]
-    fn set_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        self.planar.jacobians_at(cx.spin.om, q, v, a, k, c, m);
+    fn set_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
+        self.planar
+            .jacobians_at(cx.spin.om, q, v, a, Jacobians::new(k, c, m));
         self.ramp_jacobian(cx, q, k);
     }
 }
@@ -148,18 +135,12 @@ impl Component for FusedTilting {
         self.balls.add_residual(cx, q, v, a, out);
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
-        self.disk.add_jacobians(cx, q, v, a, k, c, m);
-        self.balls.add_jacobians(cx, q, v, a, k, c, m);
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
+        self.disk
+            .add_jacobians(cx, q, v, a, Jacobians::new(k, c, m));
+        self.balls
+            .add_jacobians(cx, q, v, a, Jacobians::new(k, c, m));
     }
     /// The rotor's and the balls' generated mass terms in one body, so that the
     /// trigonometry of the tilts is computed once for all of them.

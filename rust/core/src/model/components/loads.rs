@@ -1,4 +1,5 @@
 use crate::model::component::{Component, Ctx};
+use crate::model::Jacobians;
 use crate::model::ParamId;
 
 /// Gravity across a horizontal spin axis on a planar disk (`g` over `e w_n^2`, along
@@ -32,16 +33,8 @@ impl Component for Gravity {
         }
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        _v: &[f64],
-        _a: &[f64],
-        k: &mut [f64],
-        _c: &mut [f64],
-        _m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], _v: &[f64], _a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c: _c, m: _m } = jac;
         let d = cx.ndof();
         for j in cx.layout.balls() {
             k[j * d + j] -= self.g * (cx.spin.th + q[j]).sin();
@@ -96,15 +89,5 @@ impl Component for Impulse {
         }
     }
     /// The load does not depend on the state.
-    fn add_jacobians(
-        &self,
-        _: &Ctx,
-        _: &[f64],
-        _: &[f64],
-        _: &[f64],
-        _: &mut [f64],
-        _: &mut [f64],
-        _: &mut [f64],
-    ) {
-    }
+    fn add_jacobians(&self, _: &Ctx, _: &[f64], _: &[f64], _: &[f64], _: Jacobians<'_>) {}
 }

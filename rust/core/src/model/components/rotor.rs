@@ -1,5 +1,6 @@
 use crate::model::component::{Component, Ctx};
 use crate::model::tilt_terms::{rotor_jacobians, rotor_mass, rotor_residual, RotorConsts};
+use crate::model::Jacobians;
 use crate::model::{Layout, ParamId};
 
 /// A rigid disk turning in its plane, mass centre at `mu` from the centre C: the rotor
@@ -32,16 +33,8 @@ impl Component for PlanarDisk {
         out[y] += a[y] + 2.0 * om * v[x] - w2 * q[y] + dom * (q[x] + self.mu);
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        _q: &[f64],
-        _v: &[f64],
-        _a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, _q: &[f64], _v: &[f64], _a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         let (x, y, d) = (cx.layout.x, cx.layout.y, cx.ndof());
         let (om, dom) = (cx.spin.om, cx.spin.dom);
         m[x * d + x] += 1.0;
@@ -99,16 +92,8 @@ impl Component for TiltingDisk {
         }
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        q: &[f64],
-        v: &[f64],
-        a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, q: &[f64], v: &[f64], a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m } = jac;
         let d = cx.ndof();
         let (mut rk, mut rc, mut rm) = ([0.0; 16], [0.0; 16], [0.0; 16]);
         rotor_jacobians(

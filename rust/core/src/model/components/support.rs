@@ -1,4 +1,5 @@
 use crate::model::component::{Component, Ctx};
+use crate::model::Jacobians;
 use crate::model::{Layout, ParamId};
 
 /// The isotropic spring–damper support of the disk centre: force `-(x + 2 zeta C')` with
@@ -30,16 +31,8 @@ impl Component for IsotropicSupport {
         out[y] += q[y] + 2.0 * z * (v[y] + om * q[x]);
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        _q: &[f64],
-        _v: &[f64],
-        _a: &[f64],
-        k: &mut [f64],
-        c: &mut [f64],
-        _m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, _q: &[f64], _v: &[f64], _a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians { k, c, m: _m } = jac;
         let (x, y, d) = (cx.layout.x, cx.layout.y, cx.ndof());
         let (z, om) = (self.zeta, cx.spin.om);
         k[x * d + x] += 1.0;
@@ -115,16 +108,12 @@ impl Component for AnisotropicSupport {
         out[y] += k[1] * q[x] + k[2] * q[y] + c[1] * gx + c[2] * gy;
     }
     #[inline]
-    fn add_jacobians(
-        &self,
-        cx: &Ctx,
-        _q: &[f64],
-        _v: &[f64],
-        _a: &[f64],
-        kk: &mut [f64],
-        cc: &mut [f64],
-        _m: &mut [f64],
-    ) {
+    fn add_jacobians(&self, cx: &Ctx, _q: &[f64], _v: &[f64], _a: &[f64], jac: Jacobians<'_>) {
+        let Jacobians {
+            k: kk,
+            c: cc,
+            m: _m,
+        } = jac;
         let (x, y, d) = (cx.layout.x, cx.layout.y, cx.ndof());
         let (om, th) = (cx.spin.om, cx.spin.th);
         let k = Self::turned(self.k_x, self.k_y, th);
