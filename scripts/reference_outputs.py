@@ -14,6 +14,7 @@ compared.
 
 from __future__ import annotations
 
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -136,8 +137,16 @@ def tables() -> dict[str, Callable[[], pl.DataFrame]]:
     return t
 
 
+def _ball_name(column: str) -> str:
+    """A model column as named since balls are named from 1 (``eta[0]`` -> ``eta1``),
+    so that tables saved before compare with tables made after."""
+    m = re.fullmatch(r"(eta|zeta_b)\[(\d+)\]", column)
+    return column if m is None else f"{m.group(1)}{int(m.group(2)) + 1}"
+
+
 def _norm(df: pl.DataFrame) -> pl.DataFrame:
     df = df.drop([c for c in df.columns if c in DROP])
+    df = df.rename({c: _ball_name(c) for c in df.columns})
     return df.rename({k: v for k, v in RENAME.items() if k in df.columns})
 
 
@@ -174,7 +183,7 @@ def main(argv: list[str]) -> int:
             df.write_parquet(f)
             print(f"saved {name}: {df.height} rows x {df.width} columns")
             continue
-        ref = pl.read_parquet(f)
+        ref = _norm(pl.read_parquet(f))  # saved before a rename too
         dropped = [c for c in sorted(ignore) if c in df.columns or c in ref.columns]
         if dropped:
             print(f"   {name}: {_filled(ref, df, dropped)}")
