@@ -73,7 +73,8 @@ def test_run_up_matches_newton_integrated_here(start: float) -> None:
     err = np.abs(got - ref.y).max()
     assert err < 1e-6, err
     # the film columns are the film at the rows' speed
-    f = np.array([short_force(*q, ramp(tt, start, dur)[0]) for tt, q in zip(t, ref.y.T)])
+    f = np.array([short_force(*q, ramp(tt, start, dur)[0])
+                  for tt, q in zip(t, ref.y.T, strict=True)])
     assert np.allclose(tr.table["fx"], f[:, 0], atol=1e-5)
     assert np.allclose(tr.table["fy"], f[:, 1], atol=1e-5)
 

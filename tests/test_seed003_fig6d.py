@@ -15,10 +15,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import seed003 as s3
 from scipy.integrate import solve_ivp
 
 import ballbal
-import seed003 as s3
 from ballbal.model import from_disk_units
 
 W0, M0, E, C0, D0 = 0.6, 4.0, 2.0, 0.35, 0.35

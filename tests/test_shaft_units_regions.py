@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 import polars as pl
 import pytest
+import seed003 as s3
 
 import ballbal
-import seed003 as s3
 from ballbal.shaft import ShaftUnits
 
 M_BAR = EPS_BAR = 0.01
