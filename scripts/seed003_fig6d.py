@@ -92,6 +92,31 @@ def main() -> None:
         mean, pp, top = run(w0, m0, e, c0, d0, sp2, se6, args.t_end)
         print(f"{name:36s} {idx:>14s} {rh:>5s} {mean:9.3e} {pp:9.3e} {top:7.3f}")
 
+    # how long the derived reading's transient looks like "no balance"
+    z0 = np.array([0.0, 0.0, math.pi / 2, -math.pi / 2, 0, 0, 0, 0])
+    t = np.linspace(0.0, 400.0, 8001)
+    sol = solve_ivp(s3.rotating_rhs(W0, M0, E, C0, D0), (0, 400.0), z0, t_eval=t,
+                    method="DOP853", rtol=1e-9, atol=1e-11)
+    r = np.hypot(sol.y[0], sol.y[1])
+    wn = math.sqrt(20 / 0.1)
+    for a, b in ((0, 25), (25, 50), (50, 100), (100, 200), (200, 400)):
+        w = r[(t >= a) & (t <= b)]
+        print(f"as derived, t0 {a}-{b} ({a / wn:.1f}-{b / wn:.1f} s): r {w.min():.4f} to "
+              f"{w.max():.4f} R")
+    # the readings that reproduce 6(d), on the seed's other panels
+    print("panels: balance's max Re lambda at 6(a) (20, 2), 6(b) (0.3, 2), 6(d) (0.6, 4); "
+          "6(c) (4, 0.5) run to t0 300: mean r, p-p r (units R)")
+    for name, c0, d0, sp2 in (("as derived", C0, D0, 1.0), ("phi2 row as printed", C0, D0, -1.0),
+                              ("D0 = 0.035", C0, 0.035, 1.0), ("C0 = 0.035", 0.035, D0, 1.0)):
+        idx = []
+        for w0, m0 in ((20.0, 2.0), (0.3, 2.0), (0.6, 4.0)):
+            v = verdict(w0, m0, E, c0, d0, sp2)
+            assert v is not None
+            idx.append(f"{v[0].real.max():+.4f}")
+        mean, pp, _ = run(4.0, 0.5, E, c0, d0, sp2, 1.0, 300.0)
+        print(f"  {name:22s} 6(a) {idx[0]} 6(b) {idx[1]} 6(d) {idx[2]}  6(c) r {mean:.5f} "
+              f"(x 0.05 m = {0.05 * mean:.6f} m), p-p {pp:.2e}")
+
     import ballbal
     from ballbal.model import from_disk_units
 
