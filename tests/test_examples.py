@@ -223,7 +223,23 @@ def shaft_units_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
     return [out / "shaft_units_maps.png"]
 
 
+def bearing_spin_up(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
+    # Seed 002's conclusion 1: sudden starts either side of a threshold end differently
+    # (the equilibrium; the large whirl orbit), a run-up from rest takes both to one point.
+    lo, hi = (float(v) for v in re.search(r"eps0\* in \[(\S+), (\S+)\]", stdout).groups())
+    assert 0.2 < lo < hi < lo + 0.01, (lo, hi)
+    sudden = re.findall(r"sudden start from eps0 \S+: (\w+) \(completed\), late max eps ([\d.]+)",
+                        stdout)
+    assert [v for v, _ in sudden] == ["converges", "whirls"] and float(sudden[1][1]) > 0.8
+    ramp = re.findall(r"spin-up from rest from eps0 \S+: converges", stdout)
+    assert len(ramp) == 2
+    apart = float(re.search(r"starts end (\S+) c apart", stdout).group(1))
+    assert apart < 1e-3
+    return [out / "bearing_spin_up.png"]
+
+
 CHECKS: dict[str, Callable[[pathlib.Path, str], list[pathlib.Path]]] = {
+    "bearing_spin_up.py": bearing_spin_up,
     "shaft_units_maps.py": shaft_units_maps,
     "design_chart.py": design_chart,
     "anisotropic_support.py": anisotropic_support,

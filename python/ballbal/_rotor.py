@@ -17,6 +17,15 @@ clearance ``c``, time ``tau = w t``, film forces over ``F_S = mu w L R^3 / c^2``
   along ``direction`` (degrees); Yen's (2005) ``5 W exp(-5e5 (t - 0.006)^2)`` at 500 rad/s
   is ``RotorImpulse(5, 3, 2)``.
 
+The journal turns at the reference speed ``w`` from ``tau = 0`` (Yen's (2005) sudden
+start) unless the rotor has a :class:`SpinUp`: a linear run-up from ``start w`` to ``w``
+over ``duration`` (in ``tau``). The film at speed ``s w`` is ``s f(q, q' / s)`` (Reynolds'
+right-hand side scales with the speed, and half-Sommerfeld and Swift–Stieber cavitation
+commute with a positive factor), the unbalance's mass centre at the journal's angle
+``theta = int s dtau`` adds ``rho_u (s^2 u - s' J u)``, ``u = (cos, sin)(theta + phi_u)``;
+gravity, ``m`` and ``g_n`` keep their values at ``w``. A prescribed speed makes the rotor
+non-autonomous during the run-up: it is for :func:`simulate_rotor` only.
+
 Runs end ``"completed"``, ``"contact"`` (eccentricity reached ``eps_contact``, the time
 found on the step's dense output), ``"stiff"`` (the explicit integrator's steps held down
 by the squeeze film near the wall: use ``method="implicit"``, a Rosenbrock 2(3) method) or
@@ -64,10 +73,30 @@ class RotorImpulse:
 
 
 @dataclass(frozen=True)
+class SpinUp:
+    """A linear run-up of the journal's speed: ``s = start + (1 - start) tau / duration``
+    times the reference speed ``w`` on ``0 <= tau <= duration``, ``start`` before and 1
+    after (the journal's angle is its integral). ``start`` in ``[0, 1)``, ``duration`` in
+    ``(0, 1e12]`` (units ``1 / w``). Seed 002 (Yen 2005) contrasts its sudden start with
+    a start from rest, after Li et al. (1999)."""
+
+    start: float = 0.0
+    duration: float = 100.0
+
+    def __post_init__(self) -> None:
+        for name in ("start", "duration"):
+            object.__setattr__(self, name, _check.real(f"spin_up.{name}", getattr(self, name),
+                                                      finite=True))
+        # its ranges are the core's
+        RotorOnBearing(Bearing(), 1.0, spin_up=self)
+
+
+@dataclass(frozen=True)
 class RotorOnBearing:
     """A rigid rotor of bearing mass parameter ``mass_parameter`` on ``bearing`` under
-    ``gravity`` (``g / (c w^2)``), ``unbalance`` (``e_u / c``) and an optional
-    :class:`RotorImpulse` (module docstring). Angles in degrees."""
+    ``gravity`` (``g / (c w^2)``), ``unbalance`` (``e_u / c``), an optional
+    :class:`RotorImpulse` and an optional :class:`SpinUp` (``None``: at ``w`` from the
+    start) (module docstring). Angles in degrees."""
 
     bearing: Bearing
     mass_parameter: float
@@ -76,6 +105,7 @@ class RotorOnBearing:
     impulse: RotorImpulse | None = None
     gravity_direction: float = 0.0
     unbalance_phase: float = 0.0
+    spin_up: SpinUp | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.bearing, Bearing):
@@ -87,6 +117,11 @@ class RotorOnBearing:
                 "impulse",
                 f"impulse must be RotorImpulse or None, got {type(self.impulse).__name__}",
                 allowed="RotorImpulse or None")
+        if self.spin_up is not None and not isinstance(self.spin_up, SpinUp):
+            raise ParameterTypeError(
+                "spin_up",
+                f"spin_up must be SpinUp or None, got {type(self.spin_up).__name__}",
+                allowed="SpinUp or None")
         for name in ("mass_parameter", "gravity", "unbalance", "gravity_direction",
                      "unbalance_phase"):
             object.__setattr__(self, name, _check.real(name, getattr(self, name)))

@@ -46,6 +46,7 @@ from ._rotor import (
     RotorImpulse,
     RotorOnBearing,
     RotorTrajectory,
+    SpinUp,
     plot_trajectory,
     rotor_equilibrium,
     simulate_rotor,
@@ -59,7 +60,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Bearing", "BearingEquilibrium", "Coefficients", "Dimensions", "FilmForce", "Grooves",
-    "RotorImpulse", "RotorOnBearing", "RotorTrajectory", "Stability", "coefficients",
+    "RotorImpulse", "RotorOnBearing", "RotorTrajectory", "SpinUp", "Stability", "coefficients",
     "default_grid", "equilibrium", "film_force", "plot_pressure", "plot_trajectory",
     "rotor_equilibrium", "simulate_rotor", "stability", "groove_study", "plot_groove_study",
 ]

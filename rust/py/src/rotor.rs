@@ -6,7 +6,7 @@ use crate::bearing::BearingArgs;
 use crate::errors::CoreResult;
 use crate::run::guarded;
 use ballbal_core::analysis::journal::{
-    simulate_rotor as core_simulate_rotor, Impulse, Method, RotorOnBearing, RotorOptions,
+    simulate_rotor as core_simulate_rotor, Impulse, Method, RotorOnBearing, RotorOptions, SpinUp,
 };
 use ballbal_core::model::bearing::Dimensions;
 use ballbal_core::Error;
@@ -23,6 +23,13 @@ pub struct ImpulseArgs {
     direction: f64,
 }
 
+/// `ballbal.bearing.SpinUp`'s fields (a linear run-up).
+#[derive(FromPyObject)]
+pub struct SpinUpArgs {
+    start: f64,
+    duration: f64,
+}
+
 /// `ballbal.bearing.RotorOnBearing`'s fields (angles in degrees).
 #[derive(FromPyObject)]
 pub struct RotorArgs {
@@ -33,6 +40,7 @@ pub struct RotorArgs {
     unbalance: f64,
     unbalance_phase: f64,
     impulse: Option<ImpulseArgs>,
+    spin_up: Option<SpinUpArgs>,
 }
 
 impl RotorArgs {
@@ -50,6 +58,13 @@ impl RotorArgs {
                 sharpness: i.sharpness,
                 direction: i.direction.to_radians(),
             }),
+            spin_up: self
+                .spin_up
+                .as_ref()
+                .map_or(SpinUp::Sudden, |s| SpinUp::Ramp {
+                    start: s.start,
+                    duration: s.duration,
+                }),
         };
         r.validate()?;
         Ok(r)

@@ -23,6 +23,19 @@
 //! * Yen's (2005) impulse `F = a W exp(-s (tau - tau_c)^2)` along `e_i` (`a` over the weight,
 //!   so it needs gravity; Yen's (2005) is `a = 5`, `s = 2`, `tau_c = 3` at 500 rad/s).
 //!
+//! # Spin-up
+//!
+//! `w` is the reference speed the units are made with. The journal turns at
+//! `w s(tau)` with `s` given by [`SpinUp`]: 1 from the start ([`SpinUp::Sudden`], Yen's
+//! (2005) sudden start) or a linear run-up ([`SpinUp::Ramp`]). The film force at speed
+//! `s w` is `s F(X, V / s)` with `F` the force at `w`: Reynolds' right-hand side
+//! `6 s dH/dtheta + 12 dH/dtau` is `s` times the one at `w` with the velocity over `s`,
+//! and every cavitation model here (clipping, complementarity) commutes with a positive
+//! factor. The unbalance's mass centre at angle `theta(tau) = int s` adds
+//! `rho_u (s^2 u - s' u_perp)`, `u = (cos, sin)(theta + phi_u)`, `u_perp = J u`; the grooves
+//! of a grooved journal turn by `theta`. Gravity, `m` and `g_n` keep their reference
+//! values (`g_n = g / (c w^2)` at the reference speed).
+//!
 //! Dimensional conversion ([`RotorOnBearing::from_dimensions`]): with radius `R`, length
 //! `L`, clearance `c`, viscosity `mu`, rotor mass `M` (carried by this bearing), speed `w`,
 //! unbalance `e_u` and gravity `g`: `m = M c^3 w / (mu L R^3)`, `g_n = g / (c w^2)`,
@@ -53,6 +66,49 @@ pub struct Impulse {
     pub direction: f64,
 }
 
+/// How the journal's speed reaches the reference speed `w` (module docs, "Spin-up").
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum SpinUp {
+    /// At `w` from the start.
+    #[default]
+    Sudden,
+    /// `s = start + (1 - start) tau / duration` on `[0, duration]`, `start` before, 1 after.
+    Ramp { start: f64, duration: f64 },
+}
+
+impl SpinUp {
+    pub fn validate(&self) -> Result<()> {
+        if let SpinUp::Ramp { start, duration } = *self {
+            check_range("spin_up.start", start, 0.0, false, 1.0, true)?;
+            check_range("spin_up.duration", duration, 0.0, true, 1e12, false)?;
+        }
+        Ok(())
+    }
+
+    /// `(s, s', theta)` at `tau`: the speed over `w`, its rate, and the journal's angle
+    /// (`theta(0) = 0`).
+    #[inline]
+    pub fn at(&self, tau: f64) -> (f64, f64, f64) {
+        match *self {
+            SpinUp::Sudden => (1.0, 0.0, tau),
+            SpinUp::Ramp { start, duration } => {
+                let rate = (1.0 - start) / duration;
+                if tau <= 0.0 {
+                    (start, 0.0, start * tau)
+                } else if tau < duration {
+                    (
+                        start + rate * tau,
+                        rate,
+                        start * tau + 0.5 * rate * tau * tau,
+                    )
+                } else {
+                    (1.0, 0.0, 0.5 * (1.0 + start) * duration + (tau - duration))
+                }
+            }
+        }
+    }
+}
+
 /// A rigid rotor carried by one journal bearing, nondimensional (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RotorOnBearing {
@@ -68,6 +124,8 @@ pub struct RotorOnBearing {
     /// Phase `phi_u` of the unbalance at `tau = 0` (radians).
     pub unbalance_phase: f64,
     pub impulse: Option<Impulse>,
+    /// The journal's speed profile ([`SpinUp::Sudden`]: `w` throughout).
+    pub spin_up: SpinUp,
 }
 
 /// Which integrator.
@@ -158,6 +216,7 @@ impl RotorOnBearing {
         check_range("mass_parameter", self.mass, 0.0, true, f64::INFINITY, true)?;
         check_range("gravity", self.gravity, 0.0, false, f64::INFINITY, true)?;
         check_range("unbalance", self.unbalance, 0.0, false, f64::INFINITY, true)?;
+        self.spin_up.validate()?;
         for (name, v) in [
             ("gravity_direction", self.gravity_direction),
             ("unbalance_phase", self.unbalance_phase),
@@ -241,6 +300,7 @@ impl RotorOnBearing {
             unbalance: e_u / c,
             unbalance_phase: 0.0,
             impulse: None,
+            spin_up: SpinUp::Sudden,
         };
         rotor.validate()?;
         Ok(rotor)
@@ -268,10 +328,13 @@ impl RotorOnBearing {
     /// The applied accelerations (gravity, unbalance, impulse) at `tau`.
     pub fn applied(&self, tau: f64) -> [f64; 2] {
         let (gs, gc) = self.gravity_direction.sin_cos();
-        let (us, uc) = (tau + self.unbalance_phase).sin_cos();
+        let (s, ds, th) = self.spin_up.at(tau);
+        let (us, uc) = (th + self.unbalance_phase).sin_cos();
+        // the mass centre's acceleration relative to the journal's, -d^2/dtau^2 of rho_u u
+        let (ur, ut) = (self.unbalance * s * s, self.unbalance * ds);
         let mut a = [
-            self.gravity * gc + self.unbalance * uc,
-            self.gravity * gs + self.unbalance * us,
+            self.gravity * gc + ur * uc + ut * us,
+            self.gravity * gs + ur * us - ut * uc,
         ];
         if let Some(imp) = &self.impulse {
             let d = tau - imp.center;
@@ -294,19 +357,29 @@ struct Rhs<'a> {
     last_error: Option<Error>,
 }
 
+/// The film force `(f_x, f_y, f_radial, f_tangential)` at `tau` for the journal at
+/// `y = (x, y, x', y')` turning at `spin.at(tau)`: `s F(X, V / s)` (module docs). At rest
+/// (`s = 0`) the limit, the pure squeeze film, is taken at `s` far below `|V|`.
+pub fn film_force(solver: &mut FilmSolver, spin: &SpinUp, tau: f64, y: &[f64]) -> Result<[f64; 4]> {
+    let (s, _, th) = spin.at(tau);
+    let s = s.max(1e-12 * y[2].hypot(y[3])).max(f64::MIN_POSITIVE);
+    let st = JournalState {
+        x: y[0],
+        y: y[1],
+        vx: y[2] / s,
+        vy: y[3] / s,
+        tau: th,
+    };
+    let f = solver.force(&st, false)?;
+    Ok([s * f.fx, s * f.fy, s * f.f_radial, s * f.f_tangential])
+}
+
 impl Rhs<'_> {
     fn eval(&mut self, tau: f64, y: &[f64], dy: &mut [f64]) {
         self.evals += 1;
-        let st = JournalState {
-            x: y[0],
-            y: y[1],
-            vx: y[2],
-            vy: y[3],
-            tau,
-        };
         dy[0] = y[2];
         dy[1] = y[3];
-        match self.solver.force_xy(&st) {
+        match film_force(&mut self.solver, &self.rotor.spin_up, tau, y) {
             Ok(f) => {
                 let a = self.rotor.applied(tau);
                 dy[2] = f[0] / self.rotor.mass + a[0];
@@ -561,18 +634,8 @@ pub fn simulate_rotor(
     let mut force = Vec::with_capacity(watch.rows_t.len());
     let mut evals = rhs.evals;
     for (t, y) in watch.rows_t.iter().zip(&watch.rows_y) {
-        let st = JournalState {
-            x: y[0],
-            y: y[1],
-            vx: y[2],
-            vy: y[3],
-            tau: *t,
-        };
         evals += 1;
-        force.push(match rhs.solver.force(&st, false) {
-            Ok(f) => [f.fx, f.fy, f.f_radial, f.f_tangential],
-            Err(_) => [f64::NAN; 4],
-        });
+        force.push(film_force(&mut rhs.solver, &rotor.spin_up, *t, y).unwrap_or([f64::NAN; 4]));
     }
     Ok(RotorTrajectory {
         t: watch.rows_t,
@@ -602,6 +665,7 @@ mod tests {
             unbalance: 0.0,
             unbalance_phase: 0.0,
             impulse: None,
+            spin_up: SpinUp::Sudden,
         }
     }
 
@@ -709,6 +773,44 @@ mod tests {
     }
 
     #[test]
+    fn ramp_law_and_its_angle() {
+        let r = SpinUp::Ramp {
+            start: 0.2,
+            duration: 10.0,
+        };
+        // s = 0.2 + 0.08 tau, theta = 0.2 tau + 0.04 tau^2 up to tau = 10, then slope 1
+        let (s, ds, th) = r.at(5.0);
+        assert!((s - 0.6).abs() < 1e-14 && (ds - 0.08).abs() < 1e-14 && (th - 2.0).abs() < 1e-13);
+        let (s, ds, th) = r.at(12.0);
+        assert!(s == 1.0 && ds == 0.0 && (th - 8.0).abs() < 1e-13);
+        assert_eq!(SpinUp::Sudden.at(3.0), (1.0, 0.0, 3.0));
+    }
+
+    #[test]
+    fn film_at_a_fraction_of_the_speed_is_the_scaled_film() {
+        // The short bearing's pressure is linear in (s dH/dtheta, dH/dtau) before clipping:
+        // at half speed with no squeeze the force is half the force at w.
+        let mut solver = Bearing::plain(0.5, FilmModel::Short).solver().unwrap();
+        let half = SpinUp::Ramp {
+            start: 0.5,
+            duration: 1.0,
+        };
+        let y = [0.3, 0.1, 0.0, 0.0];
+        let f_half = film_force(&mut solver, &half, 0.0, &y).unwrap();
+        let f_full = film_force(&mut solver, &SpinUp::Sudden, 0.0, &y).unwrap();
+        for i in 0..4 {
+            assert!((f_half[i] - 0.5 * f_full[i]).abs() < 1e-12 * f_full[0].abs().max(1.0));
+        }
+        // at rest with no squeeze, no film force
+        let rest = SpinUp::Ramp {
+            start: 0.0,
+            duration: 1.0,
+        };
+        let f0 = film_force(&mut solver, &rest, 0.0, &y).unwrap();
+        assert!(f0.iter().all(|v| v.abs() < 1e-200), "{f0:?}");
+    }
+
+    #[test]
     fn bad_input_names_the_parameter() {
         let name = |r: Result<RotorTrajectory>| match r {
             Err(Error::InvalidParameter { name, .. }) => name,
@@ -746,6 +848,23 @@ mod tests {
         assert_eq!(
             name(simulate_rotor(&r, [0.0; 4], 0.0, &t, &o)),
             "impulse.amplitude"
+        );
+        let mut r = short_rotor(1.0, 1.0);
+        r.spin_up = SpinUp::Ramp {
+            start: 1.0,
+            duration: 1.0,
+        };
+        assert_eq!(
+            name(simulate_rotor(&r, [0.0; 4], 0.0, &t, &o)),
+            "spin_up.start"
+        );
+        r.spin_up = SpinUp::Ramp {
+            start: 0.0,
+            duration: 0.0,
+        };
+        assert_eq!(
+            name(simulate_rotor(&r, [0.0; 4], 0.0, &t, &o)),
+            "spin_up.duration"
         );
         let o2 = RotorOptions {
             eps_contact: 1.0,
