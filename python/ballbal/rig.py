@@ -199,6 +199,16 @@ def _refine_peak(t: np.ndarray, x: np.ndarray, f0: float, width: float) -> float
     return float(f)
 
 
+def _line_amplitude(t: np.ndarray, x: np.ndarray, f: float) -> float:
+    """The amplitude of a line at ``f`` (Hz) in ``x``: the Hann-windowed transform at
+    ``f`` over half the window's sum (exact for a pure cosine at ``f``, up to the
+    window's leakage from other lines). Noise adds to it only in quadrature, at the
+    level of one bin, unlike the RMS, which holds all the noise."""
+    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(t.size) / t.size)
+    return float(2.0 * abs(np.sum(w * x * np.exp(-2j * np.pi * f * (t - t.mean()))))
+                 / w.sum())
+
+
 def read_record(
     source: Any,
     *,
@@ -427,6 +437,10 @@ class Record:
         - ``rms`` and ``peak`` in the sensor's unit (column ``unit``), and with
           ``eccentricity`` (metres) and ``natural_frequency_rpm`` also ``rms_model`` and
           ``peak_model`` in the model's units (``e``, ``e w_n`` or ``e w_n^2``);
+        - ``main_amplitude``: the main line's amplitude (the settled segment's Hann
+          transform at ``main_frequency_rpm``), in the sensor's unit, and
+          ``main_amplitude_model`` in the model's units as ``rms_model``; unlike the
+          RMS it holds the noise of one spectral bin only;
         - ``resolution_rpm``: the spectrum's bin width.
         """
         name = self._channel(channel)
@@ -455,7 +469,8 @@ class Record:
                                    "main_frequency_rpm": None, "main_order": None,
                                    "synchronous": None, "rms": None, "peak": None,
                                    "rms_model": None, "peak_model": None,
-                                   "resolution_rpm": None}
+                                   "resolution_rpm": None, "main_amplitude": None,
+                                   "main_amplitude_model": None}
             turns = sp / 60.0 * (ts[-1] - ts[0]) if ts.size > 1 else 0.0
             even = ts.size > 16 and np.ptp(np.diff(ts)) <= 0.01 * np.mean(np.diff(ts))
             if turns >= nrev and even:
@@ -472,14 +487,18 @@ class Record:
                 row.update(status="ok", main_frequency_rpm=f, main_order=f / sp,
                            synchronous=bool(abs(f - sp) <= max(sync * sp, 1.5 * bin_rpm)),
                            rms=rms, peak=peak, resolution_rpm=bin_rpm)
+                amp = _line_amplitude(ts - ts[0], x, f / 60.0)
+                row.update(main_amplitude=amp)
                 if scale is not None:
-                    row.update(rms_model=rms * scale, peak_model=peak * scale)
+                    row.update(rms_model=rms * scale, peak_model=peak * scale,
+                               main_amplitude_model=amp * scale)
             rows.append(row)
         schema = {"step": pl.Int64, "speed_rpm": pl.Float64, "status": pl.Utf8,
                   "main_frequency_rpm": pl.Float64, "main_order": pl.Float64,
                   "synchronous": pl.Boolean, "rms": pl.Float64, "peak": pl.Float64,
                   "rms_model": pl.Float64, "peak_model": pl.Float64,
-                  "resolution_rpm": pl.Float64}
+                  "resolution_rpm": pl.Float64, "main_amplitude": pl.Float64,
+                  "main_amplitude_model": pl.Float64}
         out = pl.DataFrame(rows, schema=schema)
         return out.with_columns(pl.lit(sensor.unit).alias("unit"),
                                 st["direction"].alias("direction"))
