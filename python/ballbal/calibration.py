@@ -4,7 +4,8 @@
 ``zeta``, ``mu``, ``delta``, ``eta``, the rig's natural frequency
 ``natural_frequency_rpm`` and the sensor's scale ``sensor_scale``) to the per-step
 features of a measured stepped sweep (:meth:`ballbal.rig.Record.features`), with the
-model as the forward model and nonlinear least squares (scipy's trust-region reflective ``least_squares``).
+model as the forward model and nonlinear least squares (scipy's trust-region reflective
+``least_squares``).
 
 What is fitted:
 
