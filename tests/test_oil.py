@@ -72,3 +72,32 @@ def test_bad_input_is_named(kw: dict[str, float], name: str) -> None:
     with pytest.raises(ParameterError) as e:
         oil.track_damping(mu, **args)
     assert e.value.parameter == name
+
+
+def test_transfer_oils_round_trip() -> None:
+    """Two oils whose transitions are where the model's band ends at zeta_b 0.1 and at
+    twice that (twice the viscosity): the law calibrated on the first gives kappa in
+    closed form and predicts the second's zeta_b, so the second's residual is within
+    the band end's refinement, and its calibrated zeta_b the law's."""
+    import polars as pl
+
+    import ballbal
+    from ballbal.calibration import stable_band_end, transfer_oils
+
+    model = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, Omega=1.1,
+                             eta=(0.66, 0.66))
+    grid = (1.0, 1.6, 0.01)
+    ends = [stable_band_end(model.replace(zeta_b=z), Omega=grid) * FN for z in (0.1, 0.2)]
+    cases = pl.DataFrame({"case": ["thin", "thick"], "viscosity_cP": [20.0, 40.0],
+                          "speed_rpm": ends, "natural_frequency_rpm": [FN, FN]})
+    tr = transfer_oils(model, cases, reference=0, ball_radius=A, ball_mass=M,
+                       bracket=(0.05, 0.4), Omega=grid)
+    unit = 6 * math.pi * 20e-3 * A / (2 * M * FN * 2 * math.pi / 60)  # zeta_b at kappa 1
+    t = tr.table
+    assert tr.geometric_factor == pytest.approx(t["calibrated_zeta_b"][0] / unit, rel=1e-9)
+    assert t["calibrated_zeta_b"][0] == pytest.approx(0.1, abs=1e-3)
+    assert t["law_zeta_b"][1] == pytest.approx(2 * t["calibrated_zeta_b"][0], rel=1e-9)
+    assert t["ratio"][1] == pytest.approx(1.0, abs=0.02)
+    assert abs(t["residual_rpm"][1]) < 2.0
+    assert t["status"].to_list() == ["ok", "ok"]
+    assert "OilTransfer" in repr(tr) and "<table>" in tr._repr_html_()
