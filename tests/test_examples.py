@@ -207,7 +207,27 @@ def design_chart(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:
             assert 2 * float(eta) <= 1 and crit == "null"
         else:
             assert status == "ok" and float(crit) > float(fn)
-    return [out / "design_chart.png"]
+    # The oil law: zeta_b proportional to the viscosity; thicker oil ends the chasing
+    # sooner.
+    oil = [(float(a), float(b), float(c)) for a, b, c in re.findall(
+        r"oil (\S+) cP: zeta_b (\S+), chasing ends (\S+) rpm", stdout)]
+    assert len(oil) >= 3, stdout
+    ratios = [z / v for v, z, _ in oil]
+    assert np.allclose(ratios, ratios[0], rtol=1e-3)
+    ends = [e for _, _, e in oil]
+    assert all(b < a for a, b in zip(ends, ends[1:], strict=False)), ends
+    # eta = m_b r / (m_d e) per ball, the margin 2 eta - 1; none without a margin
+    for imb, margin, status in re.findall(
+            r"imbalance (\S+) g mm: eta margin (\S+), balanced from \S+ rpm, (\w+)", stdout):
+        assert abs(float(margin) - (2 * 2.05 * 16 / float(imb) - 1)) < 2e-3
+        assert (status == "no_balance") == (float(margin) <= 0)
+    # the binomial standard error of each fraction
+    fr = re.findall(r"balanced fraction at \S+ rpm: (\S+) ± (\S+) \((\d+)/(\d+)\)", stdout)
+    assert len(fr) >= 2, stdout
+    for p, se, k, n in fr:
+        assert abs(float(p) - int(k) / int(n)) < 1e-4
+        assert abs(float(se) - np.sqrt(float(p) * (1 - float(p)) / int(n))) < 2e-4
+    return [out / "design_chart.png", out / "design_balancing.png"]
 
 
 def shaft_units_maps(out: pathlib.Path, stdout: str) -> list[pathlib.Path]:

@@ -88,6 +88,20 @@ def _calibration() -> Calibration:
                        message="ok")
 
 
+def _oil_transfer() -> Any:
+    # the display only: a result written here
+    from ballbal.calibration import OilTransfer
+
+    t = pl.DataFrame({"case": ["thin", "thick"], "viscosity_cP": [20.0, 40.0],
+                      "natural_frequency_rpm": [513.0, 513.0], "zeta": [0.01, 0.01],
+                      "measured_rpm": [900.0, 800.0], "calibrated_zeta_b": [0.15, None],
+                      "calibrated_low": [0.14, None], "calibrated_high": [0.16, None],
+                      "status": ["ok", "unreachable"], "law_zeta_b": [0.15, 0.3],
+                      "ratio": [1.0, None], "predicted_rpm": [900.0, 700.0],
+                      "residual_rpm": [0.0, -100.0]})
+    return OilTransfer(t, 12.0, 0)
+
+
 # name -> (maker, has a plot)
 RESULTS: dict[str, tuple[Any, bool]] = {
     "PeriodicSolution": (periodic, True),
@@ -115,6 +129,14 @@ RESULTS: dict[str, tuple[Any, bool]] = {
                                            * np.sin(0.1 * np.arange(2000))), True),
     "Record": (_record, True),
     "Calibration": (_calibration, True),
+    "OilTransfer": (_oil_transfer, True),
+    "BalancingChart": (lambda: ballbal.design.balancing_chart(
+        ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, eta=(0.66, 0.66)),
+        vary="zeta_b", values=[0.1, 0.2], natural_frequency_rpm=513.0,
+        Omega=(1.0, 1.5, 0.02)), True),
+    "BalancedFraction": (lambda: ballbal.design.balanced_fraction(
+        ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, eta=(0.66, 0.66)),
+        speeds_rpm=[600.0, 650.0], natural_frequency_rpm=513.0, starts=8), True),
     # one value with its interval, all in the summary
     "Transition": (lambda: Transition(parameter="zeta_b", speed_rpm=900.0,
                                       uncertainty_rpm=10.0, value=0.1, low=0.09, high=0.11,

@@ -46,12 +46,14 @@ def entries() -> set[str]:
     return set(re.findall(r"^## ([A-Za-z][A-Za-z0-9]*)\s*$", text, flags=re.M))
 
 
-def test_references_page_lists_the_five_sources() -> None:
+def test_references_page_lists_the_seven_sources() -> None:
     assert REFERENCES.exists(), f"{REFERENCES}: set BALLBAL_REPO to the repository checkout"
     keys = entries()
     # Tien (2011) the planar model follows and the ball-spring/tilt paper at least.
     assert {"Tien2011", "Rezaee2017"} <= keys, keys
-    assert len(keys) == 5, keys
+    # and the oil law's two (Stokes' drag and the tube's wall factor)
+    assert {"Stokes1851", "HabermanSayre1958"} <= keys, keys
+    assert len(keys) == 7, keys
 
 
 def test_every_cited_key_has_an_entry() -> None:

@@ -95,6 +95,76 @@ def test_zeta_b_intervals_cover_the_truth_over_noise_draws() -> None:
     assert 0.5 < np.mean(se) / est_a.std(ddof=1) < 2.0, (se, est)
 
 
+SCALE = 2.5  # the synthetic sensor's units per e w_n^2 (a rig's mV per model unit)
+
+
+def scaled(seed: int) -> dict[str, np.ndarray]:
+    """The sweep as a sensor of scale SCALE records it, with unit noise."""
+    t, v, a, ang = clean_sweep()
+    noise = NOISE * np.random.default_rng(1000 + seed).standard_normal(t.size)
+    return {"t": t, "rpm": v, "acc": SCALE * a + noise,
+            "tacho": (np.mod(ang, 2 * np.pi) < 0.4) * 5.0}
+
+
+def test_main_amplitude_is_the_simulated_lines() -> None:
+    """The features' main-line amplitude against the simulated signal's, found here by
+    a least-squares fit of a cosine at the main frequency to the noise-free record."""
+    t, v, a, _ = clean_sweep()
+    ft = read_record({"t": t, "rpm": v, "acc": a}, speed="rpm",
+                     channels=SENSOR).features(**STEPS)
+    for row in ft.iter_rows(named=True):
+        k = (np.abs(v - row["speed_rpm"]) < 1e-9)
+        tk, ak = t[k], a[k]
+        keep = tk >= tk[0] + STEPS["settle"] * (tk[-1] - tk[0])
+        w = 2 * math.pi * row["main_frequency_rpm"] / 60
+        basis = np.column_stack([np.cos(w * tk[keep]), np.sin(w * tk[keep]),
+                                 np.ones(keep.sum())])
+        c = np.linalg.lstsq(basis, ak[keep], rcond=None)[0]
+        # other lines leak into a plain fit: 2 % of the main line
+        assert row["main_amplitude"] == pytest.approx(math.hypot(c[0], c[1]), rel=0.02)
+
+
+def test_level_and_sensor_scale_intervals_cover_the_truth() -> None:
+    """zeta_b and the sensor scale from the main frequency and the main line's
+    amplitude together, over 20 noise draws."""
+    start = TRUE.replace(zeta_b=0.08)
+    est, se, covered = [], [], np.zeros(2, dtype=int)
+    for seed in range(20):
+        ft = read_record(scaled(seed), speed="rpm", channels=SENSOR).features(**STEPS)
+        fit = calibrate(start, ft, ["zeta_b", "sensor_scale"], natural_frequency_rpm=FN,
+                        fit=("main_frequency", "main_amplitude"))
+        e = fit.estimates
+        assert e["determined"].all() and e["confounded_with"].is_null().all(), fit
+        est.append(e["value"].to_numpy())
+        se.append(e["std_error"].to_numpy())
+        covered += ((e["ci_low"].to_numpy() <= (TRUE.zeta_b, SCALE))
+                    & ((TRUE.zeta_b, SCALE) <= e["ci_high"].to_numpy()))
+    est_a, se_a = np.array(est), np.array(se)
+    assert (covered >= 17).all(), (covered, est_a, se_a)
+    spread = est_a.std(axis=0, ddof=1)
+    assert (np.abs(est_a.mean(axis=0) - (TRUE.zeta_b, SCALE))
+            < 3 * spread / math.sqrt(20)).all(), est_a
+    assert (0.5 < se_a.mean(axis=0) / spread).all() and (se_a.mean(axis=0) / spread
+                                                         < 2.0).all(), (se_a, spread)
+    # the model's amplitudes times the fitted scale against the measured, per step
+    amp = fit.residuals.filter(fit.residuals["quantity"] == "main_amplitude")
+    assert amp.height == len(OMEGAS)
+    assert np.all(np.abs(amp["residual"].to_numpy()) < 0.05 * amp["measured"].to_numpy())
+
+
+def test_sensor_scale_refused_without_amplitudes() -> None:
+    ft = read_record(scaled(0), speed="rpm", channels=SENSOR).features(**STEPS)
+    with pytest.raises(ParameterError) as e:
+        calibrate(TRUE, ft, ["zeta_b", "sensor_scale"], natural_frequency_rpm=FN)
+    assert e.value.parameter == "free"
+    with pytest.raises(ParameterError) as e:
+        calibrate(TRUE, ft, ["zeta_b"], natural_frequency_rpm=FN, fit=("main_amplitude",))
+    assert e.value.parameter == "sensor_scale"
+    with pytest.raises(ParameterError) as e:
+        calibrate(TRUE, ft, ["zeta_b"], natural_frequency_rpm=FN, fit=("level",))
+    assert e.value.parameter == "fit"
+
+
 def test_calibration_from_tacho_pulses() -> None:
     rec = read_record(noisy(100), tacho="tacho", channels=SENSOR)
     ft = rec.features(**STEPS)

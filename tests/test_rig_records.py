@@ -145,6 +145,67 @@ def test_files_csv_and_npz(tmp_path: object) -> None:
         assert "Record(" in repr(rec) and "<table>" in rec._repr_html_()
 
 
+def _same_steps(rec: Record, cols: dict[str, np.ndarray], plateaus: list) -> None:
+    st = rec.steps()
+    assert st.height == len(plateaus)
+    assert np.allclose(st["speed_rpm"], [p[2] for p in plateaus], rtol=1e-9)
+    assert np.array_equal(rec.channels["acc_mV"] if "acc_mV" in rec.channels
+                          else rec.channels["rig/acc_mV"], cols["acc_mV"] / 100.0)
+
+
+def test_files_matlab(tmp_path: object) -> None:
+    from pathlib import Path
+
+    from scipy.io import savemat
+
+    d = Path(str(tmp_path))
+    cols, plateaus = synthetic()
+    savemat(d / "r.mat", cols | {"note": "rig 1", "grid": np.ones((3, 3))})
+    rec = read_record(d / "r.mat", speed="rpm", channels=SENSOR)
+    _same_steps(rec, cols, plateaus)
+    # the 2-D variable and the text are not columns
+    with pytest.raises(ParameterError) as e:
+        read_record(d / "r.mat", speed="grid", channels=SENSOR)
+    assert e.value.parameter == "speed"
+
+
+def test_files_hdf5(tmp_path: object) -> None:
+    from pathlib import Path
+
+    h5py = pytest.importorskip("h5py")
+    d = Path(str(tmp_path))
+    cols, plateaus = synthetic()
+    with h5py.File(d / "r.h5", "w") as f:
+        g = f.create_group("rig")
+        for k, v in cols.items():
+            g.create_dataset(k, data=v)
+    rec = read_record(d / "r.h5", time="rig/t", speed="rig/rpm",
+                      channels={"rig/acc_mV": SENSOR["acc_mV"]})
+    _same_steps(rec, cols, plateaus)
+
+
+def test_files_tdms(tmp_path: object) -> None:
+    from pathlib import Path
+
+    nptdms = pytest.importorskip("nptdms")
+    d = Path(str(tmp_path))
+    cols, plateaus = synthetic()
+    with nptdms.TdmsWriter(d / "r.tdms") as w:
+        w.write_segment([nptdms.ChannelObject("rig", k, v) for k, v in cols.items()])
+    rec = read_record(d / "r.tdms", speed="rpm", channels=SENSOR)
+    _same_steps(rec, cols, plateaus)
+
+
+def test_unknown_file_type_is_named(tmp_path: object) -> None:
+    from pathlib import Path
+
+    f = Path(str(tmp_path)) / "r.xlsx"
+    f.write_bytes(b"x")
+    with pytest.raises(ParameterError) as e:
+        read_record(f, speed="rpm")
+    assert e.value.parameter == "source" and ".tdms" in str(e.value)
+
+
 def test_short_steps_are_flagged_not_fitted() -> None:
     cols, _ = synthetic()
     rec = read_record(cols, speed="rpm", channels=SENSOR)
@@ -187,3 +248,17 @@ def test_bad_records_name_the_column() -> None:
         read_record({"t": cols["t"], "rpm": cols["rpm"], "tacho_V": np.zeros(cols["t"].size)},
                     tacho="tacho_V")
     assert e.value.parameter == "tacho"
+
+
+@pytest.mark.parametrize(("module", "suffix", "extra"), [("h5py", "r.h5", "hdf5"),
+                                                          ("nptdms", "r.tdms", "tdms")])
+def test_missing_reader_names_its_extra(tmp_path: object, monkeypatch: pytest.MonkeyPatch,
+                                        module: str, suffix: str, extra: str) -> None:
+    import sys
+    from pathlib import Path
+
+    f = Path(str(tmp_path)) / suffix
+    f.write_bytes(b"x")
+    monkeypatch.setitem(sys.modules, module, None)  # import fails as if not installed
+    with pytest.raises(ImportError, match=rf"ballbal\[{extra}\]"):
+        read_record(f, speed="rpm")

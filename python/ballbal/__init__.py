@@ -8,6 +8,7 @@ from . import (
     data,
     design,
     exceptions,
+    oil,
     rig,
     sweep,
 )
@@ -98,6 +99,7 @@ __all__ = [
     "label_peaks",
     "line_spectrum",
     "load_scene",
+    "oil",
     "rig",
     "periodic",
     "plot_accuracy_cost",

@@ -1,10 +1,11 @@
 """Calibration: the model parameters a rig has, fitted to what it measured.
 
 :func:`calibrate` fits chosen parameters of a :class:`~ballbal.Balancer` (``zeta_b``,
-``zeta``, ``mu``, ``delta``, ``eta``, and the rig's natural frequency
-``natural_frequency_rpm``) to the per-step features of a measured stepped sweep
-(:meth:`ballbal.rig.Record.features`), with the model as the forward model and
-nonlinear least squares (scipy's trust-region reflective ``least_squares``).
+``zeta``, ``mu``, ``delta``, ``eta``, the rig's natural frequency
+``natural_frequency_rpm`` and the sensor's scale ``sensor_scale``) to the per-step
+features of a measured stepped sweep (:meth:`ballbal.rig.Record.features`), with the
+model as the forward model and nonlinear least squares (scipy's trust-region reflective
+``least_squares``).
 
 What is fitted:
 
@@ -14,6 +15,13 @@ What is fitted:
   (default ``"R-R"``) at that speed, against
   the measured main frequency. Each step's solution starts from the same step's
   solution at the previous parameters, so that the fit follows one branch.
+- ``main_amplitude`` (:func:`calibrate` with ``fit`` holding it): at the same steps,
+  the amplitude of that largest line, the model's (in ``e w_n^2``) times the sensor
+  scale (``sensor_scale``: given, or free), against the measured main line's amplitude
+  in the sensor's unit (:meth:`ballbal.rig.Record.features`' ``main_amplitude``). The
+  scale multiplies every model amplitude alike, so a parameter that does too (a
+  capacity ``eta`` that scales the chasing balls' force, say) cannot be told apart
+  from it by amplitudes alone: ``confounded_with`` in the estimates says so.
 - a transition speed (:func:`calibrate_transition`): the speed at which the balls
   stopped chasing round the track in a sweep up, against the model's
   :func:`stable_band_end`, the largest speed at which the model has a stable chasing
@@ -41,19 +49,25 @@ import numpy as np
 import polars as pl
 
 from . import _check
+from ._style import Summarised
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer
 from .options import Floquet, HarmonicBalance, PeriodicOptions
 from .rig import Record
 
 __all__ = ["Calibration", "calibrate", "CALIBRATABLE", "stable_band_end", "Transition",
-           "calibrate_transition"]
+           "calibrate_transition", "OilTransfer", "transfer_oils"]
 
 #: Parameters :func:`calibrate` can fit, with the range each is kept in.
 CALIBRATABLE: dict[str, tuple[float, float]] = {
     "zeta_b": (1e-6, 10.0), "zeta": (1e-6, 10.0), "mu": (1e-6, 0.99),
     "delta": (1.0, 1e4), "eta": (1e-3, 100.0), "natural_frequency_rpm": (1.0, 1e6),
+    "sensor_scale": (1e-12, 1e12),
 }
+#: What :func:`calibrate` fits at the non-synchronous steps.
+_FITTED = ("main_frequency", "main_amplitude")
+#: Correlation of two estimates beyond which the data cannot tell them apart.
+_CONFOUNDED = 0.99
 # The main frequency needs the orbit, not its multipliers.
 _DEFAULT_OPTIONS = PeriodicOptions(harmonic_balance=HarmonicBalance(N=8),
                                    floquet=Floquet(monodromy=False, hill=False))
@@ -66,7 +80,9 @@ class Calibration:
     ``model``: the balancer with the fitted values; ``natural_frequency_rpm``: the
     natural frequency used (fitted when asked). ``estimates``: one row per free
     parameter (``parameter``, ``value``, ``std_error``, ``ci_low``, ``ci_high`` at
-    ``level``, ``determined``). ``residuals``: one row per measured value used
+    ``level``, ``determined``, ``confounded_with``: the free parameters whose estimates
+    correlate with this one's beyond 0.99, which the data cannot tell apart from it,
+    or null). ``residuals``: one row per measured value used
     (``step``, ``speed_rpm``, ``quantity``, ``measured``, ``model``, ``residual``).
     ``dof``: degrees of freedom ``m - p``; ``scale``: the residuals' standard deviation
     ``s``; ``evaluations``: forward-model evaluations; ``message``: the optimiser's.
@@ -103,8 +119,9 @@ class Calibration:
                 f"<th>{100 * self.level:.0f} % interval</th><th>determined</th></tr>"
                 f"{rows}</table>")
 
-    def plot(self, ax: Any = None) -> Any:
-        """Measured against model, quantity by quantity, over the speed; returns the
+    def plot(self, ax: Any = None, quantity: str | None = None) -> Any:
+        """Measured against model over the speed for ``quantity`` (a value of the
+        residuals' ``quantity`` column; default the first fitted); returns the
         figure."""
         from .plot import _pyplot
 
@@ -113,11 +130,17 @@ class Calibration:
             fig, ax = plt.subplots(figsize=(5.5, 3.5), constrained_layout=True)
         else:
             fig = ax.figure
-        r = self.residuals.sort("speed_rpm")
+        known = list(dict.fromkeys(self.residuals["quantity"].to_list()))
+        q = known[0] if quantity is None else quantity
+        if q not in known:
+            raise ParameterError("quantity", f"{q!r:.40} was not fitted; choose from "
+                                 f"{', '.join(known)}", allowed=", ".join(known))
+        r = self.residuals.filter(pl.col("quantity") == q).sort("speed_rpm")
         ax.plot(r["speed_rpm"], r["measured"], "o", ms=4, label="measured")
         ax.plot(r["speed_rpm"], r["model"], "-", lw=1.2, label="model (fitted)")
         ax.set_xlabel("speed (rpm)")
-        ax.set_ylabel("main frequency (rpm)")
+        ax.set_ylabel("main frequency (rpm)" if q == "main_frequency_rpm"
+                      else "main line amplitude (sensor unit)")
         text = ", ".join(f"{p} = {v:.4g} ± {e:.2g}" for p, v, e in zip(
             self.estimates["parameter"], self.estimates["value"],
             self.estimates["std_error"], strict=True))
@@ -153,6 +176,8 @@ def calibrate(
     free: Sequence[str],
     *,
     natural_frequency_rpm: float,
+    fit: Sequence[str] = ("main_frequency",),
+    sensor_scale: float | None = None,
     pattern: str = "R-R",
     start: dict[str, float] | None = None,
     level: float = 0.95,
@@ -162,15 +187,23 @@ def calibrate(
     :class:`~ballbal.rig.Record` or its :meth:`~ballbal.rig.Record.features` table).
 
     ``free``: names from :data:`CALIBRATABLE`; ``eta`` moves every ball's ``eta``
-    together. ``natural_frequency_rpm``: the rig's natural frequency (the speed scale
-    ``Omega = speed / f_n``; its starting value when it is free). ``start``: starting
-    values (default: the model's). ``pattern``: the motion the non-synchronous steps are
-    fitted with. ``options``: the :class:`~ballbal.PeriodicOptions` of the forward model
-    (default ``N = 8`` harmonics, no multipliers). ``level``: the intervals' confidence level.
+    together; ``sensor_scale`` is the measured amplitude (in the features' ``unit``)
+    per model unit (``e``, ``e w_n`` or ``e w_n^2``). ``fit``: what is fitted at the
+    non-synchronous steps: ``"main_frequency"`` and/or ``"main_amplitude"`` (the
+    largest line's amplitude, model times the sensor scale: ``sensor_scale`` given, or
+    free). With both, each quantity's residuals are weighted by their own scatter
+    (estimated from a first fit, then the fit repeated). ``natural_frequency_rpm``: the
+    rig's natural frequency (the speed scale ``Omega = speed / f_n``; its starting
+    value when it is free). ``start``: starting values (default: the model's; a free
+    ``sensor_scale`` starts at the least-squares scale of the starting model).
+    ``pattern``: the motion the non-synchronous steps are fitted with. ``options``: the
+    :class:`~ballbal.PeriodicOptions` of the forward model (default ``N = 8``
+    harmonics, no multipliers). ``level``: the intervals' confidence level.
 
     Raises :class:`~ballbal.exceptions.ParameterError` for an unknown or repeated free
-    parameter, fewer usable steps than free parameters plus one, and a forward model
-    that finds no solution at a step (naming the step).
+    parameter or fitted quantity, a sensor scale neither given nor free where the
+    amplitude is fitted, fewer usable values than free parameters plus one, and a
+    forward model that finds no solution at a step (naming the step).
     """
     from scipy import optimize, stats
 
@@ -186,6 +219,21 @@ def calibrate(
                                  f"{', '.join(CALIBRATABLE)}", allowed=", ".join(CALIBRATABLE))
     if len(set(names)) != len(names):
         raise ParameterError("free", f"a parameter is named twice: {names}")
+    quantities = [_check.string("fit", q) for q in _check.sequence("fit", fit)]
+    if not quantities or len(set(quantities)) != len(quantities) or any(
+            q not in _FITTED for q in quantities):
+        raise ParameterError("fit", f"must name each of {', '.join(_FITTED)} at most once "
+                             f"(at least one), got {quantities}", allowed=", ".join(_FITTED))
+    fits_amp = "main_amplitude" in quantities
+    if "sensor_scale" in names and not fits_amp:
+        raise ParameterError("free", "sensor_scale is free but only the main frequency is "
+                             "fitted, which it does not change: add 'main_amplitude' to fit")
+    scale0: float | None = None
+    if sensor_scale is not None:
+        scale0 = _check.real("sensor_scale", sensor_scale, *CALIBRATABLE["sensor_scale"])
+    elif fits_amp and "sensor_scale" not in names:
+        raise ParameterError("sensor_scale", "fitting main_amplitude needs the sensor scale: "
+                             "give it, or free it (free=[..., 'sensor_scale'])")
     fn0 = _check.real("natural_frequency_rpm", natural_frequency_rpm, 0.0, math.inf,
                       lo_open=True, hi_open=True)
     lvl = _check.real("level", level, 0.5, 1.0, hi_open=True)
@@ -195,47 +243,41 @@ def calibrate(
     for k in starts:
         if k not in names:
             raise ParameterError("start", f"{k!r:.40} is not a free parameter ({names})")
+    if fits_amp and "main_amplitude" not in ft.columns:
+        raise ParameterError("features", "the table lacks the column 'main_amplitude' "
+                             "(give Record.features()'s table)")
 
     use = ft.filter((pl.col("status") == "ok") & pl.col("synchronous").not_())
-    if use.height < len(names) + 1:
-        raise ParameterError("features", f"{use.height} non-synchronous steps measured; "
-                             f"fitting {len(names)} parameters needs at least {len(names) + 1}")
+    n_values = use.height * len(quantities)
+    if n_values < len(names) + 1:
+        raise ParameterError("features", f"{use.height} non-synchronous steps measured "
+                             f"({n_values} values); fitting {len(names)} parameters needs "
+                             f"at least {len(names) + 1} values")
     speeds = use["speed_rpm"].to_numpy()
-    measured = use["main_frequency_rpm"].to_numpy()
+    measured_q = {"main_frequency": use["main_frequency_rpm"].to_numpy()}
+    if fits_amp:
+        measured_q["main_amplitude"] = use["main_amplitude"].to_numpy()
+    measured = np.concatenate([measured_q[q] for q in quantities])
     steps = use["step"].to_list() if "step" in use.columns else list(range(use.height))
-
-    def value0(name: str) -> float:
-        if name in starts:
-            return float(starts[name])
-        if name == "natural_frequency_rpm":
-            return fn0
-        if name == "eta":
-            return float(np.mean(model.eta))
-        return float(np.mean(getattr(model, name)))
-
-    x0 = np.array([value0(n) for n in names])
-    lo = np.array([CALIBRATABLE[n][0] for n in names])
-    hi = np.array([CALIBRATABLE[n][1] for n in names])
-    for n, v, a, b in zip(names, x0, lo, hi, strict=True):
-        if not a <= v <= b:
-            raise ParameterError(n, f"start value {v} outside [{a}, {b}]", allowed=f"[{a}, {b}]")
     guesses: dict[int, Any] = {}
     count = [0]
 
-    def at(x: np.ndarray) -> tuple[Balancer, float]:
+    def at(x: np.ndarray) -> tuple[Balancer, float, float | None]:
         changes: dict[str, Any] = {}
-        fn = fn0
+        fn, scale = fn0, scale0
         for n, v in zip(names, x, strict=True):
             if n == "natural_frequency_rpm":
                 fn = float(v)
+            elif n == "sensor_scale":
+                scale = float(v)
             else:
                 changes[n] = float(v)
-        return model.replace(**changes), fn
+        return model.replace(**changes), fn, scale
 
-    def forward(x: np.ndarray) -> np.ndarray:
+    def lines_at(b: Balancer, fn: float) -> tuple[np.ndarray, np.ndarray]:
+        """The main line's frequency (rpm) and amplitude (model units) per step."""
         count[0] += 1
-        b, fn = at(x)
-        out = np.empty(speeds.size)
+        freq, amp = np.empty(speeds.size), np.empty(speeds.size)
         for i, sp in enumerate(speeds):
             sol = periodic(b.replace(Omega=float(sp / fn)), pattern, options=opts,
                            guess=guesses.get(i))
@@ -246,38 +288,102 @@ def calibrate(
                                      f"step {steps[i]} ({sp:.1f} rpm, Omega "
                                      f"{sp / fn:.4f}): {sol.status}")
             guesses[i] = sol
-            lines = line_spectrum(sol, "acceleration")
-            out[i] = abs(float(lines.sort("amplitude", descending=True)["frequency"][0])) * fn
-        return out
+            top = line_spectrum(sol, "acceleration").sort("amplitude", descending=True)
+            freq[i] = abs(float(top["frequency"][0])) * fn
+            amp[i] = float(top["amplitude"][0])
+        return freq, amp
 
-    res = optimize.least_squares(lambda x: forward(x) - measured, x0, bounds=(lo, hi),
-                                 x_scale=np.abs(x0), diff_step=1e-6, method="trf")
-    m, p = speeds.size, len(names)
+    def forward(x: np.ndarray) -> np.ndarray:
+        b, fn, scale = at(x)
+        freq, amp = lines_at(b, fn)
+        got = {"main_frequency": freq}
+        if fits_amp:
+            got["main_amplitude"] = amp * (1.0 if scale is None else scale)
+        return np.concatenate([got[q] for q in quantities])
+
+    def value0(name: str) -> float:
+        if name in starts:
+            return float(starts[name])
+        if name == "natural_frequency_rpm":
+            return fn0
+        if name == "sensor_scale":
+            # the starting model's least-squares scale: measured ~ scale * model
+            _, amp = lines_at(*at_start()[:2])
+            m_amp = measured_q["main_amplitude"]
+            return float(np.dot(amp, m_amp) / np.dot(amp, amp))
+        if name == "eta":
+            return float(np.mean(model.eta))
+        return float(np.mean(getattr(model, name)))
+
+    def at_start() -> tuple[Balancer, float, float | None]:
+        others = {n: v for n, v in starts.items() if n != "sensor_scale"}
+        b = model.replace(**{k: v for k, v in others.items()
+                             if k != "natural_frequency_rpm"})
+        return b, float(others.get("natural_frequency_rpm", fn0)), None
+
+    x0 = np.array([value0(n) for n in names])
+    lo = np.array([CALIBRATABLE[n][0] for n in names])
+    hi = np.array([CALIBRATABLE[n][1] for n in names])
+    for n, v, a, b in zip(names, x0, lo, hi, strict=True):
+        if not a <= v <= b:
+            raise ParameterError(n, f"start value {v} outside [{a}, {b}]", allowed=f"[{a}, {b}]")
+    weight = np.ones(measured.size)
+
+    def solve(x_start: np.ndarray) -> Any:
+        return optimize.least_squares(lambda x: (forward(x) - measured) * weight, x_start,
+                                      bounds=(lo, hi), x_scale=np.abs(x_start),
+                                      diff_step=1e-6, method="trf")
+
+    res = solve(x0)
+    m, p = measured.size, len(names)
     dof = m - p
+    if len(quantities) > 1:
+        # Each quantity in its own unit: weigh it by its scatter about the first fit
+        # (its share of the degrees of freedom), and fit again from there.
+        parts = np.split(res.fun, len(quantities))
+        for qi, part in enumerate(parts):
+            share = max(part.size * dof / m, 1.0)
+            sd = math.sqrt(float(np.sum(part**2)) / share)
+            weight[qi * speeds.size:(qi + 1) * speeds.size] = 1.0 / sd if sd > 0 else 1.0
+        res = solve(res.x)
     rss = float(np.sum(res.fun**2))
     s = math.sqrt(rss / dof)
     J = res.jac
     sv = np.linalg.svd(J * np.abs(res.x), compute_uv=False)
-    rank_ok = sv.size and sv[-1] > 1e-8 * sv[0]
+    rank_ok = bool(sv.size and sv[-1] > 1e-8 * sv[0])
+    corr = np.full((p, p), np.nan)
     if rank_ok:
         cov = s**2 * np.linalg.inv(J.T @ J)
         se = np.sqrt(np.diag(cov))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            corr = cov / np.outer(se, se)
     else:
         se = np.full(p, np.inf)
     tq = float(stats.t.ppf(0.5 + lvl / 2, dof))
     rows = []
-    for n, v, e in zip(names, res.x, se, strict=True):
+    for j, (n, v, e) in enumerate(zip(names, res.x, se, strict=True)):
+        # the data tell the two apart only through the difference of their effects
+        twins = [names[k] for k in range(p) if k != j and
+                 (not rank_ok or abs(corr[j, k]) > _CONFOUNDED)]
         rows.append({"parameter": n, "value": float(v), "std_error": float(e),
                      "ci_low": float(v - tq * e), "ci_high": float(v + tq * e),
-                     "determined": bool(rank_ok and math.isfinite(e) and tq * e < abs(v))})
-    fitted, fn = at(res.x)
-    model_values = res.fun + measured
-    resid = pl.DataFrame({"step": pl.Series(steps, dtype=pl.Int64), "speed_rpm": speeds,
-                          "quantity": ["main_frequency_rpm"] * m, "measured": measured,
-                          "model": model_values, "residual": res.fun})
+                     "determined": bool(rank_ok and math.isfinite(e) and tq * e < abs(v)),
+                     "confounded_with": ", ".join(twins) or None})
+    fitted, fn, _ = at(res.x)
+    model_values = res.fun / weight + measured
+    labels = {"main_frequency": "main_frequency_rpm", "main_amplitude": "main_amplitude"}
+    resid = pl.DataFrame({"step": pl.Series(steps * len(quantities), dtype=pl.Int64),
+                          "speed_rpm": np.tile(speeds, len(quantities)),
+                          "quantity": [labels[q] for q in quantities for _ in speeds],
+                          "measured": measured, "model": model_values,
+                          "residual": model_values - measured})
+    schema = {"parameter": pl.String, "value": pl.Float64, "std_error": pl.Float64,
+              "ci_low": pl.Float64, "ci_high": pl.Float64, "determined": pl.Boolean,
+              "confounded_with": pl.String}
     return Calibration(model=fitted, natural_frequency_rpm=fn,
-                       estimates=pl.DataFrame(rows), residuals=resid, level=lvl, dof=dof,
-                       scale=s, evaluations=count[0], message=str(res.message))
+                       estimates=pl.DataFrame(rows, schema=schema), residuals=resid,
+                       level=lvl, dof=dof, scale=s, evaluations=count[0],
+                       message=str(res.message))
 
 
 def stable_band_end(model: Balancer, pattern: str = "R-R", *,
@@ -409,3 +515,151 @@ def calibrate_transition(
     low = min(known) if len(known) == 2 else None
     high = max(known) if len(known) == 2 else None
     return Transition(parameter, sp, du, value, low, high, "ok", reach)
+
+
+# --- one calibration, many oils: the viscosity -> zeta_b law put to the test -----------
+
+#: Most cases (oils, pads) :func:`transfer_oils` takes (each a few band-end searches).
+MAX_OIL_CASES = 50
+
+
+@dataclass(frozen=True, repr=False)
+class OilTransfer(Summarised):
+    """What :func:`transfer_oils` found. ``geometric_factor``: ``kappa`` of
+    :func:`ballbal.oil.track_damping`, from the reference case's calibrated ``zeta_b``;
+    ``reference``: that case's row. ``table``: one row per case: ``case``,
+    ``viscosity_cP``, ``natural_frequency_rpm``, ``zeta``, ``measured_rpm``,
+    ``calibrated_zeta_b`` (the ``zeta_b`` that puts the model's band end at the measured
+    speed, :func:`calibrate_transition`; null where no ``zeta_b`` in the bracket does),
+    ``calibrated_low`` / ``calibrated_high`` (at the measured speed -+ its uncertainty),
+    ``status`` (``"ok"`` or ``"unreachable"``), ``law_zeta_b`` (the law's prediction
+    with the reference's ``kappa``), ``ratio`` (calibrated over predicted, 1 where the
+    law transfers), ``predicted_rpm`` (the model's band end at the law's ``zeta_b``;
+    null where the model has no stable chasing band) and ``residual_rpm`` (predicted
+    minus measured)."""
+
+    table: pl.DataFrame
+    geometric_factor: float
+    reference: int
+
+    def _summary(self) -> tuple[str, list[tuple[str, Any]]]:
+        t = self.table
+        res = [r for r in t["residual_rpm"].to_list() if r is not None]
+        worst = max((abs(r) for r in res), default=float("nan"))
+        head = (f"OilTransfer(kappa={self.geometric_factor:.4g} from "
+                f"{t['case'][self.reference]!r}; {t.height} cases, worst residual "
+                f"{worst:.0f} rpm)")
+        rows: list[tuple[str, Any]] = [("geometric factor kappa", self.geometric_factor)]
+        for r in t.iter_rows(named=True):
+            pred = "-" if r["predicted_rpm"] is None else f"{r['predicted_rpm']:.0f}"
+            rows.append((f"{r['case']}: measured / predicted rpm",
+                         f"{r['measured_rpm']:.0f} / {pred}"))
+        return head, rows
+
+    def plot(self, ax: Any = None) -> Any:
+        """Calibrated and predicted ``zeta_b`` against the viscosity (left axis), case by
+        case; returns the axes."""
+        from ._style import new_axes
+
+        ax = new_axes(ax)
+        t = self.table
+        ax.plot(t["viscosity_cP"], t["law_zeta_b"], "s", mfc="none", label="law (predicted)")
+        ok = t.filter(pl.col("calibrated_zeta_b").is_not_null())
+        lo = (ok["calibrated_zeta_b"] - ok["calibrated_low"].fill_null(ok["calibrated_zeta_b"]))
+        hi = (ok["calibrated_high"].fill_null(ok["calibrated_zeta_b"]) - ok["calibrated_zeta_b"])
+        ax.errorbar(ok["viscosity_cP"], ok["calibrated_zeta_b"],
+                    yerr=[lo.abs().to_numpy(), hi.abs().to_numpy()], fmt="o",
+                    label="calibrated from the transition")
+        for r in t.iter_rows(named=True):
+            ax.annotate(r["case"], (r["viscosity_cP"], r["law_zeta_b"]), fontsize=7,
+                        xytext=(3, 3), textcoords="offset points")
+        ax.set_xlabel("oil viscosity (cP)")
+        ax.set_ylabel("zeta_b")
+        ax.legend(frameon=False)
+        return ax
+
+
+def transfer_oils(
+    model: Balancer,
+    cases: pl.DataFrame,
+    *,
+    reference: int,
+    ball_radius: float,
+    ball_mass: float,
+    channel_radius: float | None = None,
+    bracket: tuple[float, float] = (0.01, 1.0),
+    pattern: str = "R-R",
+    Omega: Any = (1.0, 2.5, 0.01),  # noqa: N803 - the model's symbol
+) -> OilTransfer:
+    """Calibrate the viscosity -> ``zeta_b`` law (:mod:`ballbal.oil`) on one measured
+    transition and transfer it to the others.
+
+    ``cases``: one row per experiment, with columns ``case`` (a name),
+    ``viscosity_cP``, ``speed_rpm`` (where a sweep up left the chasing motion),
+    ``natural_frequency_rpm`` (the rig's, which the law's ``zeta_b`` depends on), and
+    optionally ``zeta`` (the support's damping in that experiment, default the
+    model's) and ``uncertainty_rpm`` (default 0). ``reference``: the row whose
+    calibrated ``zeta_b`` fixes the geometric factor. Per case, ``zeta_b`` is calibrated
+    (:func:`calibrate_transition` over ``bracket``) and predicted by the law, and the
+    model's band end at the predicted ``zeta_b`` (:func:`stable_band_end`) is compared
+    with the measured speed. The ball's ``ball_radius`` [m], ``ball_mass`` [kg] and the
+    track's ``channel_radius`` [m] (half its width; None: no wall factor) go to
+    :func:`ballbal.oil.track_damping`. At most :data:`MAX_OIL_CASES` cases."""
+    from .oil import CENTIPOISE, geometric_factor, track_damping
+
+    _balancer(model)
+    if not isinstance(cases, pl.DataFrame):
+        raise ParameterTypeError("cases", f"must be a polars DataFrame, got "
+                                 f"{type(cases).__name__}", value=cases)
+    need = {"case", "viscosity_cP", "speed_rpm", "natural_frequency_rpm"}
+    missing = need - set(cases.columns)
+    if missing:
+        raise ParameterError("cases", f"the table lacks the columns {sorted(missing)}")
+    if not 1 <= cases.height <= MAX_OIL_CASES:
+        raise ParameterError("cases", f"must hold 1 to {MAX_OIL_CASES} rows, got "
+                             f"{cases.height}", allowed=f"[1, {MAX_OIL_CASES}] rows")
+    ref = _check.integer("reference", reference, 0, cases.height - 1)
+    rows_in = list(cases.iter_rows(named=True))
+
+    def calibrated(r: dict[str, Any]) -> tuple[Balancer, Transition]:
+        zeta = r.get("zeta")
+        b = model if zeta is None else model.replace(zeta=float(zeta))
+        tr = calibrate_transition(
+            b, r["speed_rpm"], natural_frequency_rpm=r["natural_frequency_rpm"],
+            uncertainty_rpm=float(r.get("uncertainty_rpm") or 0.0), bracket=bracket,
+            pattern=pattern, Omega=Omega)
+        return b, tr
+
+    fits = [calibrated(r) for r in rows_in]
+    ref_tr = fits[ref][1]
+    if ref_tr.value is None:
+        raise ParameterError("reference", f"the reference case {rows_in[ref]['case']!r} "
+                             f"cannot be calibrated: its transition is {ref_tr.status} "
+                             f"(band ends {ref_tr.reach_rpm} rpm over the bracket)")
+    kappa = geometric_factor(ref_tr.value, rows_in[ref]["viscosity_cP"] * CENTIPOISE,
+                             natural_frequency_rpm=rows_in[ref]["natural_frequency_rpm"],
+                             ball_radius=ball_radius, ball_mass=ball_mass,
+                             channel_radius=channel_radius)
+    out = []
+    for r, (b, tr) in zip(rows_in, fits, strict=True):
+        fn = float(r["natural_frequency_rpm"])
+        law = track_damping(r["viscosity_cP"] * CENTIPOISE, natural_frequency_rpm=fn,
+                            geometric_factor=kappa, ball_radius=ball_radius,
+                            ball_mass=ball_mass, channel_radius=channel_radius)
+        end = stable_band_end(b.replace(zeta_b=law), pattern, Omega=Omega)
+        pred = None if end is None else end * fn
+        out.append({"case": str(r["case"]), "viscosity_cP": float(r["viscosity_cP"]),
+                    "natural_frequency_rpm": fn, "zeta": float(np.mean(b.zeta)),
+                    "measured_rpm": float(r["speed_rpm"]), "calibrated_zeta_b": tr.value,
+                    "calibrated_low": tr.low, "calibrated_high": tr.high,
+                    "status": tr.status, "law_zeta_b": law,
+                    "ratio": None if tr.value is None else tr.value / law,
+                    "predicted_rpm": pred,
+                    "residual_rpm": None if pred is None else pred - float(r["speed_rpm"])})
+    schema = {"case": pl.String, "viscosity_cP": pl.Float64,
+              "natural_frequency_rpm": pl.Float64, "zeta": pl.Float64,
+              "measured_rpm": pl.Float64, "calibrated_zeta_b": pl.Float64,
+              "calibrated_low": pl.Float64, "calibrated_high": pl.Float64,
+              "status": pl.String, "law_zeta_b": pl.Float64, "ratio": pl.Float64,
+              "predicted_rpm": pl.Float64, "residual_rpm": pl.Float64}
+    return OilTransfer(pl.DataFrame(out, schema=schema), kappa, ref)

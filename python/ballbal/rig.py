@@ -109,9 +109,16 @@ def _columns_of(source: Any) -> tuple[dict[str, Any], str]:
         if low.endswith(".npz"):
             with np.load(path, allow_pickle=False) as z:
                 return {k: z[k] for k in z.files}, os.path.basename(path)
-        raise ParameterError("source", "reads .csv and .npz files (or a polars DataFrame "
-                             f"or a mapping of arrays), got {os.path.basename(path)!r}",
-                             allowed=".csv, .npz")
+        if low.endswith(".mat"):
+            return _read_mat(path), os.path.basename(path)
+        if low.endswith((".h5", ".hdf5")):
+            return _read_hdf5(path), os.path.basename(path)
+        if low.endswith(".tdms"):
+            return _read_tdms(path), os.path.basename(path)
+        raise ParameterError("source", "reads .csv, .npz, .mat, .h5/.hdf5 and .tdms files "
+                             "(or a polars DataFrame or a mapping of arrays), got "
+                             f"{os.path.basename(path)!r}",
+                             allowed=".csv, .npz, .mat, .h5, .hdf5, .tdms")
     if isinstance(source, pl.DataFrame):
         return {c: source[c] for c in source.columns}, "DataFrame"
     if isinstance(source, Mapping):
@@ -119,6 +126,59 @@ def _columns_of(source: Any) -> tuple[dict[str, Any], str]:
     raise ParameterTypeError("source", "must be a .csv or .npz path, a polars DataFrame or "
                              f"a mapping of column names to arrays, got {type(source).__name__}",
                              value=source)
+
+
+def _read_mat(path: str) -> dict[str, Any]:
+    """A MATLAB (v4 to v7.2) file's numeric vectors, by variable name (scipy.io)."""
+    from scipy import io
+
+    try:
+        raw = io.loadmat(path, squeeze_me=True)
+    except (ValueError, NotImplementedError) as e:  # v7.3 is HDF5: read it as .h5
+        raise ParameterError("source", f"cannot read {os.path.basename(path)!r} as a "
+                             f"MATLAB file ({e}); a v7.3 file is HDF5: rename it .h5") from e
+    return {k: v for k, v in raw.items() if not k.startswith("__")
+            and isinstance(v, np.ndarray) and v.ndim == 1 and v.dtype.kind in "iuf"}
+
+
+def _read_hdf5(path: str) -> dict[str, Any]:
+    """An HDF5 file's one-dimensional numeric datasets, by path without the leading
+    slash (``group/name``), through h5py (the ``hdf5`` extra)."""
+    try:
+        import h5py
+    except ImportError as e:
+        raise ImportError("reading HDF5 needs h5py: pip install 'ballbal[hdf5]'") from e
+    out: dict[str, Any] = {}
+    with h5py.File(path, "r") as f:
+        def take(name: str, obj: Any) -> None:
+            if (isinstance(obj, h5py.Dataset) and obj.ndim == 1
+                    and obj.dtype.kind in "iuf" and obj.size <= MAX_RECORD_SAMPLES):
+                out[name] = obj[()]
+        f.visititems(take)
+    return out
+
+
+def _read_tdms(path: str) -> dict[str, Any]:
+    """A TDMS file's numeric channels as ``group/channel`` (and the bare channel name
+    where it is unique), through npTDMS (the ``tdms`` extra)."""
+    try:
+        import nptdms
+    except ImportError as e:
+        raise ImportError("reading TDMS needs npTDMS: pip install 'ballbal[tdms]'") from e
+    out: dict[str, Any] = {}
+    names: dict[str, int] = {}
+    with nptdms.TdmsFile.open(path) as f:
+        for g in f.groups():
+            for c in g.channels():
+                data = c[:]
+                if data.dtype.kind in "iuf":
+                    out[f"{g.name}/{c.name}"] = data
+                    names[c.name] = names.get(c.name, 0) + 1
+    for key in list(out):
+        bare = key.split("/", 1)[1]
+        if names[bare] == 1:
+            out.setdefault(bare, out[key])
+    return out
 
 
 def _column(cols: dict[str, Any], name: str, what: str, n: int | None) -> np.ndarray:
@@ -199,6 +259,16 @@ def _refine_peak(t: np.ndarray, x: np.ndarray, f0: float, width: float) -> float
     return float(f)
 
 
+def _line_amplitude(t: np.ndarray, x: np.ndarray, f: float) -> float:
+    """The amplitude of a line at ``f`` (Hz) in ``x``: the Hann-windowed transform at
+    ``f`` over half the window's sum (exact for a pure cosine at ``f``, up to the
+    window's leakage from other lines). Noise adds to it only in quadrature, at the
+    level of one bin, unlike the RMS, which holds all the noise."""
+    w = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(t.size) / t.size)
+    return float(2.0 * abs(np.sum(w * x * np.exp(-2j * np.pi * f * (t - t.mean()))))
+                 / w.sum())
+
+
 def read_record(
     source: Any,
     *,
@@ -209,8 +279,12 @@ def read_record(
     pulses_per_revolution: int = 1,
     channels: Mapping[str, Sensor] | None = None,
 ) -> Record:
-    """Read a measured record: a ``.csv`` or ``.npz`` file, a polars DataFrame or a
-    mapping of column names to arrays.
+    """Read a measured record: a ``.csv`` or ``.npz`` file, a MATLAB ``.mat`` file (its
+    one-dimensional numeric variables), an HDF5 ``.h5``/``.hdf5`` file (its
+    one-dimensional numeric datasets as ``group/name``; needs h5py, the ``hdf5``
+    extra), a TDMS ``.tdms`` file (its channels as ``group/channel`` and by the
+    channel's name where unique; needs npTDMS, the ``tdms`` extra), a polars DataFrame
+    or a mapping of column names to arrays.
 
     ``time``: the time column, in seconds, strictly increasing (sampling may be
     uneven: steps are found on the samples as they are; spectra need an even step
@@ -427,6 +501,10 @@ class Record:
         - ``rms`` and ``peak`` in the sensor's unit (column ``unit``), and with
           ``eccentricity`` (metres) and ``natural_frequency_rpm`` also ``rms_model`` and
           ``peak_model`` in the model's units (``e``, ``e w_n`` or ``e w_n^2``);
+        - ``main_amplitude``: the main line's amplitude (the settled segment's Hann
+          transform at ``main_frequency_rpm``), in the sensor's unit, and
+          ``main_amplitude_model`` in the model's units as ``rms_model``; unlike the
+          RMS it holds the noise of one spectral bin only;
         - ``resolution_rpm``: the spectrum's bin width.
         """
         name = self._channel(channel)
@@ -455,7 +533,8 @@ class Record:
                                    "main_frequency_rpm": None, "main_order": None,
                                    "synchronous": None, "rms": None, "peak": None,
                                    "rms_model": None, "peak_model": None,
-                                   "resolution_rpm": None}
+                                   "resolution_rpm": None, "main_amplitude": None,
+                                   "main_amplitude_model": None}
             turns = sp / 60.0 * (ts[-1] - ts[0]) if ts.size > 1 else 0.0
             even = ts.size > 16 and np.ptp(np.diff(ts)) <= 0.01 * np.mean(np.diff(ts))
             if turns >= nrev and even:
@@ -472,14 +551,18 @@ class Record:
                 row.update(status="ok", main_frequency_rpm=f, main_order=f / sp,
                            synchronous=bool(abs(f - sp) <= max(sync * sp, 1.5 * bin_rpm)),
                            rms=rms, peak=peak, resolution_rpm=bin_rpm)
+                amp = _line_amplitude(ts - ts[0], x, f / 60.0)
+                row.update(main_amplitude=amp)
                 if scale is not None:
-                    row.update(rms_model=rms * scale, peak_model=peak * scale)
+                    row.update(rms_model=rms * scale, peak_model=peak * scale,
+                               main_amplitude_model=amp * scale)
             rows.append(row)
         schema = {"step": pl.Int64, "speed_rpm": pl.Float64, "status": pl.Utf8,
                   "main_frequency_rpm": pl.Float64, "main_order": pl.Float64,
                   "synchronous": pl.Boolean, "rms": pl.Float64, "peak": pl.Float64,
                   "rms_model": pl.Float64, "peak_model": pl.Float64,
-                  "resolution_rpm": pl.Float64}
+                  "resolution_rpm": pl.Float64, "main_amplitude": pl.Float64,
+                  "main_amplitude_model": pl.Float64}
         out = pl.DataFrame(rows, schema=schema)
         return out.with_columns(pl.lit(sensor.unit).alias("unit"),
                                 st["direction"].alias("direction"))
