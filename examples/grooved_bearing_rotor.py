@@ -1,4 +1,7 @@
-"""Yen's (2005) scenarios: a rigid rotor in a herringbone-grooved journal bearing.
+"""A rotor on a herringbone-grooved journal bearing
+================================================
+
+Yen's (2005) scenarios: a rigid rotor in a herringbone-grooved journal bearing.
 
 The seed (an NSC report, 2004) gives no geometry, so the numbers here are ours, chosen so
 that its qualitative regimes appear (the choice is printed):
