@@ -29,6 +29,9 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # MathJax served from the site itself, not a CDN: the pages' equations render
+    # offline (and in CI's browser test, which has no network).
+    "sphinx-mathjax-offline",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
     "matplotlib.sphinxext.plot_directive",

@@ -234,3 +234,30 @@ def test_pages_render_in_chromium(site: pathlib.Path, tmp_path: pathlib.Path, pa
     for src in parse(path).images:
         if internal(src):
             assert (path.parent / urllib.parse.unquote(src)).resolve().stat().st_size > 0, src
+
+
+def howto_blocks() -> list[tuple[str, int, str]]:
+    """(page, line, code) of every Python block of the how-to pages; a block whose first
+    line is ``# slow: ...`` is left to the reader."""
+    import re
+
+    out = []
+    for page in sorted((REPO / "docs" / "howto").glob("*.md")):
+        text = page.read_text(encoding="utf-8")
+        for m in re.finditer(r"```python\n(.*?)```", text, re.S):
+            if not m.group(1).startswith("# slow:"):
+                out.append((page.name, text[: m.start()].count("\n") + 1, m.group(1)))
+    return out
+
+
+@pytest.mark.parametrize("page, line, code", howto_blocks(),
+                         ids=[f"{p}:{n}" for p, n, _ in howto_blocks()])
+def test_howto_blocks_run_as_pasted(tmp_path: pathlib.Path, page: str, line: int,
+                                    code: str) -> None:
+    # A fresh interpreter in an empty directory: a block may use only what it defines.
+    script = tmp_path / "block.py"
+    script.write_text(code, encoding="utf-8")
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    p = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env,
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, f"{page}:{line} failed:\n{p.stderr[-2000:]}"
