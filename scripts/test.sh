@@ -38,7 +38,7 @@ stamp "install $(basename "$wheel") into a clean venv"
 "$work/venv/bin/pip" install -q "$wheel[test,plot,lint,progress,docs]"
 
 stamp "ruff, mypy, stubtest"
-"$work/venv/bin/ruff" check --no-cache python tests benchmarks examples scripts
+"$work/venv/bin/ruff" check --no-cache python tests benchmarks examples scripts docs
 # The source package, typed against the venv's numpy and polars; ballbal._native is read
 # from python/ballbal/_native.pyi (mypy cannot read the extension, so a missing stub fails).
 "$work/venv/bin/python" -m mypy --cache-dir "$work/mypy-cache" python/ballbal
