@@ -34,11 +34,11 @@ def main() -> None:
                 for _ in range(2):
                     t = time.perf_counter()
                     r = basins(m, n=n, options=BasinOptions(early_stop=early),
-                               execution=ballbal.Execution(threads=threads), orbits=False)
+                               threads=threads, orbits=False)
                     best = min(best, time.perf_counter() - t)
                 t = time.perf_counter()
                 basins(m, n=n, options=BasinOptions(early_stop=early),
-                       execution=ballbal.Execution(threads=threads))
+                       threads=threads)
                 link = time.perf_counter() - t - best
                 rate = n * n / best
                 print(f"{om:>6} {early!s:>6} {threads:>8} {rate:>9.0f} {1e3 / rate:>9.2f} "

@@ -42,7 +42,7 @@ How:
   ball count and the period doubling of each (``"R-R[-2,-2]"``, ``"O-R[0,-2]"``: every
   rotating ball two turns per period), on a 1-point grid at the point and, separately,
   on a small grid holding it (5 Omega values 0.05 apart times 3 eta values 0.1 apart;
-  ``eta[0]`` for unequal balls). A periodic attractor is *listed* by a scan when a row
+  ``eta1`` for unequal balls). A periodic attractor is *listed* by a scan when a row
   at the point has its type (pattern, with the windings for one that turns more than
   once per period, up to relabelling identical balls), ``stability == "stable"`` and
   ``|omega_row - omega_sim| <= max(3 trivial_error, 1e-3 omega)`` plus the simulation's
@@ -554,7 +554,7 @@ def scan_point(p: Point) -> ScanResult:
     oms = [p.Omega + d * 0.05 for d in (-2, -1, 0, 1, 2)]
     e0 = p.eta[0]
     etas = [e for e in (e0 - 0.1, e0, e0 + 0.1) if e > 0.05]
-    axis = "eta" if len(set(p.eta)) == 1 else "eta[0]"
+    axis = "eta" if len(set(p.eta)) == 1 else "eta1"
     grid = ballbal.scan(b, grid={"Omega": oms, axis: etas}, patterns=pats)
     seconds = time.perf_counter() - t
     at = grid.filter((pl.col("Omega") == p.Omega) & (pl.col(axis) == e0))

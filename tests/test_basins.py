@@ -6,6 +6,8 @@ Grids are small (a few dozen starts) and the physics lets t_end stay at Tien's (
 the R-R orbit's largest nontrivial multiplier 0.58 (Omega 1.35) per period of 17, so
 both are settled well within 1000; every start costs a few milliseconds."""
 
+from typing import Any
+
 import numpy as np
 import polars as pl
 import pytest
@@ -96,8 +98,8 @@ def test_classes_link_to_the_solutions_they_converge_to(maps):
 
 def test_same_table_on_one_and_two_threads():
     m = standard(1.2)
-    a = basins(m, samples=12, seed=3, execution=ballbal.Execution(threads=1, chunk=5))
-    b = basins(m, samples=12, seed=3, execution=ballbal.Execution(threads=2, chunk=4))
+    a = basins(m, samples=12, seed=3, threads=1, chunk=5)
+    b = basins(m, samples=12, seed=3, threads=2, chunk=4)
     assert a.table.equals(b.table)
     assert a.random and a.table["b1"].min() >= 0 and a.table["b1"].max() < 2 * np.pi
 
@@ -142,7 +144,7 @@ out = sys.argv[2] if len(sys.argv) > 2 else None
 print("ready", flush=True)
 with warnings.catch_warnings(record=True) as w:
     warnings.simplefilter("always")
-    r = basins(m, n=int(sys.argv[1]), execution=ballbal.Execution(threads=2, chunk=16, out=out))
+    r = basins(m, n=int(sys.argv[1]), threads=2, chunk=16, out=out)
 print("ROWS", r.table.height, "WARNED",
       sum(issubclass(x.category, ballbal.ScanInterrupted) for x in w),
       "INTERRUPTED", r.interrupted, "AT", time.monotonic(), flush=True)
@@ -196,11 +198,11 @@ def test_ctrl_c_keeps_chunks_on_disk_and_a_rerun_resumes(tmp_path):
     assert int(words[1]) == 16 * kept  # the table returned is what is on disk
     m = standard(1.2)
     before = {f: f.stat().st_mtime_ns for f in d.glob("chunk-*.parquet")}
-    resumed = basins(m, n=16, execution=ballbal.Execution(threads=2, chunk=16, out=d))
+    resumed = basins(m, n=16, threads=2, chunk=16, out=d)
     assert not resumed.interrupted
     # the kept chunks were not recomputed, and the table is the uninterrupted one
     assert {f: f.stat().st_mtime_ns for f in before} == before
-    whole = basins(m, n=16, execution=ballbal.Execution(threads=2, chunk=16))
+    whole = basins(m, n=16, threads=2, chunk=16)
     assert resumed.table.equals(whole.table)
 
 
@@ -211,30 +213,30 @@ def test_resume_from_a_directory_redoes_only_a_damaged_chunk(tmp_path):
     from ballbal.exceptions import ScanStoreError, ScanStoreWarning
 
     m = standard(1.35)
-    ex = ballbal.Execution(threads=2, chunk=4, out=tmp_path / "b")
-    full = basins(m, n=4, execution=ex)
+    ex: dict[str, Any] = {"threads": 2, "chunk": 4, "out": tmp_path / "b"}
+    full = basins(m, n=4, **ex)
     files = sorted((tmp_path / "b").glob("chunk-*.parquet"))
     assert len(files) == 4
     files[1].write_bytes(files[1].read_bytes()[:40])  # a crash mid-write, say
     before = {f: os.stat(f).st_mtime_ns for f in files if f != files[1]}
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        again = basins(m, n=4, execution=ex)
+        again = basins(m, n=4, **ex)
     assert any(issubclass(x.category, ScanStoreWarning) for x in w)
     assert again.table.equals(full.table)
     assert {f: os.stat(f).st_mtime_ns for f in before} == before
     with pytest.raises(ScanStoreError):
-        basins(m, n=5, execution=ex)
+        basins(m, n=5, **ex)
 
 
 def test_an_executor_gives_the_same_table():
     from concurrent.futures import ThreadPoolExecutor
 
     m = standard(1.2)
-    here = basins(m, samples=6, seed=5, execution=ballbal.Execution(threads=1))
+    here = basins(m, samples=6, seed=5, threads=1)
     with ThreadPoolExecutor(2) as ex:
         there = basins(m, samples=6, seed=5,
-                       execution=ballbal.Execution(chunk=2, executor=ex))
+                       chunk=2, executor=ex)
     assert there.table.equals(here.table)
 
 

@@ -190,7 +190,7 @@ def test_basins_checks_its_options_before_writing_out(tmp_path):
     were written."""
     out = tmp_path / "b"
     refused(lambda: basins(m2(), n=2, t_end=2e6,
-                           execution=ballbal.Execution(out=out)), "t_end")
+                           out=out), "t_end")
     assert not out.exists()
 
 

@@ -111,7 +111,7 @@ def test_what_is_not_dimensions_or_a_film_force_is_named() -> None:
 # --- groove study -----------------------------------------------------------------
 
 def test_groove_study_threads_are_capped_like_a_scans() -> None:
-    """threads=10**6 had no cap (a scan's Execution has MAX_THREADS). The eccentricity
+    """threads=10**6 had no cap (a scan's threads= has MAX_THREADS). The eccentricity
     is out of range too, so that the old code, which checked it first, failed at once
     naming that instead."""
     b = br.Bearing(model="short", length_ratio=0.5)

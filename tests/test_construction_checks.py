@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import ballbal
-from ballbal import Execution, Floquet, GuessSearch, HarmonicBalance, PeriodicOptions, ScanOptions
+from ballbal import Floquet, GuessSearch, HarmonicBalance, PeriodicOptions, ScanOptions
 from ballbal._branch import Continuation
 from ballbal._rotor import RotorImpulse
 from ballbal.basins import BasinOptions
@@ -37,7 +37,6 @@ BAD: list[tuple[str, Callable[[], Any], str]] = [
     ("max_tail", lambda: PeriodicOptions(max_tail=0.0), "max_tail"),
     ("scan max_closure", lambda: ScanOptions(max_closure=-1.0), "max_closure"),
     ("block", lambda: ScanOptions(block=0), "block"),
-    ("chunk", lambda: Execution(chunk=0), "chunk"),
     ("ds above ds_max", lambda: Continuation(ds=1.0), "ds"),
     ("grow", lambda: Continuation(grow=0.5), "grow"),
     ("window above t_end", lambda: BasinOptions(t_end=100.0, window=200.0), "window"),
@@ -101,7 +100,6 @@ def test_valid_objects_still_build() -> None:
     HarmonicBalance(N="auto", N_max=3)
     Floquet(method="magnus", hill_band=0.0)
     ScanOptions(block=1)
-    Execution(chunk=1)
     Continuation(ds=0.05)
     BasinOptions(t_end=100.0, window=100.0)
     RotorImpulse()

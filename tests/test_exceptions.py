@@ -21,7 +21,7 @@ from ballbal.exceptions import (
         ({"mu": 1.5}, "mu", "(0, 1)"),
         ({"zeta": -0.1}, "zeta", "[0, inf)"),
         ({"delta": 0.0}, "delta", "(0, inf)"),
-        ({"eta": (1.0, -2.0)}, "eta[1]", "(0, inf)"),
+        ({"eta": (1.0, -2.0)}, "eta2", "(0, inf)"),
     ],
 )
 def test_core_range_error_carries_parameter_and_range(changes, parameter, allowed):

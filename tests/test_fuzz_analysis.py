@@ -76,17 +76,16 @@ def built(cls: Any, v: Any) -> Any:
     """``cls(**v)`` when ``v`` is a dict of keywords (a failure to build is then the
     result, checked like any other), else ``v`` itself."""
     return check(cls, **v) if isinstance(v, dict) else v
-THREADS = st.one_of(st.none(), st.just(bb.Execution(threads=1)),
-                    st.just(bb.Execution(threads=1, chunk=2)), BAD)
+CHUNK = st.one_of(st.none(), st.just(2), count(1, 3), BAD)
 
 
 @FUZZ
 @given(MODEL2, kwargs(b1=LISTS, b2=LISTS, n=count(1, 3), samples=count(1, 4), seed=SEED,
                       t_end=num(1, 6), settle_check=st.one_of(st.booleans(), BAD),
-                      options=OPTIONS, execution=THREADS))
+                      options=OPTIONS, chunk=CHUNK, threads=st.one_of(st.just(1), BAD)))
 def test_basins(model: Any, kw: dict[str, Any]) -> None:
     kw.setdefault("t_end", 4.0)
-    kw.setdefault("execution", bb.Execution(threads=1))
+    kw.setdefault("threads", 1)
     kw["options"] = built(BasinOptions, kw.get("options") or {"window": 2.0})
     r = check(basins, model, **kw)
     if isinstance(r, bb.basins.Basins):
@@ -102,7 +101,7 @@ def test_basins(model: Any, kw: dict[str, Any]) -> None:
 @given(SEED, st.integers(1, 3))
 def test_basins_seed(seed: Any, samples: Any) -> None:
     r = check(basins, bb.Balancer(eta=(0.7, 0.7)), samples=samples, seed=seed, t_end=2.0,
-              options=BasinOptions(window=1.0), execution=bb.Execution(threads=1))
+              options=BasinOptions(window=1.0), threads=1)
     if isinstance(r, bb.basins.Basins):
         assert r.random and r.table.height == samples
 
@@ -110,7 +109,7 @@ def test_basins_seed(seed: Any, samples: Any) -> None:
 @cache
 def small_basins() -> bb.basins.Basins:
     return basins(bb.Balancer(eta=(0.7, 0.7), Omega=1.35), n=2, t_end=4.0,
-                  options=BasinOptions(window=2.0), execution=bb.Execution(threads=1))
+                  options=BasinOptions(window=2.0), threads=1)
 
 
 @FEW
@@ -164,8 +163,8 @@ def test_residual_imbalance(eta: Any, angles: Any) -> None:
 
 DISK_UNITS = st.builds(DiskUnits, st.floats(0.3, 1.5), st.floats(0.05, 0.5), st.floats(1.0, 3.0))
 PARAMETERS = sometimes(
-    st.sampled_from(["Omega", "eta", "eta[1]", "zeta", "zeta_b", "mu", "delta"]),
-    st.one_of(st.sampled_from(["eta[9]", "springs", "m0", "omega0", "nope", ""]), BAD))
+    st.sampled_from(["Omega", "eta", "eta2", "zeta", "zeta_b", "mu", "delta"]),
+    st.one_of(st.sampled_from(["eta10", "springs", "m0", "omega0", "nope", ""]), BAD))
 #: Valid ranges hold the models' values of the parameters above (0.05 to 1.2).
 RANGE = sometimes(st.tuples(st.floats(0.01, 0.04), num(1.3, 2.0)),
                   st.one_of(st.just((2.0, 1.0)), st.just((1.0, 1.0, 2.0)), st.just("ab"),
@@ -187,7 +186,7 @@ CONTINUATION = sometimes(kwargs(
     direction=st.one_of(st.sampled_from(["forward", "backward", "both", "up"]), BAD,
                         st.just(np.array([1, 2])))))
 def test_equilibrium_branch(model: Any, parameter: Any, kw: dict[str, Any]) -> None:
-    TYPED.update(["eta[9]", "nope", "", "springs", "m0", "omega0"])
+    TYPED.update(["eta10", "nope", "", "springs", "m0", "omega0"])
     kw.setdefault("range", (0.01, 1.8))
     kw["options"] = built(Continuation, kw.get("options", {}))
     check(equilibrium_branch, model, parameter, **kw)
@@ -211,7 +210,7 @@ BRANCH = sometimes(st.just("branch"), BAD)
 @given(BRANCH, EVENT, PARAMETERS, RANGE, CONTINUATION)
 def test_equilibrium_switch_and_curve(branch: Any, event: Any, parameter2: Any, rng: Any,
                                       options: Any) -> None:
-    TYPED.update(["eta[9]", "nope", "", "springs", "m0", "omega0"])
+    TYPED.update(["eta10", "nope", "", "springs", "m0", "omega0"])
     br = together_branch() if branch == "branch" else branch
     assert br is branch or br.events.height >= 2
     check(switch_equilibrium, br, event)
@@ -246,7 +245,7 @@ PERIODIC_OPTIONS = st.one_of(st.none(), st.just(POPTS), BAD)
     range=RANGE, options=CONTINUATION, N=st.one_of(count(1, 4), st.just(300)),
     periodic_options=PERIODIC_OPTIONS, min_omega=num(1e-4, 0.1), event_tol=num(1e-9, 1e-3)))
 def test_periodic_branch(start: Any, parameter: Any, kw: dict[str, Any]) -> None:
-    TYPED.update(["eta[9]", "nope", "", "springs", "m0", "omega0"])
+    TYPED.update(["eta10", "nope", "", "springs", "m0", "omega0"])
     if start == "solution":
         start = rr_solution()
     elif start == "failed":
@@ -263,7 +262,7 @@ def test_periodic_branch(start: Any, parameter: Any, kw: dict[str, Any]) -> None
     range=RANGE, range1=st.one_of(st.none(), RANGE), options=CONTINUATION,
     periodic_options=PERIODIC_OPTIONS, locate_tol=num(1e-10, 1e-4)))
 def test_periodic_curve(branch: Any, event: Any, parameter2: Any, kw: dict[str, Any]) -> None:
-    TYPED.update(["eta[9]", "nope", "", "springs", "m0", "omega0"])
+    TYPED.update(["eta10", "nope", "", "springs", "m0", "omega0"])
     br = snake() if branch == "branch" else branch
     kw.setdefault("range", (0.8, 1.2))
     kw["options"] = built(Continuation, kw.get("options", {"max_points": 4}))
@@ -277,7 +276,7 @@ def test_periodic_curve(branch: Any, event: Any, parameter2: Any, kw: dict[str, 
                                          st.just(np.array([1]))),
     event=EVENT, model=MODEL, amplitude=num(1e-3, 0.1), N=st.one_of(count(1, 4), BAD)))
 def test_switch(what: str, bad: Any, kw: dict[str, Any]) -> None:
-    TYPED.update(["eta[9]", "nope", "", "springs", "m0", "omega0"])
+    TYPED.update(["eta10", "nope", "", "springs", "m0", "omega0"])
     solution = {"periodic": rr_solution, "equilibrium": lambda: bb.equilibria(
         bb.Balancer())[0], "branch": together_branch, "bad": lambda: bad}[what]()
     kw.setdefault("options", POPTS)

@@ -32,7 +32,7 @@ import ballbal as bb
 from ballbal.exceptions import BallbalError, ParameterError
 
 #: Every name a ParameterError may carry: the public functions' parameters, the model's
-#: fields and effect keys, scan axes (also indexed: ``eta[1]``).
+#: fields and effect keys, scan axes (also one ball's: ``eta2``).
 NAMES = {
     # models
     "mu", "zeta", "zeta_b", "delta", "Omega", "eta", "balancer", "model", "scene",
@@ -69,7 +69,7 @@ NAMES = {
 
 
 def known_parameter(name: str) -> bool:
-    base = re.sub(r"\[\d+\]$", "", name)
+    base = re.sub(r"^(eta|zeta_b)[1-9]\d*$", r"\1", name)  # one ball's: eta1, zeta_b2
     if base in NAMES:
         return True
     # An unknown key or axis the caller typed is named as typed.
@@ -345,7 +345,7 @@ GRID_VALUES = st.one_of(
     st.lists(st.floats(0.5, 2.0), min_size=1, max_size=2),
     st.sampled_from(["1.0:1.2:0.1", "1:2", "a:b:c", "2:1:0.1", "1:1:0", "0:1e300:1e-300", ""]),
     st.tuples(num(0.5, 2), num(0.5, 2), num(0.05, 1)), BAD, st.just([]))
-GRID_NAMES = st.sampled_from(["Omega", "eta", "zeta", "mu", "eta[0]", "eta[7]", "zeta_b[1]",
+GRID_NAMES = st.sampled_from(["Omega", "eta", "zeta", "mu", "eta1", "eta8", "zeta_b2",
                               "springs", "j_t", "Omgea", "delta"])
 
 
@@ -359,7 +359,7 @@ GRID_NAMES = st.sampled_from(["Omega", "eta", "zeta", "mu", "eta[0]", "eta[7]", 
     max_tail=num(0.01, 1), hill=st.one_of(st.booleans(), BAD),
     out=st.one_of(st.none(), st.sampled_from(["", 3, b"x"]))))
 def test_scan(model: Any, axes: dict[str, Any], kw: dict[str, Any]) -> None:
-    TYPED.update(["Omgea", "eta[7]", "zeta_b[1]", "springs", "j_t"])
+    TYPED.update(["Omgea", "eta8", "zeta_b2", "springs", "j_t"])
     kw.setdefault("threads", 1)
     kw.update(settle=3.0, window=10.0)
     kw.setdefault("max_steps", 1000)
@@ -375,7 +375,7 @@ def test_scan(model: Any, axes: dict[str, Any], kw: dict[str, Any]) -> None:
 @given(MODEL, st.dictionaries(GRID_NAMES, st.one_of(
     st.lists(st.floats(0.5, 2.0), min_size=1, max_size=2), BAD, st.just([])), max_size=2))
 def test_balance_map(model: Any, axes: dict[str, Any]) -> None:
-    TYPED.update(["Omgea", "eta[0]", "eta[7]", "zeta_b[1]", "j_t"])
+    TYPED.update(["Omgea", "eta1", "eta8", "zeta_b2", "j_t"])
     check(bb.balance_map, model, **axes)
 
 

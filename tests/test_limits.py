@@ -75,7 +75,7 @@ def test_small_ball_counts_stay_exhaustive() -> None:
 def test_validate_checks_parameters_without_analysing(tmp_path) -> None:
     with pytest.raises(ParameterError) as e:
         Balancer(eta=(0.5, -0.5)).validate()
-    assert e.value.parameter == "eta[1]"
+    assert e.value.parameter == "eta2"
     with pytest.raises(ParameterError) as e:
         Balancer(mu=1.5).validate()
     assert e.value.parameter == "mu"

@@ -45,7 +45,7 @@ def periodic() -> ballbal.PeriodicSolution:
 
 @cache
 def periodic_branch() -> cont.Branch:
-    return cont.periodic_branch(periodic(), "eta[0]", range=(0.5, 1.5),
+    return cont.periodic_branch(periodic(), "eta1", range=(0.5, 1.5),
                                 options=cont.Continuation(max_points=25))
 
 
@@ -309,8 +309,8 @@ def test_every_registry_parameter_has_a_symbol() -> None:
         assert _style.symbol(name) != name, name
         assert _style.symbol(name).startswith("$"), name
         if p["per_ball"]:
-            # balls counted from 0 in names, from 1 as the coordinates b1, b2 are
-            assert re.search(r"_\{([a-z]+,)?1\}\$$", _style.symbol(f"{name}[0]")), name
+            # the first ball's name ends in 1 and so does its subscript, as b1's does
+            assert re.search(r"_\{([a-z]+,)?1\}\$$", _style.symbol(f"{name}1")), name
     # Omega and omega differ in more than case
     assert _style.label("Omega") == r"$\Omega$ ($\omega_n$)"
     assert _style.label("omega") == r"$\omega$ ($\omega_n$)"
@@ -368,7 +368,7 @@ def test_progress_counts_the_steps_of_the_long_loops(capsys: Any) -> None:
 
     cb = _Calls()
     r = ballbal.basins.basins(ballbal.Balancer(Omega=1.35), n=4, orbits=False,
-                              execution=ballbal.Execution(chunk=5, progress=cb))
+                              chunk=5, progress=cb)
     assert cb.calls and cb.calls[-1] == (16, 16) == (r.table.height, r.table.height)
     assert np.all(np.diff([done for done, _ in cb.calls]) > 0)
 
@@ -397,7 +397,7 @@ def test_progress_must_be_a_flag_or_a_callable() -> None:
 def test_every_label_is_valid_mathtext() -> None:
     # a malformed label raises only when drawn: draw them all
     fig, ax = plt.subplots()
-    names = [*_style.QUANTITIES, "eta[1]", "zeta_b[0]", "b3", "db2"]
+    names = [*_style.QUANTITIES, "eta2", "zeta_b1", "b3", "db2"]
     for i, name in enumerate(names):
         ax.text(0.0, i, _style.label(name))
     fig.canvas.draw()

@@ -14,7 +14,6 @@ import pytest
 
 import ballbal
 from ballbal import (
-    Execution,
     Floquet,
     GuessSearch,
     HarmonicBalance,
@@ -35,7 +34,8 @@ def test_options_are_frozen_and_checked_when_made():
                        (lambda: Floquet(hill=1), "hill"),  # type: ignore[arg-type]
                        (lambda: GuessSearch(seeds=1.5), "seeds"),  # type: ignore[arg-type]
                        (lambda: PeriodicOptions(floquet=None), "floquet"),  # type: ignore
-                       (lambda: Execution(out=3), "out")]:  # type: ignore[arg-type]
+                       (lambda: ballbal.scan(ballbal.Balancer(), Omega=[1.2],
+                                             out=3), "out")]:  # type: ignore[arg-type]
         with pytest.raises(ParameterTypeError) as e:
             make()
         assert e.value.parameter == name
@@ -168,7 +168,7 @@ def test_scan_options_in_full_equal_the_defaults_replaced(tmp_path):
                                        hill_band=ballbal.options.SCAN_HILL_BAND),
                        guess=GuessSearch(settle=1000.0, window=2000.0, rtol=1e-5,
                                          atol=1e-5 * 1e-3, seeds=2, starts=2))
-    new = ballbal.scan(B, options=opts, execution=Execution(threads=1, out=tmp_path / "s"),
+    new = ballbal.scan(B, options=opts, threads=1, out=tmp_path / "s",
                        **grid)
     assert new.drop("seconds").equals(flat.drop("seconds"))
     meta = ballbal.scan_meta(tmp_path / "s")

@@ -230,8 +230,8 @@ def test_resume_refuses_another_floquet_method(tmp_path):
         ({"Omega": [-1.0], "eta": [1.0]}, "Omega"),
         ({"Omega": (2.0, 1.0, 0.1)}, "Omega"),
         ({"Omega": "1:2"}, "Omega"),
-        ({"eta[5]": [1.0]}, "eta[5]"),
-        ({"eta": [0.0]}, "eta[0]"),
+        ({"eta6": [1.0]}, "eta6"),
+        ({"eta": [0.0]}, "eta1"),
     ],
 )
 def test_bad_grids_raise_before_work(grid, name):

@@ -141,18 +141,18 @@ def test_period_doubled_orbits_are_seeded_from_the_orbits_they_double() -> None:
     lead = float(np.max(np.abs(np.delete(ev, trivial))))
     assert abs(ev[trivial] - 1.0) < 1e-4 and 0.85 < lead < 0.95
     grid = {"Omega": [b.Omega + d * 0.05 for d in (-2, -1, 0, 1, 2)],
-            "eta[0]": [0.8629, 0.9629, 1.0629]}
+            "eta1": [0.8629, 0.9629, 1.0629]}
     alone = ballbal.scan(b, grid=grid, patterns=["O-R[0,-2]"])
     both = ballbal.scan(b, grid=grid, patterns=["O-R", "O-R[0,-2]"])
     # The single-turn O-R orbits are solved either way (unreported when not asked
     # for), so the doubled type's rows are the same.
-    key = ["Omega", "eta[0]", "solution"]
+    key = ["Omega", "eta1", "solution"]
     a = alone.sort(key).select(*key, "status", "stability", "origin")
     c = both.filter(pl.col("type") == "O-R[0,-2]").sort(key).select(*key, "status",
                                                                     "stability", "origin")
     assert a.equals(c)
     at = _rows(alone, "O-R[0,-2]").filter((pl.col("Omega") == b.Omega)
-                                           & (pl.col("eta[0]") == 0.9629))
+                                           & (pl.col("eta1") == 0.9629))
     assert at.height == 1, alone.filter(pl.col("status") == "converged")
     row = at.row(0, named=True)
     assert row["origin"] == "period_doubling" and row["N"] == 6

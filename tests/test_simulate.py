@@ -78,7 +78,7 @@ def test_fixed_frame_position():
         ({"zeta": -0.1}, "zeta"),
         ({"zeta_b": float("inf")}, "zeta_b"),
         ({"delta": 0.0}, "delta"),
-        ({"eta": (1.0, 0.0)}, "eta[1]"),
+        ({"eta": (1.0, 0.0)}, "eta2"),
         ({"eta": ()}, "eta"),
         ({"Omega": -1.0}, "Omega"),
         ({"mu": 1.5}, "mu"),

@@ -38,7 +38,7 @@ BASINS = dict(n=4)
 
 
 def basin_execution(out=None):
-    return ballbal.Execution(threads=1, chunk=4, out=out)
+    return {"threads": 1, "chunk": 4, "out": out}
 
 
 @pytest.fixture(scope="module")
@@ -58,13 +58,13 @@ def scan_written(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def basin_reference():
-    return basins(standard(), **BASINS, execution=basin_execution()).table
+    return basins(standard(), **BASINS, **basin_execution()).table
 
 
 @pytest.fixture(scope="module")
 def basin_written(tmp_path_factory):
     out = tmp_path_factory.mktemp("basins") / "b"
-    basins(standard(), **BASINS, execution=basin_execution(out))
+    basins(standard(), **BASINS, **basin_execution(out))
     return out
 
 
@@ -95,7 +95,7 @@ def resume_scan(out):
 def resume_basins(out):
     with warnings.catch_warnings(record=True) as w:
         warnings.simplefilter("always")
-        r = basins(standard(), **BASINS, execution=basin_execution(out))
+        r = basins(standard(), **BASINS, **basin_execution(out))
     return r.table, store_warnings(w)
 
 

@@ -25,7 +25,6 @@ from .exceptions import ScanInterrupted
 from .model import Balancer, from_disk_units, zeta_from_log_decrement
 from .options import (
     Collocation,
-    Execution,
     Floquet,
     GuessSearch,
     HarmonicBalance,
@@ -66,7 +65,6 @@ __all__ = [
     "Collocation",
     "DisturbanceResponse",
     "Equilibrium",
-    "Execution",
     "Floquet",
     "GuessSearch",
     "HarmonicBalance",

@@ -7,7 +7,6 @@ pseudo-arclength engine (``rust/core/src/continuation/arclength.rs``) are
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -16,12 +15,6 @@ import polars as pl
 from ballbal import _check, _native
 from ballbal._style import Summarised, value_range
 from ballbal.exceptions import ParameterError, ParameterTypeError
-from ballbal.model import Balancer
-from ballbal.scene import Scene
-
-#: A ball's parameter by its index (``eta[1]``): the core's per-ball parameters.
-_INDEXED = re.compile("^({})\\[(\\d+)\\]$".format(
-    "|".join(p["key"] for p in _native.parameters() if p["per_ball"])))
 
 
 def parameter_range(v: Any) -> tuple[float, float]:
@@ -114,24 +107,6 @@ def branch_controls(at: Any, stop: Any) -> tuple[list[float] | None, list[str] |
                              f"{_check.MAX_STOP_EVENTS}",
                              allowed=f"at most {_check.MAX_STOP_EVENTS} names")
     return values, [event_name(n, "stop") for n in names]
-
-
-def model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:
-    """``model`` with ``parameter`` set to ``value``. A ball-indexed name counts balls
-    from 0, as Python indexes ``Balancer.eta`` and as the core and the scans do:
-    ``"eta[0]"`` is the first ball's ``eta``."""
-    m = _INDEXED.match(parameter)
-    if m is None:
-        return model.replace(**{parameter: value})
-    name, i = m.group(1), int(m.group(2))
-    bal = model.balancer if isinstance(model, Scene) else model
-    if i >= bal.n_balls:
-        raise ParameterError(parameter, f"ball index {i} of {bal.n_balls} balls (counted from 0)",
-                             allowed=f"{name}[0] to {name}[{bal.n_balls - 1}]")
-    old = getattr(bal, name)
-    vals = list(old) if isinstance(old, (tuple, list)) else [old] * bal.n_balls
-    vals[i] = value
-    return model.replace(**{name: tuple(vals)})
 
 
 @dataclass(frozen=True)

@@ -20,13 +20,12 @@ from ballbal._branch import (
     branch_controls,
     directed,
     event_row,
-    model_at,
     parameter_range,
 )
 from ballbal.analysis import Equilibrium, _equilibrium, capacities, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer, DiskUnits
-from ballbal.scene import Scene, model_argument
+from ballbal.scene import Scene, model_argument, model_at
 
 __all__ = ["equilibrium_branch", "equilibrium_curve", "switch_equilibrium"]
 
@@ -138,7 +137,7 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
     ``model``, or a kind name: the first equilibrium of that kind) continued in
     ``parameter`` (any name ``with_param`` takes: ``"Omega"``, ``"eta"`` (all balls),
-    ``"eta[1]"`` (the second ball: balls count from 0), ``"zeta"``, ``"zeta_b"``,
+    ``"eta2"`` (the second ball's; balls are named from 1), ``"zeta"``, ``"zeta_b"``,
     ``"mu"``, ``"delta"``, scene parameters) by pseudo-arclength over ``range``, through
     folds.
 

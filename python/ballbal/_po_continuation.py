@@ -18,12 +18,12 @@ from ._branch import (
     Continuation,
     branch_controls,
     directed,
-    model_at,
     parameter_range,
 )
 from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
+from .scene import model_at
 
 __all__ = ["Branch", "Continuation", "periodic_branch"]
 
@@ -86,7 +86,7 @@ def periodic_branch(
 ) -> Branch:
     """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
     in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
-    ``"eta[1]"`` (the second ball: balls count from 0), a scene's ``"springs"``, ...)
+    ``"eta2"`` (the second ball's; balls are named from 1), a scene's ``"springs"``, ...)
     over ``range = (lo, hi)`` by
     pseudo-arclength continuation of the harmonic-balance equations (through folds),
     with ``N`` harmonics (default: the start's).

@@ -13,11 +13,12 @@ import numpy as np
 import polars as pl
 
 from . import _check, _native
-from ._branch import Branch, Continuation, Curve, event_row, model_at, parameter_range
+from ._branch import Branch, Continuation, Curve, event_row, parameter_range
 from ._po_continuation import _multipliers
 from .analysis import _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import PERIODIC_DEFAULTS, PeriodicOptions
+from .scene import model_at
 
 __all__ = ["periodic_curve"]
 

@@ -9,12 +9,12 @@ from typing import Any, Literal
 import numpy as np
 
 from . import _check, _native
-from ._branch import Branch, _listing, event_name, event_row, model_at
+from ._branch import Branch, _listing, event_name, event_row
 from .analysis import Equilibrium, PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer, DiskUnits
 from .options import PERIODIC_DEFAULTS, PeriodicOptions, refuses_keywords, with_harmonics
-from .scene import Scene, model_argument
+from .scene import Scene, model_argument, model_at
 
 
 def _from_branch(branch: Branch, event: Any, kind: str | None, parameter: str | None,

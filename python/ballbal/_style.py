@@ -23,8 +23,8 @@ from . import _native
 
 #: How a quantity is written: mathtext symbol and unit ("" for a pure number). Keys are
 #: the registry's parameter names, the disk units' parameters, and the columns of the
-#: result tables. A ball-indexed name ``eta[0]`` is written with the ball counted from 1
-#: (``eta_1``), as the coordinates ``b1, b2`` count them.
+#: result tables. A per-ball name ``eta1`` is written with its ball as a subscript
+#: (``eta_1``), as the coordinates ``b1, b2`` are.
 QUANTITIES: dict[str, tuple[str, str]] = {
     # the planar balancer (registry)
     "mu": (r"$\mu$", ""),
@@ -84,7 +84,6 @@ QUANTITIES: dict[str, tuple[str, str]] = {
     "speed_rpm": (r"$n$", "rpm"),
 }
 
-_INDEXED = re.compile(r"^(.+)\[(\d+)\]$")
 _BALL = re.compile(r"^d?b(\d+)$")
 
 
@@ -95,13 +94,18 @@ def registry_names() -> tuple[str, ...]:
 
 
 @cache
-def _per_ball() -> frozenset[str]:
-    return frozenset(p["name"] for p in _native.parameters() if p["per_ball"])
+def _ball_parameter(name: str) -> tuple[str, int | None]:
+    """The core's reading of a per-ball name (``"eta2"`` -> ``("eta", 1)``); ``(name,
+    None)`` for any other name or column."""
+    try:
+        return _native.parse_parameter(name)
+    except ValueError:
+        return name, None
 
 
 def symbol(name: str) -> str:
     """The mathtext symbol of a parameter or column (``"Omega"`` -> ``$\\Omega$``,
-    ``"eta[0]"`` -> ``$\\eta_{1}$``, ``"b2"`` -> ``$b_{2}$``); the name itself when
+    ``"eta1"`` -> ``$\\eta_{1}$``, ``"b2"`` -> ``$b_{2}$``); the name itself when
     it has none."""
     return _written(name)[0]
 
@@ -114,10 +118,10 @@ def unit(name: str) -> str:
 def _written(name: str) -> tuple[str, str]:
     if name in QUANTITIES:
         return QUANTITIES[name]
-    m = _INDEXED.match(name)
-    if m and m.group(1) in _per_ball() and m.group(1) in QUANTITIES:
-        sym, u = QUANTITIES[m.group(1)]
-        ball = str(int(m.group(2)) + 1)
+    key, index = _ball_parameter(name)
+    if index is not None and key in QUANTITIES:
+        sym, u = QUANTITIES[key]
+        ball = str(index + 1)
         sub = re.match(r"^\$(.*)_\{?([^{}$]*)\}?\$$", sym)
         if sub:  # zeta_b of ball 1: zeta_{b,1}, not a double subscript
             return f"${sub.group(1)}_{{{sub.group(2)},{ball}}}$", u
@@ -161,9 +165,9 @@ def fixed_caption(source: Any, varying: Iterable[str] = ()) -> str:
     :class:`~ballbal.continuation.DiskUnits`) or from a result
     table's model columns (the registry's names; a column constant over the table is
     fixed, the balls' values of one name shown together). ``varying``: names left out
-    (the axes; ``"eta"`` also leaves out ``eta[0]``...)."""
+    (the axes; ``"eta"`` also leaves out ``eta1``...)."""
     skip = set(varying)
-    skip |= {_INDEXED.sub(r"\1", v) for v in skip}
+    skip |= {_ball_parameter(v)[0] for v in skip}
     parts: list[str] = []
     # a Scene holds its balancer as a field (DiskUnits derives one: its own are shown)
     holds = dataclasses.is_dataclass(source) and any(
@@ -180,7 +184,7 @@ def fixed_caption(source: Any, varying: Iterable[str] = ()) -> str:
         return ""
     groups: dict[str, list[float]] = {}
     for col in columns:
-        base = _INDEXED.sub(r"\1", col)
+        base = _ball_parameter(col)[0]
         if base not in registry_names() or col in skip or base in skip:
             continue
         values = source[col].unique()

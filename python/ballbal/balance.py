@@ -14,7 +14,7 @@ from . import _check, _native
 from .analysis import Equilibrium, _equilibrium, capacities
 from .exceptions import ParameterError
 from .model import Balancer
-from .scene import Scene, model_argument
+from .scene import Scene, model_argument, model_at
 
 
 def balanced_state(model: Balancer | Scene) -> Equilibrium | None:
@@ -62,13 +62,11 @@ def balance_map(
         raise ParameterError("axes", "give at least one parameter to vary, e.g. Omega=[...]")
     scene = model if isinstance(model, Scene) else Scene(balancer=model)
     names = list(axes)
-    allowed = set(_native.parameter_keys(scene))
+    # the core's check, as a scan's: a name the scene cannot vary is refused with the
+    # names it can (a per-ball one, ``eta2``, included) before any work
+    _native.check_axes(scene, names)
     values: list[list[float]] = []
     for name in names:
-        if name not in allowed:
-            raise ParameterError(name, "not a parameter balance_map can vary (allowed: "
-                                 f"{', '.join(sorted(allowed))})",
-                                 allowed=", ".join(sorted(allowed)))
         v = _check.axis(name, axes[name], _check.MAX_MAP_POINTS)
         _planar_range(scene.balancer, name, v)
         values.append([float(x) for x in v])
@@ -114,12 +112,12 @@ def _planar_range(balancer: Balancer, name: str, values: np.ndarray) -> None:
     """Refuses an axis of a balancer parameter with a value outside its range (the
     core's, through :meth:`Balancer.validate`). The ranges are intervals, so the
     smallest and the largest value decide; the error names the axis (``eta``, not the
-    ball ``eta[1]`` the core names)."""
-    if name not in _PLANAR_AXES:
+    ball ``eta2`` the core names)."""
+    if _native.parse_parameter(name)[0] not in _PLANAR_AXES:
         return
     for x in (float(values.min()), float(values.max())):
         try:
-            balancer.replace(**{name: x}).validate()
+            model_at(balancer, name, x)  # a Balancer is validated as it is made
         except ParameterError as e:
             raise ParameterError(name, f"{x:g} is outside its range: {e.message}",
                                  allowed=e.allowed, value=x) from None

@@ -36,7 +36,7 @@ import json
 import math
 import os
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -47,7 +47,7 @@ from . import _check, _native
 from ._progress import Progress
 from .exceptions import ParameterError, ParameterTypeError, ScanInterrupted, ScanStoreError
 from .model import Balancer
-from .options import Execution
+from .options import _Execution
 from .scan import SCHEMA
 from .scene import Scene, model_argument
 
@@ -291,8 +291,8 @@ def _fitted_orbit(model: Balancer | Scene, y0: Any, wind: Sequence[Any] | None, 
 
 
 class _BasinStore:
-    """Finished chunks of a basin grid as Parquet files in a directory (``execution.
-    out``), with the scan store's guarantees (:class:`ballbal.scan._Store`, whose
+    """Finished chunks of a basin grid as Parquet files in a directory (``basins(...,
+    out=...)``), with the scan store's guarantees (:class:`ballbal.scan._Store`, whose
     locking, atomic writes and setting aside of damaged files it reuses): a later call
     with the same arguments skips the chunks on disk; a chunk file that is unreadable,
     changed since it was written (its checksum), of another grid or another chunk's
@@ -398,9 +398,13 @@ def basins(
     t_end: float = 1000.0,
     settle_check: bool = False,
     options: BasinOptions | None = None,
-    execution: Execution | None = None,
     orbits: bool = True,
     N: int = 8,  # noqa: N803 - the harmonics' symbol
+    threads: int | None = None,
+    chunk: int | None = None,
+    executor: Any = None,
+    progress: bool | Callable[[int, int], Any] = False,
+    out: str | os.PathLike[str] | None = None,
 ) -> Basins:
     """Label the starts of a grid (or random sample) of initial ball angles by the
     attractor they reach; two balls.
@@ -411,7 +415,8 @@ def basins(
     ``t_end``: time simulated per start (Tien (2011): 1000; overrides ``options``).
     ``settle_check``: simulate every start again for ``3 t_end`` (``options.
     settle_factor``) and report ``long_label`` and ``settled`` (the labels agree).
-    ``execution``: ``threads`` (default all cores), ``chunk`` (starts per task,
+    Where it runs, as for :func:`ballbal.scan` (none of it changes the table):
+    ``threads`` (default all cores), ``chunk`` (starts per task,
     default 256) and ``out`` (a directory the finished chunks are written to as
     Parquet and resumed from, with the scan store's checks: see :class:`_BasinStore`);
     Ctrl-C stops the work and returns the finished chunks' starts (in chunk order) with
@@ -436,8 +441,8 @@ def basins(
         raise ParameterError("model", f"basins are drawn for two balls, got {model.n_balls}")
     options = _check.option("options", options, BasinOptions, BasinOptions(),
                             "ballbal.basins.BasinOptions")
-    execution = _check.option("execution", execution, Execution, Execution(),
-                              "ballbal.Execution")
+    execution = _Execution(threads=threads, chunk=chunk, executor=executor,
+                           progress=progress, out=out)
     t_end = _check.real("t_end", t_end)
     window = min(options.window, t_end)
     factor = options.settle_factor
@@ -577,7 +582,7 @@ def basins(
                     f"basins interrupted: {len(parts)} of {n_chunks} chunks finished"
                     + (f" and kept in {execution.out}; run the same call again to resume"
                        if store is not None
-                       else "; pass execution.out to keep chunks on disk")
+                       else "; pass out= to keep chunks on disk")
                 ),
                 stacklevel=2,
             )

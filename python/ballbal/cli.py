@@ -293,7 +293,7 @@ def main(argv: list[str] | None = None) -> int:
         # one spelling for every subcommand: --zeta-b, as periodic and equilibria
         ps.add_argument(f"--{name.replace('_', '-')}", dest=name, metavar="START:STOP:STEP")
     ps.add_argument("--grid", action="append", default=[], metavar="NAME=START:STOP:STEP",
-                    help="any scannable parameter, e.g. 'eta[0]=0.5:1.5:0.1'")
+                    help="any scannable parameter, e.g. 'eta1=0.5:1.5:0.1' (the first ball's eta)")
     ps.add_argument("--types", nargs="+", default=["R-R"], help="e.g. R-R O-O R-O")
     ps.add_argument("--N", type=int, default=3)
     ps.add_argument("--threads", type=int, default=None)

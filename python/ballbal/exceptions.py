@@ -34,8 +34,8 @@ class BallbalError(Exception):
 class ParameterError(BallbalError, ValueError):
     """A parameter is outside its allowed range or otherwise unusable.
 
-    ``parameter``: its name (``"Omega"``, ``"eta[1]"`` (the second ball: balls count
-    from 0), ``"N"``, ``"t_span"``, ...);
+    ``parameter``: its name (``"Omega"``, ``"eta2"`` (the second ball's: balls are
+    named from 1, as the coordinates ``b1``, ``b2``), ``"N"``, ``"t_span"``, ...);
     ``allowed``: the allowed range or values as text, or ``None``; ``value``: what was
     given, where it can be shown.
     """

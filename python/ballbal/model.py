@@ -31,7 +31,7 @@ def _tuple(name: str, v: float | Sequence[float]) -> tuple[float, ...]:
     if not all(_is_number(x) for x in items):
         raise bad
     _check.at_most(name, len(items), _check.MAX_BALLS, "balls")  # an iterable without len
-    return tuple(_check.real(f"{name}[{i}]", x) for i, x in enumerate(items))
+    return tuple(_check.real(_native.ball_parameter_name(name, i), x) for i, x in enumerate(items))
 
 
 def _unknown_fields(cls: type, changes: dict[str, Any]) -> None:

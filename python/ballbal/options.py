@@ -7,8 +7,9 @@ harmonic-balance system a model of that size allows). One vocabulary:
 ``rtol``/``atol`` are always integration tolerances (relative, absolute) of the
 Dormand–Prince integrator that uses them: :class:`Floquet`'s of the monodromy,
 :class:`GuessSearch`'s of the simulations that find starts. Mathematics (what is
-computed) is apart from execution (:class:`Execution`: where and how it runs, which
-never changes a result).
+computed) is apart from execution: where and how a scan or a basin grid runs
+(``threads=``, ``chunk=``, ``executor=``, ``progress=``, ``out=``), which never changes
+a result and is given as keywords of the call.
 
 ``periodic()`` and ``scan()`` mean the same by every option but differ in some
 defaults, on purpose: a scan solves thousands of points, continues each solution to
@@ -317,8 +318,9 @@ class ScanOptions:
 
 
 @dataclass(frozen=True)
-class Execution:
-    """Where and how a scan runs; none of it changes the table.
+class _Execution:
+    """Where and how a scan or a basin grid runs (their keywords, checked together);
+    none of it changes the table.
 
     ``threads``: cores for the core's parallel loop (default: all here; 1 per task on
     an ``executor``). ``chunk``: values of the last axis per chunk, rounded up to whole

@@ -41,8 +41,8 @@ from .model import Balancer
 from .options import (
     REMOVED_KEYWORDS,
     SCAN_DEFAULTS,
-    Execution,
     ScanOptions,
+    _Execution,
     refuse_keywords,
     with_harmonics,
 )
@@ -57,7 +57,7 @@ except ImportError:  # pragma: no cover - not on POSIX: scan directories are not
 #: owners and ranges every model's parameters are checked with.
 PARAMETERS: tuple[dict[str, Any], ...] = tuple(_native.parameters())
 #: The planar balancer's parameters a scan can vary (per-ball ones also one ball at a
-#: time, ``eta[1]``).
+#: time, ``eta2`` for the second ball).
 SCANNABLE: tuple[str, ...] = tuple(p["key"] for p in PARAMETERS if p["key"] and p["planar"])
 #: Scene parameters a scan can vary besides the balancer's: the core takes each only from
 #: a scene that has its component (the tilt's with a tilting disk, ``rho``,
@@ -210,14 +210,15 @@ def _multipliers(re_rows: Sequence[Any], im_rows: Sequence[Any]) -> pl.Series:
 
 
 def _model_values(model: Balancer | Scene) -> dict[str, float]:
-    """Every balancer parameter of ``model``, ball-indexed ones per ball (``eta[0]``,
-    ``zeta_b[1]``, the grid axes' spelling), so that a table says what model its rows
+    """Every balancer parameter of ``model``, ball-indexed ones per ball (``eta1``,
+    ``zeta_b2``, the grid axes' spelling), so that a table says what model its rows
     are of wherever it goes (a CSV file, a join of two scans)."""
     b = model.balancer if isinstance(model, Scene) else model
     n = b.n_balls
     zeta_b = b.zeta_b if isinstance(b.zeta_b, tuple) else (b.zeta_b,) * n
-    return {"mu": b.mu, "zeta": b.zeta, **{f"zeta_b[{i}]": z for i, z in enumerate(zeta_b)},
-            "delta": b.delta, "Omega": b.Omega, **{f"eta[{i}]": e for i, e in enumerate(b.eta)}}
+    ball = _native.ball_parameter_name
+    return {"mu": b.mu, "zeta": b.zeta, **{ball("zeta_b", i): z for i, z in enumerate(zeta_b)},
+            "delta": b.delta, "Omega": b.Omega, **{ball("eta", i): e for i, e in enumerate(b.eta)}}
 
 
 def _index_name(axis: str) -> str:
@@ -241,7 +242,7 @@ def _frame(job: _Job, d: dict[str, Any]) -> pl.DataFrame:
         cols[c] = mult if c == "multipliers" else pl.Series(c, d[c], dtype=dtype)
     rows = len(d["type"])
     for k, v in job.model_values().items():
-        family = k.split("[")[0]
+        family = _native.parse_parameter(k)[0]
         # A ball's value under an axis that sets every ball's is that axis' value.
         cols[k] = (cols[family].alias(k) if family in names
                    else pl.Series(k, [v], dtype=pl.Float64).new_from_index(0, rows))
@@ -708,7 +709,6 @@ def scan(  # noqa: E302 - overloads above
     patterns: Sequence[str] = ("R-R",),
     N: int | Literal["auto"] | None = None,  # noqa: N803
     options: ScanOptions | None = None,
-    execution: Execution | None = None,
     chunk: int | None = None,
     threads: int | None = None,
     progress: bool | Callable[[int, int], Any] = False,
@@ -721,8 +721,9 @@ def scan(  # noqa: E302 - overloads above
     """Scan parameters of ``model`` over a grid and return one row per solution found.
 
     Axes are keywords (``Omega=(1.0, 2.0, 0.1), eta=np.arange(0.4, 1.51, 0.1)``) or a
-    ``grid`` mapping (needed for ``"eta[0]"``); each is a sequence, ``(start, stop, step)``
-    or ``"start:stop:step"``. Any number of axes; the first varies fastest in the table.
+    ``grid`` mapping; a per-ball name sets one ball (``eta1=...``, balls named from 1).
+    Each is a sequence, ``(start, stop, step)`` or ``"start:stop:step"``. Any number of
+    axes; the first varies fastest in the table.
 
     ``patterns``: the solution types, each a rotation pattern (one letter per ball, ``R``
     turning round the track, ``O`` oscillating, joined by ``-``: ``"R-R"``, ``"R-O"``) or
@@ -746,10 +747,16 @@ def scan(  # noqa: E302 - overloads above
     harmonics (``options.harmonic_balance.N`` when given). The flat option keywords of
     before (``hill=``, ``seeds=``, ``block=``, ...) are refused with a
     :class:`~ballbal.exceptions.ParameterTypeError` naming the field that replaces each
-    (they are no parameters, so never axes). ``execution``: an
-    :class:`~ballbal.Execution` (where it runs: ``threads, chunk, executor, progress,
-    out, lazy``); the keywords of the same names override it. Execution never changes
-    the table.
+    (they are no parameters, so never axes).
+
+    Where it runs, which never changes the table: ``threads`` (cores for the core's
+    parallel loop; default all here, 1 per task on an ``executor``), ``chunk`` (values
+    of the last axis per chunk, rounded up to whole blocks; default one block: the unit
+    of progress, interruption, resumption, files and executor tasks), ``executor`` (a
+    ``concurrent.futures`` executor or Dask ``Client`` running the chunks as tasks),
+    ``progress`` (True for a progress bar, or a callable ``f(done_points,
+    total_points)``), ``out`` (a directory the chunks are written to and resumed from)
+    and ``lazy`` (a ``polars.LazyFrame`` over its files).
 
     ``model`` may be an autonomous :class:`Scene` (ball springs, a tilting disk): its
     ``springs`` and tilt fields ``a``, ``b``, ``j_t``, ``j_z``, ``zeta_r`` can be axes
@@ -793,7 +800,7 @@ def scan(  # noqa: E302 - overloads above
     which ``write_csv`` cannot hold: :func:`ballbal.flat` spreads it into
     ``multipliers_re_0, multipliers_im_0, ...``). After them, the table says what model
     its rows are of: a column for every balancer parameter that is not an axis (``mu``,
-    ``zeta``, ``zeta_b[i]``, ``delta``, ``Omega``, ``eta[i]``, one per ball; a ball's
+    ``zeta``, ``zeta_b1``, ..., ``delta``, ``Omega``, ``eta1``, ..., one per ball; a ball's
     column repeats an axis that sets every ball, such as ``eta``). Columns rather than
     metadata, since a polars DataFrame carries none: they survive every format, filter
     and join. What columns cannot hold (options, a scene's effects) is in the stored
@@ -842,17 +849,12 @@ def scan(  # noqa: E302 - overloads above
     model_argument("model", model)
     options = _check.option("options", options, ScanOptions, SCAN_DEFAULTS,
                             "ballbal.ScanOptions")
-    execution = _check.option("execution", execution, Execution, Execution(),
-                              "ballbal.Execution")
-    given: dict[str, Any] = {k: v for k, v in (("chunk", chunk), ("threads", threads),
-                                               ("out", out), ("executor", executor))
-                             if v is not None}
-    if progress is not False:
-        given["progress"] = progress
-    if lazy is not False:
-        given["lazy"] = lazy
-    if given:
-        execution = replace(execution, **given)
+    execution = _Execution(threads=threads, chunk=chunk, executor=executor,
+                           progress=progress, out=out, lazy=lazy)
+    if "execution" in axes:
+        raise ParameterTypeError("execution", "is no option: where a scan runs is given by "
+                                 "its keywords threads=, chunk=, executor=, progress=, out=, "
+                                 "lazy=")
     refuse_keywords("scan", ScanOptions, [k for k in axes if k in REMOVED_KEYWORDS])
     options = with_harmonics(options, N)
     p = _check.patterns("patterns", patterns)

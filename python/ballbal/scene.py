@@ -65,7 +65,7 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
-from . import _check
+from . import _check, _native
 from .bearing import Bearing, Dimensions, Grooves
 from .exceptions import ParameterError, ParameterTypeError
 from .model import Balancer, _is_number
@@ -642,3 +642,24 @@ def model_argument(name: str, v: Any) -> Balancer | Scene:
             name, f"must be a ballbal.Balancer or ballbal.Scene, got {type(v).__name__}",
             value=v)
     return v
+
+
+def model_at(model: Balancer | Scene, parameter: str, value: float) -> Balancer | Scene:
+    """``model`` with ``parameter`` set to ``value``. A per-ball name sets one ball's
+    value, balls named from 1 as the core names them (``"eta1"`` is the ball whose angle
+    is ``b1``, ``Balancer.eta[0]``)."""
+    try:
+        name, i = _native.parse_parameter(parameter)
+    except ParameterError:
+        i = None  # not a registry name: the model's own fields say whether it has it
+    if i is None:
+        return model.replace(**{parameter: value})
+    bal = model.balancer if isinstance(model, Scene) else model
+    if i >= bal.n_balls:
+        first, last = (_native.ball_parameter_name(name, j) for j in (0, bal.n_balls - 1))
+        raise ParameterError(parameter, f"names ball {i + 1} of a balancer with {bal.n_balls}",
+                             allowed=f"{first} to {last}")
+    old = getattr(bal, name)
+    vals = list(old) if isinstance(old, (tuple, list)) else [old] * bal.n_balls
+    vals[i] = value
+    return model.replace(**{name: tuple(vals)})

@@ -556,6 +556,28 @@ pub fn parameters(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
         .collect()
 }
 
+/// A parameter name as the core reads it: `(key, ball)` with `ball` the index from 0 of
+/// a per-ball name (`"eta2"` -> `("eta", 1)`), `None` for every ball or a parameter
+/// that is not per ball; the core's error (with its hint for `eta[1]`) for a name it
+/// does not know.
+#[pyfunction]
+pub fn parse_parameter(name: &str) -> PyResult<(&'static str, Option<usize>)> {
+    use ballbal_core::model::params::{key_list, unknown, ParamRef, REGISTRY};
+    let owners: Vec<&str> = REGISTRY.iter().map(|s| s.owner).collect();
+    let p = ParamRef::parse(name)
+        .ok_or_else(|| unknown(name, "registry", &key_list(&owners)))
+        .py()?;
+    let s = p.id.spec();
+    Ok((s.key.unwrap_or(s.name), p.ball))
+}
+
+/// The name of the ball at index `ball` (from 0) of the per-ball parameter `key`:
+/// `ball_parameter_name("eta", 0)` is `"eta1"`.
+#[pyfunction]
+pub fn ball_parameter_name(key: &str, ball: usize) -> String {
+    ballbal_core::model::params::ball_name(key, ball)
+}
+
 /// The model built as a scan builds it (a scene stays a scene).
 fn scanned_model(model: &ModelArgs) -> PyResult<Model> {
     model.build(matches!(model, ModelArgs::Scene(_))).py()
@@ -573,7 +595,7 @@ pub fn check_axes(model: ModelArgs, names: Vec<String>) -> PyResult<()> {
 }
 
 /// The registry's keys the model takes by name (its per-ball parameters as one key for
-/// every ball; `eta[i]` also takes one ball), in the registry's order.
+/// every ball; `eta1`, `eta2`, ... also take one ball), in the registry's order.
 #[pyfunction]
 pub fn parameter_keys(model: ModelArgs) -> PyResult<Vec<&'static str>> {
     use ballbal_core::model::params::REGISTRY;

@@ -79,6 +79,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entries::scan_profile, m)?)?;
     m.add_function(wrap_pyfunction!(entries::scan_wave_order, m)?)?;
     m.add_function(wrap_pyfunction!(entries::parameters, m)?)?;
+    m.add_function(wrap_pyfunction!(entries::parse_parameter, m)?)?;
+    m.add_function(wrap_pyfunction!(entries::ball_parameter_name, m)?)?;
     m.add_function(wrap_pyfunction!(entries::parameter_keys, m)?)?;
     m.add_function(wrap_pyfunction!(entries::check_axes, m)?)?;
     m.add_function(wrap_pyfunction!(tables::scan_schema, m)?)?;

@@ -85,7 +85,15 @@ impl Family for Scene {
 
 /// A parameter's value looked up in the registry, or an error naming it.
 fn registry_value(name: &str, v: Option<f64>) -> Result<f64> {
-    v.ok_or_else(|| crate::Error::param(name, "is not a parameter of this model"))
+    v.ok_or_else(|| {
+        crate::Error::param(
+            name,
+            format!(
+                "is not a parameter of this model{}",
+                crate::model::params::ball_hint(name)
+            ),
+        )
+    })
 }
 
 #[cfg(test)]

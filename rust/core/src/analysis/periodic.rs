@@ -616,7 +616,7 @@ pub fn pattern_whirl_starts<D: Parametric>(p: &D, rotating: &[bool]) -> Vec<Vec<
         return vec![];
     }
     let Ok(eta) = (0..n)
-        .map(|j| p.param_value(&format!("eta[{j}]")))
+        .map(|j| p.param_value(&crate::model::params::ball_name("eta", j)))
         .collect::<crate::Result<Vec<f64>>>()
     else {
         return vec![];

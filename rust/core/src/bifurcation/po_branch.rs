@@ -402,7 +402,10 @@ pub fn periodic_branch<D: Parametric>(
     let p0 = base.param_value(name).map_err(|_| {
         Error::param(
             "parameter",
-            format!("{name:?} is not a parameter of this model"),
+            format!(
+                "{name:?} is not a parameter of this model{}",
+                crate::model::params::ball_hint(name)
+            ),
         )
     })?;
     if !(opts.arc.p_min..=opts.arc.p_max).contains(&p0) {

@@ -83,7 +83,8 @@ pub struct ParamSpec {
     /// The component that owns it (see [`crate::model::component`]).
     pub owner: &'static str,
     pub range: Interval,
-    /// One value per ball (`eta[i]`, `zeta_b[i]`).
+    /// One value per ball (`eta1`, `zeta_b2`: balls are named from 1, as the
+    /// coordinates `b1`, `b2` are).
     pub per_ball: bool,
 }
 
@@ -283,14 +284,15 @@ impl ParamId {
         self.check_named(self.spec().name, v)
     }
 
-    /// Checks per-ball values, named `name[i]` (or `name` when one value is shared).
+    /// Checks per-ball values, named `name1`, `name2`, ... (or `name` when one value is
+    /// shared).
     pub fn check_balls(self, values: &[f64], shared: bool) -> Result<()> {
         let base = self.spec().name;
         for (i, &v) in values.iter().enumerate() {
             if shared {
                 self.check_named(base, v)?;
             } else {
-                self.check_named(&format!("{base}[{i}]"), v)?;
+                self.check_named(&ball_name(base, i), v)?;
             }
         }
         Ok(())
@@ -312,7 +314,8 @@ impl From<ParamId> for ParamRef {
 }
 
 impl ParamRef {
-    /// Looks a `with_param` name up: `"mu"`, `"a"`, `"eta"` (every ball), `"eta[2]"` (the third ball: balls count from 0, as everywhere in ballbal).
+    /// Looks a `with_param` name up: `"mu"`, `"a"`, `"eta"` (every ball), `"eta3"` (the
+    /// third ball: balls are named from 1, as the coordinates `b1`, `b2` are).
     pub fn parse(name: &str) -> Option<ParamRef> {
         for s in REGISTRY {
             let Some(key) = s.key else { continue };
@@ -331,19 +334,27 @@ impl ParamRef {
         None
     }
 
-    /// The `with_param` name (`"eta[2]"`), or the registered name when it has none.
+    /// The `with_param` name (`"eta3"` for the third ball), or the registered name when
+    /// it has none.
     pub fn name(&self) -> String {
         let s = self.id.spec();
         let base = s.key.unwrap_or(s.name);
         match self.ball {
-            Some(i) => format!("{base}[{i}]"),
+            Some(i) => ball_name(base, i),
             None => base.to_string(),
         }
     }
 }
 
+/// A per-ball parameter's name for the ball at index `i` (from 0): `eta1` for `i = 0`.
+/// Names count balls from 1, as the coordinates `b1`, `b2` and the rates `rate1` do, so
+/// that `eta1` is the ball whose angle is `b1`.
+pub fn ball_name(base: &str, i: usize) -> String {
+    format!("{base}{}", i + 1)
+}
+
 /// The `with_param` names of the parameters owned by `owners`, as an error lists them:
-/// `mu, zeta, zeta_b, ..., eta[i], zeta_b[i]` (per-ball forms last).
+/// `mu, zeta, zeta_b, ..., eta<k>, zeta_b<k>` (per-ball forms last; `k` from 1).
 pub fn key_list(owners: &[&str]) -> String {
     let rows = || {
         REGISTRY
@@ -354,25 +365,56 @@ pub fn key_list(owners: &[&str]) -> String {
     names.extend(
         rows()
             .filter(|s| s.per_ball)
-            .map(|s| format!("{}[i]", s.key.unwrap())),
+            .map(|s| format!("{}<k>", s.key.unwrap())),
     );
     names.join(", ")
 }
 
-/// The error for a name that is not in the registry (or not of this model).
+/// The error for a name that is not in the registry (or not of this model). A ball
+/// written with an index in brackets (`eta[0]`, Python's indexing of `Balancer.eta`) is
+/// told the name it meant.
 pub fn unknown(name: &str, model: &str, owners: &str) -> Error {
     Error::param(
         name,
-        format!("is not a parameter of the {model} ({owners})"),
+        format!(
+            "is not a parameter of the {model} ({owners}){}",
+            ball_hint(name)
+        ),
     )
 }
 
+/// For a ball written with an index in brackets (`eta[0]`), the sentence that tells the
+/// name it meant; empty for any other name.
+pub fn ball_hint(name: &str) -> String {
+    bracketed(name)
+        .map(|(base, i)| {
+            format!(
+                "; balls are named from 1 without brackets: {} is the ball at index {i}",
+                ball_name(base, i)
+            )
+        })
+        .unwrap_or_default()
+}
+
+/// The ball index of `name` = `base` followed by its number from 1 (`eta1` -> 0); `None`
+/// for `eta0`, a leading zero (`eta01`) or anything else.
 fn indexed(name: &str, base: &str) -> Option<usize> {
-    let rest = name
-        .strip_prefix(base)?
-        .strip_prefix('[')?
-        .strip_suffix(']')?;
-    rest.parse().ok()
+    let rest = name.strip_prefix(base)?;
+    if rest.starts_with('0') || !rest.bytes().all(|c| c.is_ascii_digit()) {
+        return None;
+    }
+    rest.parse::<usize>().ok()?.checked_sub(1)
+}
+
+/// `eta[2]` -> (`eta`, 2) for a per-ball key: the bracketed form that names balls from 0.
+fn bracketed(name: &str) -> Option<(&'static str, usize)> {
+    let (base, rest) = name.split_once('[')?;
+    let i = rest.strip_suffix(']')?.parse().ok()?;
+    REGISTRY
+        .iter()
+        .filter(|s| s.per_ball)
+        .find_map(|s| s.key.filter(|k| *k == base))
+        .map(|k| (k, i))
 }
 
 /// The components of the planar balancer, as the registry names them.
@@ -391,17 +433,30 @@ mod tests {
             }
         }
         assert_eq!(
-            ParamRef::parse("zeta_b[3]"),
+            ParamRef::parse("zeta_b4"),
             Some(ParamRef {
                 id: ParamId::ZetaB,
                 ball: Some(3)
             })
         );
-        assert_eq!(ParamRef::parse("mu[1]"), None);
+        assert_eq!(ParamRef::parse("zeta_b4").unwrap().name(), "zeta_b4");
+        for refused in [
+            "zeta_b[3]",
+            "eta0",
+            "eta01",
+            "eta1.5",
+            "eta-1",
+            "mu1",
+            "mu[1]",
+        ] {
+            assert_eq!(ParamRef::parse(refused), None, "{refused}");
+        }
+        let hint = unknown("eta[0]", "planar balancer", "").to_string();
+        assert!(hint.contains("eta1 is the ball at index 0"), "{hint}");
         assert_eq!(ParamRef::parse("ramp.to"), None);
         assert_eq!(
             key_list(PLANAR_OWNERS),
-            "mu, zeta, zeta_b, delta, Omega, eta, zeta_b[i], eta[i]"
+            "mu, zeta, zeta_b, delta, Omega, eta, zeta_b<k>, eta<k>"
         );
     }
 

@@ -1,7 +1,7 @@
 //! The planar n-ball balancer on an isotropic spring–damper support, fused into one
 //! residual for speed: every scene without effects runs this code.
 
-use super::params::{key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
+use super::params::{ball_name, key_list, unknown, ParamId, ParamRef, PLANAR_OWNERS};
 use super::Dynamics;
 use crate::error::{Error, Result};
 
@@ -140,7 +140,7 @@ impl Planar {
     }
 
     /// Returns a copy with one named parameter changed (used by scans and continuation):
-    /// a registry name (`"mu"`, `"eta"` for every ball, `"eta[1]"`, the second ball: balls count from 0), revalidated.
+    /// a registry name (`"mu"`, `"eta"` for every ball, `"eta2"`, the second ball), revalidated.
     pub fn with_param(&self, name: &str, value: f64) -> Result<Self> {
         self.with(Self::param_ref(name)?, value)
     }
@@ -197,9 +197,14 @@ impl Planar {
             Some(i) => match balls.get_mut(i) {
                 Some(x) => *x = value,
                 None => {
-                    return Err(Error::param(
+                    return Err(Error::param_range(
                         p.name(),
-                        format!("ball index out of range 0..{n}"),
+                        format!("names ball {} of a balancer with {n}", i + 1),
+                        format!(
+                            "{} to {}",
+                            ball_name(p.id.spec().name, 0),
+                            ball_name(p.id.spec().name, n - 1)
+                        ),
                     ))
                 }
             },
@@ -566,6 +571,6 @@ mod tests {
         let e = Planar::new(0.2, 0.1, &[0.05], 50.0, f64::NAN, &[1.0]).unwrap_err();
         assert!(e.to_string().starts_with("Omega:"), "{e}");
         let e = Planar::new(0.2, 0.1, &[0.05], 50.0, 1.0, &[1.0, 0.0]).unwrap_err();
-        assert!(e.to_string().starts_with("eta[1]:"), "{e}");
+        assert!(e.to_string().starts_with("eta2:"), "{e}");
     }
 }

@@ -215,7 +215,13 @@ pub fn periodic_curve<D: Parametric>(
     let mut p0 = [0.0; 2];
     for (k, (name, label)) in names.iter().zip(["parameter", "parameter2"]).enumerate() {
         p0[k] = base.param_value(name).map_err(|_| {
-            Error::param(label, format!("{name:?} is not a parameter of this model"))
+            Error::param(
+                label,
+                format!(
+                    "{name:?} is not a parameter of this model{}",
+                    crate::model::params::ball_hint(name)
+                ),
+            )
         })?;
     }
     let (lo, hi) = opts.p1_range;
