@@ -1,4 +1,7 @@
-"""What accuracy costs in time, at Tien's (2011) standard case (Omega 1.2, eta 1.0) and its
+"""Accuracy against cost
+=====================
+
+What accuracy costs in time, at Tien's (2011) standard case (Omega 1.2, eta 1.0) and its
 hard case (Omega 1.0, eta 0.7: slow rotation, period about 106, near resonance). The
 Floquet multipliers' cost is shown for both monodromy methods: RK45 (knob ``rtol``) and
 sixth-order Magnus steps (knob ``magnus``), at the same multiplier errors.

@@ -1,4 +1,7 @@
-"""A rig whose frame is stiffer in Y than in X: a second support resonance in the spectrum.
+"""A support stiffer in one direction
+==================================
+
+A rig whose frame is stiffer in Y than in X: a second support resonance in the spectrum.
 
 Tien's (2011) rig has its support resonance at f_n = 513 rpm; fig. 4-11's 800 rpm record
 also holds a line at 996 rpm that the isotropic support cannot give. Here the frame's Y

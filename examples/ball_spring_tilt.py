@@ -1,4 +1,7 @@
-"""Rezaee et al. (2017): the ball-spring balancer on a tilting rotor with gyroscopic coupling.
+"""Ball-spring balancer on a tilting rotor
+=======================================
+
+Rezaee et al. (2017): the ball-spring balancer on a tilting rotor with gyroscopic coupling.
 
 1. The balanced state's stable region from the eigenvalues of the linearised system, in
    the (track damping, speed) and (ball mass, speed) planes, classic balancer against

@@ -1,4 +1,7 @@
-"""Where a ball balancer on a herringbone-grooved journal bearing balances stably.
+"""A balancer on a grooved journal bearing
+=======================================
+
+Where a ball balancer on a herringbone-grooved journal bearing balances stably.
 
     python examples/bearing_balancer.py [output-directory] [--model finite]
     # about 30 s on 2 cores

@@ -1,4 +1,7 @@
-"""Design charts in lab units: from which spin the balls balance stably, against the ball
+"""Design charts in lab units
+==========================
+
+Design charts in lab units: from which spin the balls balance stably, against the ball
 mass and the track radius, for a rig like Tien's (2011) (m_d e = 33.12 g mm, 2.05 g balls
 on a 16 mm track, the support's resonance near 513 rpm, zeta 0.05, zeta_b about 0.1);
 then, from the model of that rig (design_balancing.png), the speed from which a sweep up

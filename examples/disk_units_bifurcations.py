@@ -1,4 +1,7 @@
-"""Bifurcation diagrams of the two-ball balancer in units of the disk alone, after
+"""Bifurcation curves in units of the disk alone
+=============================================
+
+Bifurcation diagrams of the two-ball balancer in units of the disk alone, after
 [EccentricRotorABB]: its equilibria continued with ballbal's own continuation (the paper
 used AUTO), drawn in the disk's units.
 

@@ -1,4 +1,7 @@
-"""Yen's (2005) scenarios: a rigid rotor in a herringbone-grooved journal bearing.
+"""A rotor on a herringbone-grooved journal bearing
+================================================
+
+Yen's (2005) scenarios: a rigid rotor in a herringbone-grooved journal bearing.
 
 The seed (an NSC report, 2004) gives no geometry, so the numbers here are ours, chosen so
 that its qualitative regimes appear (the choice is printed):
@@ -118,10 +121,13 @@ def describe(label: str, tr: RotorTrajectory, seconds: float) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser()
     name = "grooved_bearing_rotor.png"
-    default = os.path.join(tempfile.mkdtemp(prefix="grooved_bearing_rotor-"), name) if SMALL \
-        else os.path.join(os.path.dirname(os.path.abspath(__file__)), name)
-    ap.add_argument("--out", default=default)
+    ap.add_argument("--out", default=None)
     args = ap.parse_args()
+    # The default is made only when needed: the documentation's gallery runs this script
+    # with --out and without a __file__.
+    if args.out is None:
+        args.out = os.path.join(tempfile.mkdtemp(prefix="grooved_bearing_rotor-"), name) \
+            if SMALL else os.path.join(os.path.dirname(os.path.abspath(__file__)), name)
     t_all = time.perf_counter()
     base = RotorOnBearing(grooved(), MASS, gravity=GRAVITY)
     xe, ye = rotor_equilibrium(base)

@@ -1,4 +1,7 @@
-"""Tien's (2011) Omega-eta maps (its figures 3-6 to 3-16): where R-R, O-O and R-O motions
+"""Omega-eta maps of R-R, O-O and R-O motions
+==========================================
+
+Tien's (2011) Omega-eta maps (its figures 3-6 to 3-16): where R-R, O-O and R-O motions
 exist and are stable, for zeta in {0.02, 0.05, 0.1} and zeta_b in {0.05, 0.1, 0.2}
 (mu 0.2, delta 50, N 3), and omega against eta for several Omega (figure 3-7).
 

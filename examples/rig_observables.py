@@ -1,4 +1,7 @@
-"""Tien's (2011) chapter 4 in the model: fixed-frame spectra of its figures
+"""Spectra, basins and a speed sweep on the rig
+============================================
+
+Tien's (2011) chapter 4 in the model: fixed-frame spectra of its figures
 4-12 (R-R), 4-27 (O-O) and 4-28 (R-O), the main vibration frequency against speed of
 figure 4-13 against the measured band (``ballbal.data``), the basins of attraction of
 figures 4-15 / 4-16 and a speed sweep up and down with its hysteresis.

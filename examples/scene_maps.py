@@ -1,4 +1,7 @@
-"""R-R motions of ball-spring balancers (scans of scenes): where balls that chase round
+"""Maps of ball-spring balancers
+=============================
+
+R-R motions of ball-spring balancers (scans of scenes): where balls that chase round
 the track exist and are stable, over spin speed and spring stiffness, for a planar disk
 and for an off-centre disk that tilts on its shaft (Rezaee et al.'s (2017) rotor).
 

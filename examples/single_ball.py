@@ -1,5 +1,8 @@
-"""Tien's (2011) single-ball experiment (section 4-3) in the model: the support
-vibration (mean |Z''|) of one ball of eta 0.54, 0.99 and 1.85 (from the masses and
+"""The single-ball balancer
+========================
+
+Tien's (2011) single-ball experiment (section 4-3) in the model: the support
+vibration (mean ``|Z''|``) of one ball of eta 0.54, 0.99 and 1.85 (from the masses and
 radii in ``ballbal.data``) against speed, at the stable equilibrium (figure 4-7) and in
 the rotating motion (figure 4-8), beside the disk without balls; and the residual
 imbalance the ball leaves.

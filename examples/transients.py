@@ -1,4 +1,7 @@
-"""Transient studies with scenes (time simulation of non-autonomous scenes).
+"""Transients: disturbances and run-up
+===================================
+
+Transient studies with scenes (time simulation of non-autonomous scenes).
 
 1. [TwoBallStrength]: a spin-speed disturbance (Omega 2.0 -> 2.5 in 5 time units) from the
    perfect balance; peak radial amplitude and settling time into a +-0.01 e band against

@@ -35,15 +35,21 @@ wheel=$(ls "$work"/dist/ballbal-*.whl)
 stamp "install $(basename "$wheel") into a clean venv"
 "$py" -m venv "$work/venv"
 "$work/venv/bin/pip" install -q --upgrade pip
-"$work/venv/bin/pip" install -q "$wheel[test,plot,lint]"
+"$work/venv/bin/pip" install -q "$wheel[test,plot,lint,progress,docs]"
 
 stamp "ruff, mypy, stubtest"
-"$work/venv/bin/ruff" check --no-cache python tests benchmarks examples scripts
+"$work/venv/bin/ruff" check --no-cache python tests benchmarks examples scripts docs
 # The source package, typed against the venv's numpy and polars; ballbal._native is read
 # from python/ballbal/_native.pyi (mypy cannot read the extension, so a missing stub fails).
 "$work/venv/bin/python" -m mypy --cache-dir "$work/mypy-cache" python/ballbal
 # The stub against the installed extension module, from outside the source tree.
 (cd "$work" && "$work/venv/bin/python" -m mypy.stubtest ballbal._native)
+
+stamp "documentation site (scripts/docs.sh: Sphinx, warnings as errors, gallery small)"
+# Built once here against the installed wheel; tests/test_docs_site.py checks it and
+# opens it in headless Chromium.
+PYTHON="$work/venv/bin/python" bash scripts/docs.sh
+export BALLBAL_DOCS_HTML="$root/docs/_build/html"
 
 stamp "pytest against the installed package"
 cp -r tests "$work/tests"

@@ -2,8 +2,9 @@
 
 Fig. 3 is the classic two-ball balancer on a Jeffcott rotor (flat disk at mid-span),
 which the paper says equals its reference [6]'s map; it prints no boundary values, so
-the boundary is computed here from [6]'s equations in the disk's units (``tests/seed003.py``,
-written without ballbal: ``m0 = m_bar``, ``e = eps_bar``, ``C0 = zeta_t / 2``,
+the boundary is computed here from [6]'s equations in the disk's units
+(``tests/disk_units_equations.py``, written without ballbal: ``m0 = m_bar``,
+``e = eps_bar``, ``C0 = zeta_t / 2``,
 ``D0 = lam``, time over ``omega0``): the lowest ``omega_bar`` where Routh–Hurwitz calls
 the perfect balance stable, by bisection. ``ShaftUnits``' scene must change its verdict
 there, and ``balance_map``'s lowest stable grid point must be the first one above it.
@@ -14,10 +15,11 @@ from __future__ import annotations
 import numpy as np
 import polars as pl
 import pytest
-import seed003 as s3
 
 import ballbal
 from ballbal.shaft import ShaftUnits
+
+import disk_units_equations as s3
 
 M_BAR = EPS_BAR = 0.01
 ZETA_T = 0.1

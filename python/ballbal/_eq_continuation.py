@@ -224,7 +224,7 @@ def equilibrium_curve(branch: Branch, event: int | str, parameter2: str, *,
     ``parameter2``, continued both ways:
     a fold gives the saddle-node curve, a Hopf point the Hopf curve (with ``omega``), a
     branch point of the balls-together branch the pitchfork curve (folds and pitchforks
-    of that branch are continued on its invariant subspace ``b_1 = ... = b_n``).
+    of that branch are continued on its invariant subspace, all ``b_i`` equal).
 
     With a branch continued in the disk's units (a :class:`~ballbal.model.DiskUnits`
     model), ``parameter2`` is one of its parameters and the tables are in those

@@ -86,7 +86,7 @@ def periodic_curve(
     ``LPPD`` on a PD curve; for ``CP``, ``R3``, ``R4`` the curve's own), ``residual`` /
     ``own_residual`` (the smallest perturbation of the monodromy that puts a multiplier at
     the added / the curve's own value) and ``error`` (the monodromy's estimated error);
-    see docs/guide.md, "Certificates of codimension-two points".
+    see docs/howto/errors.md, "Certificates of codimension-two points".
     ``meta["solutions"]``: the :class:`~ballbal.PeriodicSolution` of every row.
     """
     if not isinstance(branch, Branch) or branch.kind != "periodic":

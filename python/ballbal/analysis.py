@@ -394,6 +394,8 @@ class PeriodicSolution(Summarised, LineSource):
 
     @property
     def period(self) -> float:
+        """The orbit's period ``2 pi / omega`` in units of ``1 / omega_n``; a
+        :class:`ValueError` if the solve did not converge."""
         if self.omega is None:
             raise ValueError(f"no period: the solve did not converge (status {self.status})")
         return 2 * np.pi / self.omega

@@ -69,6 +69,7 @@ class Balancer:
 
     @property
     def n_balls(self) -> int:
+        """The number of balls (one per ``eta`` value)."""
         return len(self.eta)
 
     @property

@@ -345,10 +345,12 @@ class Scene:
     # the interface the analyses use, shared with Balancer
     @property
     def n_balls(self) -> int:
+        """The number of balls of the scene's balancer."""
         return self.balancer.n_balls
 
     @property
     def Omega(self) -> float:  # noqa: N802 - Tien's (2011) symbol
+        """The spin ratio of the scene's balancer."""
         return self.balancer.Omega
 
     @property
@@ -408,6 +410,8 @@ class Scene:
         return None
 
     def to_dict(self) -> dict[str, Any]:
+        """The scene as nested dictionaries, the tables of its TOML file
+        (:func:`~ballbal.load_scene` reads them back)."""
         d: dict[str, Any] = {"balancer": asdict(self.balancer)}
         b = d["balancer"]
         b["eta"] = list(b["eta"])
@@ -440,6 +444,7 @@ class Scene:
         return d
 
     def to_toml(self) -> str:
+        """The scene as the text of a TOML file (see :meth:`to_dict`)."""
         lines: list[str] = []
         for table, values in self.to_dict().items():
             lines.append(f"[{table}]")
@@ -456,6 +461,7 @@ class Scene:
         return "\n".join(lines)
 
     def save(self, path: str | os.PathLike[str]) -> None:
+        """Write :meth:`to_toml` to ``path`` (UTF-8), for :func:`~ballbal.load_scene`."""
         with open(path, "w", encoding="utf-8") as f:
             f.write(self.to_toml())
 

@@ -1,14 +1,16 @@
-"""Seed 003's figure 6(d) (omega0 0.6, m0 4, e 2): the evidence for docs/source_documents.md.
+"""Figure 6(d) of [EccentricRotorABB] (omega0 0.6, m0 4, e 2): the evidence for
+docs/source_documents.md.
 
-For each candidate reading of the seed, from the seed's own equations (``tests/seed003.py``,
-written independently of ballbal): the perfect balance's eigenvalues (roots of the
+For each candidate reading of the paper, from its own equations
+(``tests/disk_units_equations.py``, written independently of ballbal): the perfect
+balance's eigenvalues (roots of the
 characteristic polynomial ``det(lambda^2 M + lambda C + K)``), the Routh–Hurwitz verdict,
 and a scipy DOP853 run from the seed's start (``x = y = 0``, ``phi1 = pi/2``,
 ``phi2 = -pi/2``, at rest) reporting the radial vibration ``r = sqrt(x^2 + y^2)`` late in the
 run (its mean and peak-to-peak: a figure like 6(d) needs ``r`` to keep oscillating).
 Then ballbal's own verdict (``equilibria(from_disk_units(...))``).
 
-Run: ``python scripts/seed003_fig6d.py [--t-end 3000]``.
+Run: ``python scripts/disk_units_fig6d.py [--t-end 3000]``.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
-import seed003 as s3  # noqa: E402
+import disk_units_equations as s3  # noqa: E402
 
 W0, M0, E = 0.6, 4.0, 2.0
 #: Table 2's defaults; table 1's dimensional values give D0 = D / (m R^2 omega_n) = 1.414.
@@ -103,7 +105,7 @@ def main() -> None:
         w = r[(t >= a) & (t <= b)]
         print(f"as derived, t0 {a}-{b} ({a / wn:.1f}-{b / wn:.1f} s): r {w.min():.4f} to "
               f"{w.max():.4f} R")
-    # the readings that reproduce 6(d), on the seed's other panels
+    # the readings that reproduce 6(d), on the paper's other panels
     print("panels: balance's max Re lambda at 6(a) (20, 2), 6(b) (0.3, 2), 6(d) (0.6, 4); "
           "6(c) (4, 0.5) run to t0 300: mean r, p-p r (units R)")
     for name, c0, d0, sp2 in (("as derived", C0, D0, 1.0), ("phi2 row as printed", C0, D0, -1.0),

@@ -1,7 +1,7 @@
 """Seed 003's figure 6(d) (omega0 0.6, m0 4, e 2): the perfect balance is stable.
 
 The seed draws a radial vibration that never settles; its own equations (as eq. (3)
-gives them, ``tests/seed003.py``) make the perfect balance stable there. The
+gives them, ``tests/disk_units_equations.py``) make the perfect balance stable there. The
 characteristic polynomial is built here from those equations (central differences, a
 determinant sampled on a circle), judged by Routh–Hurwitz, and its roots compared with
 ballbal's eigenvalues in the seed's time unit; a DOP853 run from the seed's start settles
@@ -15,11 +15,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import seed003 as s3
 from scipy.integrate import solve_ivp
 
 import ballbal
 from ballbal.model import from_disk_units
+
+import disk_units_equations as s3
 
 W0, M0, E, C0, D0 = 0.6, 4.0, 2.0, 0.35, 0.35
 
