@@ -22,7 +22,7 @@ from ._branch import (
 )
 from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
-from .options import PERIODIC_DEFAULTS, PeriodicOptions
+from .options import BRANCH_DEFAULTS, PeriodicOptions
 from .scene import model_at
 
 __all__ = ["Branch", "Continuation", "periodic_branch"]
@@ -111,7 +111,8 @@ def periodic_branch(
     parameter value) and at an infinite period.
 
     Every point gets the certificates and Floquet multipliers of :func:`ballbal.periodic`
-    with ``periodic_options`` (default :data:`ballbal.options.PERIODIC_DEFAULTS`;
+    with ``periodic_options`` (default :data:`ballbal.options.BRANCH_DEFAULTS`: Magnus'
+    monodromy, Hill's method where the verdict is in doubt;
     ``Floquet(monodromy=False, hill=True)`` uses Hill's multipliers instead): a point
     whose certificate fails has status ``not_closed`` / ``truncated`` and is never
     called stable. Events (named as on every branch, see
@@ -161,7 +162,7 @@ def periodic_branch(
                             "ballbal.continuation.Continuation")
     options, both = directed(options, direction)
     popts = _check.option("periodic_options", periodic_options, PeriodicOptions,
-                          PERIODIC_DEFAULTS, "ballbal.PeriodicOptions")
+                          BRANCH_DEFAULTS, "ballbal.PeriodicOptions")
     n = start.N if N is None else _check.integer("N", N, 1, 256)
     popts = replace(popts, harmonic_balance=replace(popts.harmonic_balance, N=n))
     min_omega = _check.real("min_omega", min_omega)

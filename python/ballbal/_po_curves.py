@@ -17,7 +17,7 @@ from ._branch import Branch, Continuation, Curve, event_row, parameter_range
 from ._po_continuation import _multipliers
 from .analysis import _solution
 from .exceptions import ParameterError, ParameterTypeError
-from .options import PERIODIC_DEFAULTS, PeriodicOptions
+from .options import BRANCH_DEFAULTS, PeriodicOptions
 from .scene import model_at
 
 __all__ = ["periodic_curve"]
@@ -59,7 +59,8 @@ def periodic_curve(
     continued with its balls merged.
 
     ``table``: one row per point (the two parameters, ``omega``, ``period``, status,
-    stability and multipliers with ``periodic_options``, ``modulus_error`` and
+    stability and multipliers with ``periodic_options`` (default
+    :data:`ballbal.options.BRANCH_DEFAULTS`), ``modulus_error`` and
     ``modulus_error_source`` (the bound on the leading non-trivial modulus' error that the
     verdict was judged against, from a series with more harmonics, as on a
     :func:`~ballbal.continuation.periodic_branch`; the point keeps its ``N``, and a
@@ -110,7 +111,7 @@ def periodic_curve(
                             Continuation(ds=0.01, ds_max=0.05, max_points=200),
                             "ballbal.continuation.Continuation")
     popts = _check.option("periodic_options", periodic_options, PeriodicOptions,
-                          PERIODIC_DEFAULTS, "ballbal.PeriodicOptions")
+                          BRANCH_DEFAULTS, "ballbal.PeriodicOptions")
     n = int(branch.meta.get("N", branch.event_solutions[i].N))
     popts = replace(popts, harmonic_balance=replace(popts.harmonic_balance, N=n))
     locate_tol = _check.real("locate_tol", locate_tol)

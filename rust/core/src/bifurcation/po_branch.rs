@@ -301,7 +301,7 @@ fn bordered_det<P: Problem + ?Sized>(prob: &mut P, pt: &ArcPoint, w: &[f64]) -> 
             }
         }
     }
-    Ok(m.lu().determinant())
+    Ok(crate::numerics::linalg::ColumnLu::new(m.as_slice(), n + 1).determinant())
 }
 
 /// The index of the trivial multiplier (the one closest to 1; `usize::MAX` without any).

@@ -20,8 +20,9 @@
 //! point and of a fold.
 
 use crate::error::{Error, Result};
+use crate::numerics::linalg::ColumnLu;
 use crate::numerics::problem::Problem;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 /// Settings of [`Arclength`].
 #[derive(Debug, Clone)]
@@ -231,13 +232,12 @@ fn tangent_at<P: Problem + ?Sized>(
     let n1 = y.len();
     let row: Vec<f64> = orient.iter().zip(w).map(|(o, w)| o * w).collect();
     let (m, _) = bordered(problem, y, &row)?;
-    let mut rhs = DVector::zeros(n1);
+    let mut rhs = vec![0.0; n1];
     rhs[n1 - 1] = 1.0;
-    let lu = m.clone().lu();
-    let Some(t) = lu.solve(&rhs) else {
+    let Some(t) = ColumnLu::new(m.as_slice(), n1).solve(&rhs) else {
         return Ok(None);
     };
-    let norm = wdot(w, t.as_slice(), t.as_slice()).sqrt();
+    let norm = wdot(w, &t, &t).sqrt();
     if !(norm > 0.0 && norm.is_finite()) {
         return Ok(None);
     }
@@ -249,7 +249,7 @@ fn tangent_at<P: Problem + ?Sized>(
     for j in 0..n1 {
         mt[(n1 - 1, j)] = w[j] * t[j];
     }
-    let det = mt.lu().determinant();
+    let det = ColumnLu::new(mt.as_slice(), n1).determinant();
     Ok(Some((t, det.signum())))
 }
 
@@ -274,7 +274,7 @@ fn correct<P: Problem + ?Sized>(
             Err(Error::InvalidParameter { .. }) => return Ok(None),
             Err(e) => return Err(e),
         };
-        let mut rhs = DVector::zeros(n1);
+        let mut rhs = vec![0.0; n1];
         for i in 0..n {
             rhs[i] = -r[i];
         }
@@ -283,7 +283,7 @@ fn correct<P: Problem + ?Sized>(
             t,
             &y.iter().zip(y_pred).map(|(a, b)| a - b).collect::<Vec<_>>(),
         );
-        let Some(dy) = m.lu().solve(&rhs) else {
+        let Some(dy) = ColumnLu::new(m.as_slice(), n1).solve(&rhs) else {
             // Singular exactly on a branch point: a point that already solves F stands.
             let ok = max_abs(&r) <= opts.tol && rhs[n].abs() <= opts.tol;
             return Ok(ok.then(|| (y.clone(), it - 1, max_abs(&r))));
@@ -294,7 +294,7 @@ fn correct<P: Problem + ?Sized>(
         for (yi, d) in y.iter_mut().zip(dy.iter()) {
             *yi += d;
         }
-        let step = max_abs(dy.as_slice());
+        let step = max_abs(&dy);
         let mut rr = vec![0.0; n];
         match problem.residual(&y[..n], y[n], &mut rr) {
             Ok(()) => {}
