@@ -141,7 +141,8 @@ def periodic_branch(
     ``modulus_error``). ``"auto"`` (default): harmonic balance, handing over to
     collocation at the first point where, with omega falling, harmonic balance's omega
     bound exceeds 1e-6 of omega, its certificates fail, or omega falls below
-    ``min_omega`` (the rows up to there are those of ``"hb"``). The ``method`` column
+    ``min_omega`` (the rows up to there are those of ``"hb"``; without Floquet
+    multipliers there is no omega bound, and only the last two hand over). The ``method`` column
     says which discretisation each row used. On collocation rows ``dp_ds``,
     ``det_sign``, ``test_fold`` and ``test_branch_point`` are NaN (no arclength tangent);
     the multiplier events are located between rows by bisection in the parameter on the
@@ -149,7 +150,9 @@ def periodic_branch(
     orbit, which falls to zero linearly at a saddle-node on the invariant circle: the
     ``infinite_period`` event is its zero extrapolated from the last two rows, the branch
     approaching it in steps that halve the remaining distance and ending when the last
-    row is within ``event_tol`` of it (``min_omega`` does not end collocation rows).
+    row is within ``event_tol`` of it, or when a row's speed leaves the line through the
+    two before it by half (the orbit no longer resolves it; the end is then where those
+    two put it). ``min_omega`` does not end collocation rows.
 
     Every verdict is bounded as :func:`ballbal.periodic`'s is, but at the branch's own
     ``N`` (a branch keeps one truncation): the point's series is solved again from itself

@@ -429,7 +429,11 @@ pub fn periodic_branch_both_ways<D: Parametric>(
 
 /// Continues the periodic solution `start` (a converged series of `base`) in the
 /// parameter `name` of `base` over `opts.arc.p_min ..= p_max`, from `base`'s value of
-/// it, with `opts.periodic.hb.n_harm` harmonics.
+/// it, with `opts.periodic.hb.n_harm` harmonics, by `opts.method`: harmonic balance, or
+/// collocation from the start's series ([`super::po_colloc`]), or harmonic balance
+/// handing over to collocation ([`SWITCH_OMEGA_ERROR`]; the rows' `method` says which).
+/// Without Floquet options a point has no `omega_error`, and `Auto` hands over only
+/// where the certificates fail or omega falls below `min_omega`.
 pub fn periodic_branch<D: Parametric>(
     base: &D,
     name: &str,

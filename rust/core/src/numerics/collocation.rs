@@ -1698,6 +1698,37 @@ mod tests {
         assert!((fitted - omega_star).abs() < 5e-9, "fitted end {fitted}");
     }
 
+    /// The slowest speed along an orbit near the infinite-period end against a brute-force
+    /// minimum: the model's vector field at 200 000 evenly spaced times (its own
+    /// `accel`, not the collocation's `Rhs`). The golden-section search must find a
+    /// minimum at least as low, and not lower by more than the grid's resolution allows.
+    #[test]
+    fn colloc_slowest_speed_matches_a_dense_search() {
+        let p = balancer(0.93);
+        let r = hb(&balancer(1.2), 24, None);
+        let o = opts(50);
+        let s = solve(&balancer(1.2), &CollocOrbit::from_hb(&r.sol, 50, 4), &o).unwrap();
+        let down = follow(&balancer(1.2), "Omega", &s, 0.93, 0.05, 1e-6, &o).unwrap();
+        let orbit = &down.last().unwrap().solution.orbit;
+        let (v, at) = slowest_speed(&p, orbit);
+        let d = orbit.n / 2;
+        let (mut y, mut dy, mut a) = (vec![0.0; orbit.n], vec![0.0; orbit.n], vec![0.0; d]);
+        let mut brute = (f64::INFINITY, 0.0);
+        let k = 200_000;
+        for i in 0..k {
+            let sc = i as f64 / k as f64;
+            orbit.eval(sc, &mut y, &mut dy);
+            p.accel(0.0, &y[..d], &y[d..], &mut a);
+            let speed = (y[d..].iter().chain(&a).map(|x| x * x).sum::<f64>()).sqrt();
+            if speed < brute.0 {
+                brute = (speed, sc);
+            }
+        }
+        assert!(v <= brute.0 * (1.0 + 1e-12), "{v} vs {brute:?}");
+        assert!(v > 0.99 * brute.0, "{v} vs {brute:?}");
+        assert!((at - brute.1).abs() < 1e-3, "{at} vs {brute:?}");
+    }
+
     /// The collocation system through the generic [`Problem`] interface: its
     /// implicit-function tangent's `dT/dOmega` against the difference of two solves.
     #[test]
