@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 import ballbal
-from ballbal.continuation import periodic_branch
+from ballbal.continuation import Continuation, periodic_branch
 from ballbal.exceptions import ParameterError
 
-from shooting import shoot
+from shooting import monodromy_multipliers, shoot
 
 ZETA = 0.05
 OMEGA_STAR = float(np.sqrt(1 + 3 * ZETA**2) - np.sqrt(3) * ZETA)
@@ -147,3 +147,32 @@ def test_forced_collocation_agrees_with_resolved_harmonic_balance(start):
 def test_bad_method_is_refused(start):
     with pytest.raises(ParameterError, match="method"):
         periodic_branch(start, "Omega", range=(0.9, 1.2), method="fourier")  # type: ignore[arg-type]
+
+
+def test_period_doubling_located_on_a_collocation_branch():
+    """The merged R-R branch in eta (Omega 1.2, zeta_b 0.05) doubles its period near eta
+    0.8676: located on collocation rows (bisection on the discretised multipliers), the
+    orbit there has a real multiplier at -1 by tests/shooting.py's finite-difference
+    monodromy, and the harmonic-balance branch (N = 8) puts it at the same eta."""
+    b = ballbal.Balancer(mu=0.2, zeta=0.05, delta=50.0, zeta_b=0.05, Omega=1.2,
+                         eta=(0.9, 0.9))
+    opts = ballbal.PeriodicOptions(harmonic_balance=ballbal.HarmonicBalance(N=8),
+                                   floquet=ballbal.Floquet(hill=False))
+    s = ballbal.periodic(b, "R-R", options=opts)
+    cont = Continuation(ds=0.01, ds_max=0.02, forward=False, max_points=60)
+    col = periodic_branch(s, "eta", range=(0.8, 0.9), periodic_options=opts, options=cont,
+                          method="collocation")
+    hb = periodic_branch(s, "eta", range=(0.8, 0.9), periodic_options=opts, options=cont,
+                         method="hb")
+    pd_c = col.events.filter(col.events["type"] == "period_doubling")
+    pd_h = hb.events.filter(hb.events["type"] == "period_doubling")
+    assert pd_c.height == pd_h.height == 1
+    eta = float(pd_c["eta"][0])
+    assert abs(eta - float(pd_h["eta"][0])) < 1e-6, (eta, pd_h["eta"][0])
+    k = int(np.flatnonzero(col.events["type"] == "period_doubling")[0])
+    sol = col.event_solutions[k]
+    q = sol.balancer
+    y0, T = shoot(q, np.asarray(sol.state(0.0), dtype=float), sol.period, [0, 0, -1, -1],
+                  phase_index=2)
+    ev = monodromy_multipliers(q, y0, T)
+    assert np.min(np.abs(ev + 1)) < 1e-4, ev
