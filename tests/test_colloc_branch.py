@@ -176,3 +176,17 @@ def test_period_doubling_located_on_a_collocation_branch():
                   phase_index=2)
     ev = monodromy_multipliers(q, y0, T)
     assert np.min(np.abs(ev + 1)) < 1e-4, ev
+
+
+def test_stop_conditions_on_collocation_rows(start):
+    """stop_period and a stop at a user point, both met past the hand-over."""
+    b = periodic_branch(start, "Omega", range=(0.9, 1.2), direction="backward",
+                        stop_period=1000.0)
+    assert b.stop == "period"
+    last = b.table.row(-1, named=True)
+    assert last["method"] == "collocation"
+    assert abs(last["period"] / 1000.0 - 1) < 1e-9
+    u = periodic_branch(start, "Omega", range=(0.9, 1.2), direction="backward", at=[0.95],
+                        stop="UZ")
+    assert u.stop == "user"
+    assert u.table["Omega"][-1] == 0.95 and u.table["method"][-1] == "collocation"
