@@ -351,6 +351,48 @@ def hb_curve(br: Branch, name: str, popts: ballbal.PeriodicOptions) -> dict:
     return {"points": t.height, "Omega_end": hit["Omega"][0] if hit.height else None}
 
 
+def branch_runs(repeat: int) -> None:
+    """``periodic_branch`` itself (multipliers and certificates at every row): the
+    downward run to the end with every default (``method="auto"``: harmonic balance,
+    then collocation), and the matched branch (1.2 -> 1.3, and 1.2 -> 0.93) by harmonic
+    balance (N = 24, the N that matches AUTO NTST 20's period accuracy at 0.93) and by
+    collocation (NTST 50)."""
+    from ballbal.continuation import periodic_branch
+
+    start = ballbal.periodic(balancer(1.2), "R-R")
+    t_down, down = median_time(lambda: periodic_branch(
+        start, "Omega", range=(0.9, 1.2), direction="backward", at=[0.95, 0.93]), repeat)
+    tb = down.table
+    methods = tb["method"].to_list()
+    k = methods.index("collocation") if "collocation" in methods else len(methods)
+    switch = tb["Omega"][k] if k < len(methods) else float("nan")
+    ip = down.events.filter(down.events["type"] == "infinite_period")
+    user = down.events.filter(down.events["type"] == "user")
+    print(f"periodic_branch defaults, 1.2 -> end: {t_down:6.3f} s, {tb.height} rows "
+          f"({k} hb, {tb.height - k} collocation; switch at Omega {switch:.6f}), stop "
+          f"{down.stop!r}, reach {tb['Omega'][-1] - OMEGA_STAR:.1e} (T {tb['period'][-1]:.3e}),"
+          f" end event {ip['Omega'][0] - OMEGA_STAR if ip.height else float('nan'):+.1e} "
+          f"from Omega*; periods at {user['Omega'].to_list()}: {user['period'].to_list()}",
+          flush=True)
+    times = {}
+    for name, kw in (("hb N=24", {"N": 24, "method": "hb"}),
+                     ("collocation NTST 50", {"method": "collocation"})):
+        def matched(kw=kw):
+            up = periodic_branch(start, "Omega", range=(1.2, 1.3), direction="forward",
+                                 **kw)
+            dn = periodic_branch(start, "Omega", range=(0.93, 1.2), direction="backward",
+                                 **kw)
+            return up, dn
+        t, (up, dn) = median_time(matched, repeat)
+        times[name] = t
+        rows = up.table.height + dn.table.height
+        print(f"matched branch with multipliers, {name}: {t:6.3f} s, {rows} rows "
+              f"({1e3 * t / rows:.1f} ms per row), stops {up.stop!r} / {dn.stop!r}, "
+              f"T(0.93) {dn.table['period'][-1]:.9f}", flush=True)
+    h, c = times["hb N=24"], times["collocation NTST 50"]
+    print(f"ratio collocation / hb on the matched branch: {c / h:.2f}", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--ntst", type=int, nargs="+", default=[20, 50, 100])
@@ -381,6 +423,7 @@ def main() -> None:
               f"{t_down:6.3f} s ({len(down['param'])} points), reach {reach:.1e} "
               f"(T {down['period'][-1]:.3e}, mesh indicator {down['mesh_error'][-1]:.1e})",
               flush=True)
+    branch_runs(a.repeat)
     side_by_side(a.ntst, a.repeat, Path(a.anchor))
 
 

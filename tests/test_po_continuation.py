@@ -272,8 +272,10 @@ def rr_zeta_b_01_down() -> ballbal.continuation.Branch:
     b = ballbal.Balancer(mu=0.2, zeta=0.05, zeta_b=0.1, delta=50.0, Omega=1.0,
                          eta=(1.0, 1.0))
     start = ballbal.periodic(b, "R-R", options=OPTS)
+    # Harmonic balance's own end (method="auto" would hand over to collocation).
     return periodic_branch(start, "Omega", range=(0.5, 1.0),
-                           options=Continuation(ds=0.02, ds_max=0.05, forward=False))
+                           options=Continuation(ds=0.02, ds_max=0.05, forward=False),
+                           method="hb")
 
 
 def _simulated_period(b: ballbal.Balancer, y0: np.ndarray, t_end: float) -> float:

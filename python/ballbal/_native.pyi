@@ -182,7 +182,8 @@ def periodic_branch(
     start: tuple[float, npt.NDArray[np.float64], list[float]], p_range: tuple[float, float],
     continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
     both: bool = False, at: Sequence[float] | None = None, stop: Sequence[str] | None = None,
-    stop_period: float | None = None,
+    stop_period: float | None = None, method: str = "hb",
+    collocation: Collocation | None = None,
 ) -> dict[str, Any]: ...
 # {"kind", "together", "points": [solution dict + p1, p2, test, test_*], "special", "stop"}
 # special: [{"type", "p1", "p2", "omega", "row", "status" ("confirmed" | "rejected" |

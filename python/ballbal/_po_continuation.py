@@ -22,7 +22,7 @@ from ._branch import (
 )
 from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
-from .options import BRANCH_DEFAULTS, PeriodicOptions
+from .options import BRANCH_DEFAULTS, COLLOCATION_DEFAULTS, Collocation, PeriodicOptions
 from .scene import model_at
 
 __all__ = ["Branch", "Continuation", "periodic_branch"]
@@ -54,7 +54,9 @@ def _row(parameter: str, d: dict[str, Any]) -> dict[str, Any]:
         "test_fold": d["test_fold"], "test_branch_point": d["test_branch_point"],
         "test_branch_point_multipliers": d["test_branch_point_multipliers"],
         "test_period_doubling": d["test_period_doubling"],
-        "test_neimark_sacker": d["test_neimark_sacker"], "event": d["event"],
+        "test_neimark_sacker": d["test_neimark_sacker"],
+        "test_infinite_period": d["test_infinite_period"], "method": d["method"],
+        "event": d["event"],
     }
 
 
@@ -66,7 +68,7 @@ def _schema(parameter: str) -> dict[str, Any]:
             "closure": f, "tail": f, "separation_error": f, "residual": f, "dp_ds": f,
             "det_sign": f, "test_fold": f, "test_branch_point": f,
             "test_branch_point_multipliers": f, "test_period_doubling": f,
-            "test_neimark_sacker": f, "event": s}
+            "test_neimark_sacker": f, "test_infinite_period": f, "method": s, "event": s}
 
 
 def periodic_branch(
@@ -83,6 +85,8 @@ def periodic_branch(
     at: float | Sequence[float] | None = None,
     stop: str | Sequence[str] | None = None,
     stop_period: float | None = None,
+    method: Literal["hb", "collocation", "auto"] = "auto",
+    collocation: Collocation | None = None,
 ) -> Branch:
     """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
     in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
@@ -128,6 +132,29 @@ def periodic_branch(
     ``T = C / sqrt|p - p*| + D``, the period law near a saddle-node on the invariant
     circle).
 
+    ``method``: the discretisation. ``"hb"``: harmonic balance with ``N`` harmonics,
+    pseudo-arclength through folds (every row as before). ``"collocation"``: orthogonal
+    collocation on an adaptive mesh (``collocation``, a :class:`~ballbal.Collocation`,
+    default :data:`ballbal.options.COLLOCATION_DEFAULTS`; the mesh adapted at every
+    point), continued naturally in the parameter (a fold ends it with
+    ``"step_too_small"``), every row certified as ``periodic(method="collocation")``
+    certifies its orbit (closure; the discretised monodromy's multipliers with
+    ``modulus_error``). ``"auto"`` (default): harmonic balance, handing over to
+    collocation at the first point where, with omega falling, harmonic balance's omega
+    bound exceeds 1e-6 of omega, its certificates fail, or omega falls below
+    ``min_omega`` (the rows up to there are those of ``"hb"``; without Floquet
+    multipliers there is no omega bound, and only the last two hand over). The ``method`` column
+    says which discretisation each row used. On collocation rows ``dp_ds``,
+    ``det_sign``, ``test_fold`` and ``test_branch_point`` are NaN (no arclength tangent);
+    the multiplier events are located between rows by bisection in the parameter on the
+    discretised multipliers; ``test_infinite_period`` is the slowest speed along the
+    orbit, which falls to zero linearly at a saddle-node on the invariant circle: the
+    ``infinite_period`` event is its zero extrapolated from the last two rows, the branch
+    approaching it in steps that halve the remaining distance and ending when the last
+    row is within ``event_tol`` of it, or when a row's speed leaves the line through the
+    two before it by half (the orbit no longer resolves it; the end is then where those
+    two put it). ``min_omega`` does not end collocation rows.
+
     Every verdict is bounded as :func:`ballbal.periodic`'s is, but at the branch's own
     ``N`` (a branch keeps one truncation): the point's series is solved again from itself
     with more harmonics (``N 3 vs 5``, ``N 8 vs 12``), and ``modulus_error`` (twice the
@@ -170,12 +197,16 @@ def periodic_branch(
     at_values, stop_events = branch_controls(at, stop)
     if stop_period is not None:
         stop_period = _check.real("stop_period", stop_period)
+    if method not in ("hb", "collocation", "auto"):
+        raise ParameterError("method", f'must be "hb", "collocation" or "auto", got {method!r}')
+    colloc = _check.option("collocation", collocation, Collocation, COLLOCATION_DEFAULTS,
+                           "ballbal.Collocation")
     model = start.balancer
     coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
     winding = [float(w) for w in start.winding]
     d = _native.periodic_branch(model, parameter, (float(start.omega), coeffs, winding),
                                 (lo, hi), options, popts, min_omega, event_tol, both,
-                                at_values, stop_events, stop_period)
+                                at_values, stop_events, stop_period, method, colloc)
     table = pl.DataFrame([_row(parameter, p) for p in d["points"]], schema=_schema(parameter),
                          orient="row") if d["points"] else pl.DataFrame(schema=_schema(parameter))
     ev_rows = []
@@ -194,5 +225,5 @@ def periodic_branch(
     return Branch(kind="periodic", parameter=parameter, table=table, events=events,
                   stop=d["stop"], solutions=solutions, event_solutions=event_solutions,
                   meta={"N": n, "pattern": start.type, "range": (lo, hi),
-                        "min_omega": min_omega, "event_tol": event_tol,
+                        "min_omega": min_omega, "event_tol": event_tol, "method": method,
                         "options": options})

@@ -1,15 +1,18 @@
 //! Continuation of periodic solutions in one parameter: `ballbal.continuation.
 //! periodic_branch`'s native half (core: `ballbal_core::bifurcation::po_branch`).
 
+use crate::collocation::CollocArgs;
 use crate::continuation::{controls, ContinuationArgs};
 use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
 use crate::run::guarded;
 use crate::tables::solution_dict;
+use ballbal_core::analysis::colloc_periodic::Method;
 use ballbal_core::bifurcation::po_branch::{
     periodic_branch as core_branch, periodic_branch_both_ways, PoBranchOptions, PoPoint,
 };
 use ballbal_core::hb::{HbSolution, Status};
+use ballbal_core::numerics::collocation::CollocOptions;
 use ballbal_core::periodic::require_autonomous;
 use ballbal_core::{Dynamics, Error};
 use numpy::PyReadonlyArray1;
@@ -34,6 +37,8 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
     d.set_item("test_branch_point_multipliers", pt.tests.bp_multipliers)?;
     d.set_item("test_period_doubling", pt.tests.pd)?;
     d.set_item("test_neimark_sacker", pt.tests.ns)?;
+    d.set_item("test_infinite_period", pt.tests.ip)?;
+    d.set_item("method", pt.method.as_str())?;
     d.set_item(
         "event",
         pt.events
@@ -48,14 +53,15 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
 /// Continues the periodic solution `start = (omega, coeffs, winding)` of `model` in
 /// `parameter` over `p_range` (`both`: both ways from the start, joined into one branch),
 /// with user points at the parameter values `at`, stopping at the first event named in
-/// `stop` or where the period reaches `stop_period`; returns `{"points": [dict],
+/// `stop` or where the period reaches `stop_period`, by `method` ("hb", "collocation" or
+/// "auto", collocation with `collocation`'s options); returns `{"points": [dict],
 /// "events": [dict], "stop": str}`.
 #[allow(
     clippy::too_many_arguments,
     reason = "a #[pyfunction]'s arguments are the Python call's keywords"
 )]
 #[pyfunction]
-#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false, at=None, stop=None, stop_period=None))]
+#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false, at=None, stop=None, stop_period=None, method="hb", collocation=None))]
 pub fn periodic_branch<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -70,7 +76,14 @@ pub fn periodic_branch<'py>(
     at: Option<Vec<f64>>,
     stop: Option<Vec<String>>,
     stop_period: Option<f64>,
+    method: &str,
+    collocation: Option<CollocArgs>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let method = Method::parse(method).py()?;
+    let collocation = match &collocation {
+        Some(c) => c.to_core()?,
+        None => CollocOptions::default(),
+    };
     // A scene is continued as a scene even with every effect off (as a scan does).
     let always_scene = matches!(model, ModelArgs::Scene(_));
     let m = model.build(always_scene).py()?;
@@ -100,6 +113,8 @@ pub fn periodic_branch<'py>(
         event_tol,
         controls: controls(at, stop)?,
         stop_period,
+        method,
+        collocation,
     };
     let name = parameter.to_string();
     let b = guarded(py, || {

@@ -12,6 +12,7 @@
 pub mod equilibria;
 pub mod event;
 pub mod po_branch;
+mod po_colloc;
 pub mod po_curves;
 pub mod switch;
 

@@ -26,10 +26,18 @@
 //!   fitted `p*` falls short of the saddle-node's closed form by far more than the fit's
 //!   error; docs/measurements.md, "Continuation and bifurcation", has the numbers).
 //!
+//! Under [`Method::Auto`] the branch hands over to collocation ([`super::po_colloc`])
+//! on its way to an infinite-period end, before harmonic balance's series loses the
+//! period's accuracy ([`SWITCH_OMEGA_ERROR`]); collocation then locates the `IP` event
+//! from the orbits (their slowest speed), not from the fit above.
+//!
 //! Every test function is continuous along the branch and changes sign exactly at its
 //! event; [`crate::continuation::locate`] finds the zero in arclength to `event_tol`,
 //! which bounds the error in the parameter (`|dp/ds| <= 1` in the unit tangent).
 
+pub use super::po_colloc::RowMethod;
+use super::po_colloc::{collocation_tail, TailStart};
+pub use crate::analysis::colloc_periodic::Method;
 use crate::bifurcation::event::{check_stop_events, Event};
 use crate::continuation::arclength::bordered;
 use crate::continuation::curves::join_halves;
@@ -39,6 +47,7 @@ use crate::continuation::{
 use crate::error::{Error, Result};
 use crate::floquet::Stability;
 use crate::hb::{default_samples, solve, HbProblem, HbSolution, Status};
+use crate::numerics::collocation::{CollocOptions, CollocOrbit};
 use crate::numerics::problem::{ModelAt, Parametric, Problem};
 use crate::periodic::{finish_on_branch, multipliers_on_branch, Periodic, PeriodicOptions};
 
@@ -60,7 +69,25 @@ pub struct PoBranchOptions {
     /// The branch ends where the period reaches this (it must exceed the start's), its
     /// last row solved with that period; the stop reason is `"period"`.
     pub stop_period: Option<f64>,
+    /// The discretisation: harmonic balance ([`Method::Hb`], pseudo-arclength through
+    /// folds), collocation ([`Method::Collocation`], natural continuation in the
+    /// parameter: see [`super::po_colloc`]), or harmonic balance switching to collocation
+    /// where its series is no longer accurate on the way to an infinite-period end
+    /// ([`Method::Auto`]: see [`SWITCH_OMEGA_ERROR`]).
+    pub method: Method,
+    /// Collocation's mesh and Newton settings.
+    pub collocation: CollocOptions,
 }
+
+/// Under [`Method::Auto`] the branch leaves harmonic balance for collocation at the
+/// first point, with omega falling along the branch, whose frequency bound
+/// (`omega_error`, from the finer series the verdict is bounded against) exceeds this
+/// fraction of omega, or that fails its certificates, or whose omega falls below
+/// `min_omega`. 1e-6 is the period accuracy AUTO-07p's NTST 20 gives on the merged R-R
+/// branch of issue 33 at Omega 0.93; harmonic balance at the default `N = 3` passes it
+/// near Omega 1.08 there (its omega bound grows as the slow phase sharpens), and its
+/// certificates still accept the series down to 0.951, where its period is 0.6 % off.
+pub const SWITCH_OMEGA_ERROR: f64 = 1e-6;
 
 /// The events a periodic branch can be asked to stop at (it always stops at an
 /// infinite period).
@@ -81,6 +108,8 @@ impl Default for PoBranchOptions {
             event_tol: 1e-7,
             controls: Controls::default(),
             stop_period: None,
+            method: Method::Hb,
+            collocation: CollocOptions::default(),
         }
     }
 }
@@ -99,6 +128,7 @@ impl PoBranchOptions {
         }
         self.arc.validate()?;
         self.periodic.validate()?;
+        self.collocation.validate()?;
         crate::error::check_range("min_omega", self.min_omega, 0.0, false, 1e3, true)?;
         crate::error::check_range("event_tol", self.event_tol, 0.0, true, 1.0, true)?;
         check_stop_events(&self.controls, &PO_STOP_EVENTS)?;
@@ -155,6 +185,11 @@ pub struct PoTests {
     pub ns: Option<f64>,
     /// Number of complex pairs among the non-trivial multipliers.
     pub complex_pairs: usize,
+    /// The slowest speed along the orbit (collocation rows: [`slowest_speed`]), zero at
+    /// an infinite-period end.
+    ///
+    /// [`slowest_speed`]: crate::numerics::collocation::slowest_speed
+    pub ip: Option<f64>,
 }
 
 /// One point of a branch.
@@ -168,6 +203,8 @@ pub struct PoPoint {
     pub tests: PoTests,
     /// Events located between the previous point and this one.
     pub events: Vec<PoEventKind>,
+    /// The discretisation the row was solved with.
+    pub method: RowMethod,
 }
 
 impl PoPoint {
@@ -273,6 +310,7 @@ impl<D: Parametric> Ctx<'_, D> {
             arc: pt.clone(),
             tests: PoTests::default(),
             events: vec![],
+            method: RowMethod::Hb,
         };
         if let Some(m) = po.multipliers() {
             let t = multiplier_tests(m);
@@ -319,7 +357,7 @@ fn trivial_index(m: &[(f64, f64)]) -> usize {
 /// `(bp, pd, ns, complex pairs)` from the multipliers, the trivial one (closest to 1)
 /// left out. Each factor is divided by a positive scale so that strongly unstable orbits
 /// (moduli up to 1e7) keep the products in range.
-fn multiplier_tests(m: &[(f64, f64)]) -> (f64, f64, f64, usize) {
+pub(super) fn multiplier_tests(m: &[(f64, f64)]) -> (f64, f64, f64, usize) {
     let trivial = trivial_index(m);
     let (mut bp, mut pd, mut ns) = ((1.0, 0.0), (1.0, 0.0), 1.0);
     let mut pairs = 0;
@@ -391,7 +429,11 @@ pub fn periodic_branch_both_ways<D: Parametric>(
 
 /// Continues the periodic solution `start` (a converged series of `base`) in the
 /// parameter `name` of `base` over `opts.arc.p_min ..= p_max`, from `base`'s value of
-/// it, with `opts.periodic.hb.n_harm` harmonics.
+/// it, with `opts.periodic.hb.n_harm` harmonics, by `opts.method`: harmonic balance, or
+/// collocation from the start's series ([`super::po_colloc`]), or harmonic balance
+/// handing over to collocation ([`SWITCH_OMEGA_ERROR`]; the rows' `method` says which).
+/// Without Floquet options a point has no `omega_error`, and `Auto` hands over only
+/// where the certificates fail or omega falls below `min_omega`.
 pub fn periodic_branch<D: Parametric>(
     base: &D,
     name: &str,
@@ -420,6 +462,36 @@ pub fn periodic_branch<D: Parametric>(
     }
     check_start(base, start)?;
     let (popts, n_harm, samples) = branch_options(&opts.periodic);
+    let copts = &opts.collocation;
+    if opts.method == Method::Collocation {
+        let dir = if opts.arc.forward { 1.0 } else { -1.0 };
+        let tail = collocation_tail(
+            base,
+            name,
+            &popts,
+            opts,
+            dir,
+            TailStart {
+                from_p: p0,
+                orbit: CollocOrbit::from_hb(start, copts.ntst, copts.ncol),
+                first_p: p0,
+                before: None,
+                offset: 0,
+                h0: opts.arc.ds,
+            },
+        )?;
+        if tail.points.is_empty() {
+            return Err(Error::param(
+                "start",
+                format!("does not converge by collocation at {name} = {p0}"),
+            ));
+        }
+        return Ok(PoBranch {
+            points: tail.points,
+            events: tail.events,
+            stop: tail.stop,
+        });
+    }
     // The start at the branch's own harmonics and samples.
     let first = solve(base, start, &popts.hb);
     if first.status != Status::Converged {
@@ -455,6 +527,8 @@ pub fn periodic_branch<D: Parametric>(
     let mut tests = PoTestsDeclared {
         ctx,
         min_omega: opts.min_omega,
+        auto: opts.method == Method::Auto,
+        switched: None,
     };
     let x0 = first.unknowns();
     let from = Start {
@@ -487,10 +561,32 @@ pub fn periodic_branch<D: Parametric>(
         &controls,
         &mut tests,
     )?;
+    let (mut points, mut events) = (run.points, run.events);
+    let mut stop = ArcStop::text(Some(&run.stop));
+    if let (Some(pb), Some(a)) = (tests.switched, points.last().cloned()) {
+        let tail = collocation_tail(
+            base,
+            name,
+            &tests.ctx.popts,
+            opts,
+            (pb - a.p).signum(),
+            TailStart {
+                from_p: a.p,
+                orbit: CollocOrbit::from_hb(&a.result.sol, copts.ntst, copts.ncol),
+                first_p: pb,
+                offset: points.len(),
+                h0: (pb - a.p).abs(),
+                before: Some(a),
+            },
+        )?;
+        points.extend(tail.points);
+        events.extend(tail.events);
+        stop = tail.stop;
+    }
     Ok(PoBranch {
-        points: run.points,
-        events: run.events,
-        stop: ArcStop::text(Some(&run.stop)),
+        points,
+        events,
+        stop,
     })
 }
 
@@ -529,6 +625,10 @@ fn multiplier_spectrum(m: &[(f64, f64)]) -> Spectrum {
 struct PoTestsDeclared<'a, D> {
     ctx: Ctx<'a, D>,
     min_omega: f64,
+    /// [`Method::Auto`]: hand over to collocation (see [`SWITCH_OMEGA_ERROR`]).
+    auto: bool,
+    /// Where it handed over: the parameter of the first point not kept.
+    switched: Option<f64>,
 }
 
 impl<D> PoTestsDeclared<'_, D> {
@@ -672,6 +772,14 @@ impl<D: Parametric, P: Problem + ?Sized> Declared<P> for PoTestsDeclared<'_, D> 
         let prev = points.last()?;
         let certified = b.result.sol.status == Status::Converged;
         let falling = b.omega() < prev.omega();
+        let loose = b
+            .result
+            .omega_error
+            .is_some_and(|e| e > SWITCH_OMEGA_ERROR * b.omega());
+        if self.auto && falling && (loose || !certified || b.omega() < self.min_omega) {
+            self.switched = Some(b.p);
+            return Some(("collocation", None));
+        }
         (b.omega() < self.min_omega || (!certified && falling))
             .then(|| ("infinite_period", Some(infinite_period(points))))
     }

@@ -1192,6 +1192,64 @@ pub fn integrated_monodromy<D: Dynamics + ?Sized>(
     Ok(phi)
 }
 
+/// The slowest speed `min_t |f(y(t))|` (Euclidean norm of the first-order vector field)
+/// along the orbit, and the scaled time where it is reached. Near a saddle-node on an
+/// invariant circle the orbit passes the bottleneck at a speed proportional to the
+/// parameter's distance from the saddle-node (normal form `x' = a (p - p*) + b x^2`), so
+/// it falls to zero linearly at the infinite-period end, where the period (`~ 1 /
+/// sqrt|p - p*|`) diverges: a test function read off the orbit itself. Each interval is
+/// sampled at `4 NCOL + 1` points, then the best sample's neighbourhood is searched by
+/// golden section (the slow phase is smooth, the minimum a parabola there).
+pub fn slowest_speed<D: Dynamics + ?Sized>(model: &D, orbit: &CollocOrbit) -> (f64, f64) {
+    let n = orbit.n;
+    let mut rhs = Rhs::new(n / 2);
+    let (mut y, mut dy, mut f) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    let mut speed = |s: f64| {
+        orbit.eval(s, &mut y, &mut dy);
+        rhs.eval(model, &y, &mut f, None);
+        f.iter().map(|v| v * v).sum::<f64>().sqrt()
+    };
+    let per = 4 * orbit.ncol;
+    let (mut best, mut at, mut width) = (f64::INFINITY, 0.0, 0.0);
+    for j in 0..orbit.ntst() {
+        let (a, b) = (orbit.mesh[j], orbit.mesh[j + 1]);
+        for k in 0..per {
+            let s = a + (b - a) * k as f64 / per as f64;
+            let v = speed(s);
+            if v < best {
+                (best, at, width) = (v, s, (b - a) / per as f64);
+            }
+        }
+    }
+    // Golden section on [at - width, at + width].
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut lo, mut hi) = (at - width, at + width);
+    let (mut c, mut d) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut fc, mut fd) = (speed(c), speed(d));
+    for _ in 0..80 {
+        if fc < fd {
+            hi = d;
+            (d, fd) = (c, fc);
+            c = hi - g * (hi - lo);
+            fc = speed(c);
+        } else {
+            lo = c;
+            (c, fc) = (d, fd);
+            d = lo + g * (hi - lo);
+            fd = speed(d);
+        }
+        if hi - lo < 1e-15 {
+            break;
+        }
+    }
+    let (s, v) = if fc < fd { (c, fc) } else { (d, fd) };
+    if v < best {
+        (v, s.rem_euclid(1.0))
+    } else {
+        (best, at)
+    }
+}
+
 /// The collocation system as a [`Problem`] (dense Jacobian; for the package's generic
 /// continuation and checks on small meshes): unknowns the point values and `T`, the
 /// parameter one of the model's.
@@ -1645,6 +1703,37 @@ mod tests {
         }
         let fitted = 0.5 * (lo + hi);
         assert!((fitted - omega_star).abs() < 5e-9, "fitted end {fitted}");
+    }
+
+    /// The slowest speed along an orbit near the infinite-period end against a brute-force
+    /// minimum: the model's vector field at 200 000 evenly spaced times (its own
+    /// `accel`, not the collocation's `Rhs`). The golden-section search must find a
+    /// minimum at least as low, and not lower by more than the grid's resolution allows.
+    #[test]
+    fn colloc_slowest_speed_matches_a_dense_search() {
+        let p = balancer(0.93);
+        let r = hb(&balancer(1.2), 24, None);
+        let o = opts(50);
+        let s = solve(&balancer(1.2), &CollocOrbit::from_hb(&r.sol, 50, 4), &o).unwrap();
+        let down = follow(&balancer(1.2), "Omega", &s, 0.93, 0.05, 1e-6, &o).unwrap();
+        let orbit = &down.last().unwrap().solution.orbit;
+        let (v, at) = slowest_speed(&p, orbit);
+        let d = orbit.n / 2;
+        let (mut y, mut dy, mut a) = (vec![0.0; orbit.n], vec![0.0; orbit.n], vec![0.0; d]);
+        let mut brute = (f64::INFINITY, 0.0);
+        let k = 200_000;
+        for i in 0..k {
+            let sc = i as f64 / k as f64;
+            orbit.eval(sc, &mut y, &mut dy);
+            p.accel(0.0, &y[..d], &y[d..], &mut a);
+            let speed = (y[d..].iter().chain(&a).map(|x| x * x).sum::<f64>()).sqrt();
+            if speed < brute.0 {
+                brute = (speed, sc);
+            }
+        }
+        assert!(v <= brute.0 * (1.0 + 1e-12), "{v} vs {brute:?}");
+        assert!(v > 0.99 * brute.0, "{v} vs {brute:?}");
+        assert!((at - brute.1).abs() < 1e-3, "{at} vs {brute:?}");
     }
 
     /// The collocation system through the generic [`Problem`] interface: its
