@@ -12,7 +12,7 @@ import ballbal
 from ballbal.basins import BasinOptions, basins
 from ballbal.exceptions import ParameterError, ParameterTypeError
 
-B = ballbal.Balancer(eta=0.7, zeta_b=0.05, Omega=1.2)
+B = ballbal.Balancer(eta=(0.7, 0.7), zeta_b=0.05, Omega=1.2)
 OPTS = BasinOptions(t_end=5.0, window=2.0)
 
 
