@@ -1,6 +1,9 @@
-"""Seed 002's start-up study (Yen 2005, fig. 3 and conclusion 1): a sudden start can whirl.
+"""A rotor's start-up on a journal bearing
+========================================
 
-The seed starts a rotor on a plain journal bearing suddenly at 500 rad/s from rest at
+Yen's (2005) start-up study (fig. 3 and conclusion 1): a sudden start can whirl.
+
+The paper starts a rotor on a plain journal bearing suddenly at 500 rad/s from rest at
 eccentricity 0.4, attitude -135 deg, and watches it converge; from 0.4005 it whirls into
 the sleeve. Its conclusion 1: a sudden start may touch the sleeve, while a start at a
 suitable speed reaches the same equilibrium from any position (after Li et al. 1999).
@@ -13,7 +16,7 @@ It gives no geometry, so the numbers here are ours, chosen so that the regime ap
   orbit instead of the equilibrium;
 * sudden starts (the journal at ``w`` from ``tau = 0``) from rest along -135 deg: the
   start eccentricity ``eps0*`` that separates the two outcomes is found by bisection (the
-  seed's 0.4 / 0.4005 is its value for its rotor);
+  paper's 0.4 / 0.4005 is its value for its rotor);
 * the same starts with a run-up from rest (``SpinUp(0, 100)``: linear to ``w`` over
   ``tau = 100``), which all converge on the one equilibrium.
 
@@ -121,7 +124,7 @@ def main() -> None:
     ax[2].set_xlabel("tau = w t")
     ax[2].set_ylabel("eccentricity")
     ax[2].legend(fontsize=7)
-    fig.suptitle("seed 002 fig. 3: sudden start against spin-up (plain bearing, L/D 1)",
+    fig.suptitle("Yen (2005) fig. 3: sudden start against spin-up (plain bearing, L/D 1)",
                  fontsize=10)
     fig.tight_layout()
     path = os.path.join(out_dir, "bearing_spin_up.png")

@@ -1,7 +1,7 @@
 """Stability regions of a tilting rotor in its own units
 =====================================================
 
-Seed 004's (Rezaee et al. 2017) stability maps in its own axes: fig. 3 (the classic
+Rezaee et al.'s (2017) stability maps in its own axes: fig. 3 (the classic
 balancer on a Jeffcott rotor, lam against omega_bar), fig. 4 (the tilting disk on its
 shaft, lam against omega_bar, m_bar = eps_bar = 0.01, zeta_t = zeta_r = 0.1) and fig. 5
 (m_bar against omega_bar, lam = 0.1). The paper does not print its shaft geometry or

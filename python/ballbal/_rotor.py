@@ -77,7 +77,7 @@ class SpinUp:
     """A linear run-up of the journal's speed: ``s = start + (1 - start) tau / duration``
     times the reference speed ``w`` on ``0 <= tau <= duration``, ``start`` before and 1
     after (the journal's angle is its integral). ``start`` in ``[0, 1)``, ``duration`` in
-    ``(0, 1e12]`` (units ``1 / w``). Seed 002 (Yen 2005) contrasts its sudden start with
+    ``(0, 1e12]`` (units ``1 / w``). [Yen2005] contrasts its sudden start with
     a start from rest, after Li et al. (1999)."""
 
     start: float = 0.0

@@ -4,7 +4,7 @@ oil-filled track, from the oil's viscosity and the track's geometry.
 A ball of radius ``a`` moving at speed ``U`` through a viscous oil at small Reynolds
 number feels Stokes' drag ``F = 6 pi mu a U`` [Stokes1851]. In a track the walls are
 close, and the drag grows: for a sphere moving along the axis of a cylindrical channel
-of radius ``R`` Haberman and Sayre's wall factor [HabermanSayre1958]
+of radius ``R`` Haberman and Sayre's wall factor [HabermanSayre1958]::
 
     K(lam) = (1 - 0.75857 lam^5)
              / (1 - 2.1050 lam + 2.0865 lam^3 - 1.7068 lam^5 + 0.72603 lam^6),

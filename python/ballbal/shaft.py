@@ -1,4 +1,4 @@
-"""A ball(-spring) balancer on a flexible shaft in the units of [Rezaee2017] (seed 004).
+"""A ball(-spring) balancer on a flexible shaft in the units of [Rezaee2017].
 
 Rezaee et al. (2017) carry a disk (mass ``M``, mass centre at ``eps`` from the shaft,
 transverse and polar inertia ``J_t, J_z``) on a massless, simply supported shaft of

@@ -55,7 +55,7 @@ class DisturbanceResponse(Summarised):
 def _balanced_start(model: Balancer | Scene) -> np.ndarray:
     """The steady state at the starting speed, where the disturbance begins: the stable
     balanced state; or, when the balls cannot cancel the imbalance (total capacity
-    ``sum eta_i <= 1``, seed 001's light-ball cases), the stable equilibrium in which they
+    ``sum eta_i <= 1``, [TwoBallStrength]'s light-ball cases), the stable equilibrium in which they
     settle against it (of several, the one leaving the least imbalance), or at exactly
     the capacity the perfect balance, marginal as it is."""
     if isinstance(model, Scene) and model.time_dependence is not None:
@@ -97,7 +97,7 @@ def disturbance_response(
 ) -> DisturbanceResponse:
     """Start at the stable perfect balance at ``model.Omega`` (balls under capacity,
     ``sum eta_i <= 1``: at the stable equilibrium where they settle against the
-    imbalance, seed 001's light-ball cases), change the spin to
+    imbalance, [TwoBallStrength]'s light-ball cases), change the spin to
     ``to`` linearly over ``duration`` from ``start`` ([TwoBallStrength]: 100 rad/s in 0.11 s), and
     measure the radial vibration. ``band`` is in units of the eccentricity ``e``.
 
