@@ -12,8 +12,6 @@ import pathlib
 from typing import Any
 
 OUTPUT = pathlib.Path(__file__).resolve().parent / "_build" / "gallery-output"
-# The two scripts that take their output file as ``--out FILE`` rather than a directory.
-OUT_FILE = {"ball_spring_tilt", "grooved_bearing_rotor"}
 
 
 def argv(gallery_conf: dict[str, Any], script_vars: dict[str, Any]) -> list[str]:
@@ -21,8 +19,6 @@ def argv(gallery_conf: dict[str, Any], script_vars: dict[str, Any]) -> list[str]
     name = pathlib.Path(script_vars["src_file"]).stem
     out = OUTPUT / name
     out.mkdir(parents=True, exist_ok=True)
-    if name in OUT_FILE:
-        return ["--out", str(out / f"{name}.png")]
     if name.startswith("plot_"):
         return []
     return [str(out)]

@@ -9,7 +9,7 @@ Rezaee et al. (2017): the ball-spring balancer on a tilting rotor with gyroscopi
 2. The run-up through the critical speed of both (its figures 8 to 10): peak whirl and
    peak tilt.
 
-Run: python examples/ball_spring_tilt.py [--out ball_spring_tilt.png]   (about 5 s)
+Run: python examples/ball_spring_tilt.py [OUT_DIR]   (about 5 s)
 """
 
 import argparse
@@ -31,7 +31,7 @@ BASE = ballbal.Scene(
 SPRINGS = 2e-5
 MAX_WHIRL = 0.1  # residual whirl (units of e) still counted as balanced
 # BALLBAL_EXAMPLE_SMALL=1 (tests/test_examples.py): maps of 9 x 5 points and a short
-# run-up, written into a temporary directory unless --out is given.
+# run-up, written into a temporary directory unless an output directory is given.
 SMALL = os.environ.get("BALLBAL_EXAMPLE_SMALL") == "1"
 SPEEDS, PLANE_POINTS = (9, 5) if SMALL else (77, None)
 RUN_UP, SETTLE = (100.0, 200.0) if SMALL else (300.0, 600.0)
@@ -77,16 +77,17 @@ def run_up(ax):
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    name = "ball_spring_tilt.png"
-    default = os.path.join(tempfile.mkdtemp(prefix="ball_spring_tilt-"), name) if SMALL else name
-    ap.add_argument("--out", default=default)
+    default = tempfile.mkdtemp(prefix="ball_spring_tilt-") if SMALL else "ball_spring_tilt"
+    ap.add_argument("out", nargs="?", default=default, help="output directory")
     args = ap.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    png = os.path.join(args.out, "ball_spring_tilt.png")
     fig, ax = plt.subplots(3, 2, figsize=(10, 12))
     maps(ax)
     run_up(ax[2])
     fig.tight_layout()
-    fig.savefig(args.out, dpi=110)
-    print(f"wrote {args.out}")
+    fig.savefig(png, dpi=110)
+    print(f"wrote {png}")
 
 
 if __name__ == "__main__":

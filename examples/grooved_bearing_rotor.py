@@ -21,7 +21,7 @@ Panels (seed figures 2-19): two starts converging to one equilibrium (plain bear
 Yen's (2005) smooth one), the impulse response against groove angle, L/D, depth and width ratio
 (orbit and tangential film force), and the three unbalance regimes.
 
-Run: ``python examples/grooved_bearing_rotor.py [--out grooved_bearing_rotor.png]``;
+Run: ``python examples/grooved_bearing_rotor.py [OUT_DIR]``;
 ``BALLBAL_EXAMPLE_SMALL=1`` runs a shortened version (fewer values, shorter times) for the tests.
 """
 
@@ -120,14 +120,13 @@ def describe(label: str, tr: RotorTrajectory, seconds: float) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    name = "grooved_bearing_rotor.png"
-    ap.add_argument("--out", default=None)
+    ap.add_argument("out", nargs="?", default=None, help="output directory")
     args = ap.parse_args()
-    # The default is made only when needed: the documentation's gallery runs this script
-    # with --out and without a __file__.
-    if args.out is None:
-        args.out = os.path.join(tempfile.mkdtemp(prefix="grooved_bearing_rotor-"), name) \
-            if SMALL else os.path.join(os.path.dirname(os.path.abspath(__file__)), name)
+    if args.out is None:  # made only when needed (a temporary directory in small mode)
+        args.out = (tempfile.mkdtemp(prefix="grooved_bearing_rotor-") if SMALL
+                    else "grooved_bearing_rotor")
+    os.makedirs(args.out, exist_ok=True)
+    png = os.path.join(args.out, "grooved_bearing_rotor.png")
     t_all = time.perf_counter()
     base = RotorOnBearing(grooved(), MASS, gravity=GRAVITY)
     xe, ye = rotor_equilibrium(base)
@@ -190,8 +189,8 @@ def main() -> None:
     orbit(ax[4, 0], runs, "mass unbalance (fig. 16-18)")
     tangential(ax[4, 1], runs, "mass unbalance: tangential force (fig. 19)")
     fig.tight_layout()
-    fig.savefig(args.out, dpi=60)
-    print(f"total {time.perf_counter() - t_all:.1f} s; wrote {args.out}")
+    fig.savefig(png, dpi=60)
+    print(f"total {time.perf_counter() - t_all:.1f} s; wrote {png}")
 
 
 if __name__ == "__main__":
