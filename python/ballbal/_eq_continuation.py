@@ -22,6 +22,7 @@ from ballbal._branch import (
     event_row,
     parameter_range,
 )
+from ballbal._progress import Progress, ProgressArg
 from ballbal.analysis import Equilibrium, _equilibrium, capacities, equilibria
 from ballbal.exceptions import ParameterError, ParameterTypeError
 from ballbal.model import Balancer, DiskUnits
@@ -133,7 +134,8 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
                        range: tuple[float, float], options: Continuation = _DEFAULT,
                        direction: Literal["forward", "backward", "both"] | None = None,
                        at: float | Sequence[float] | None = None,
-                       stop: str | Sequence[str] | None = None) -> Branch:
+                       stop: str | Sequence[str] | None = None,
+                       progress: ProgressArg = False) -> Branch:
     """The branch of equilibria through ``start`` (an :class:`~ballbal.Equilibrium` of
     ``model``, or a kind name: the first equilibrium of that kind) continued in
     ``parameter`` (any name ``with_param`` takes: ``"Omega"``, ``"eta"`` (all balls),
@@ -169,7 +171,11 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
     antisymmetric ball mode's stiffness), ``test_hopf`` (the bialternate-product
     determinant) and ``event``, the events located since the previous row). ``events``:
     fold, Hopf (with its frequency ``omega``) and branch points, located to ~1e-11 in
-    arclength."""
+    arclength.
+
+    ``progress``: True for a progress bar over the points (tqdm, notebook-aware), or a
+    callable ``f(done, total)`` called as points are added (``total`` the most the call
+    can make: ``max_points`` per direction)."""
     native, seed = _native_model(model)
     model_argument("model", native)
     parameter = _check.string("parameter", parameter)
@@ -186,8 +192,11 @@ def equilibrium_branch(model: Any, parameter: str, *, start: Equilibrium | str =
         start = found[0]
     if not isinstance(start, Equilibrium):
         raise ParameterTypeError("start", "must be an Equilibrium or a kind name")
-    d = _native.equilibrium_branch(native, parameter, [float(v) for v in start.q], start.kind,
-                                   rng, options, both, seed, at_values, stop_events)
+    with Progress(progress, options.max_points * (2 if both else 1), "ballbal branch",
+                  "point") as bar:
+        d = _native.equilibrium_branch(native, parameter, [float(v) for v in start.q],
+                                       start.kind, rng, options, both, seed, at_values,
+                                       stop_events, bar.reporter())
     return _branch(d, parameter, model, rng, options)
 
 
@@ -197,27 +206,34 @@ def _event(branch: Any, event: Any) -> int:
     return event_row(branch, event)
 
 
-def switch_equilibrium(branch: Branch, event: int | str = "branch_point") -> Branch:
+def switch_equilibrium(branch: Branch, event: int | str = "branch_point", *,
+                       progress: ProgressArg = False) -> Branch:
     """The other branch through the branch point ``event`` of ``branch`` (a row of
     ``branch.events``, or an event name: the first event of that kind; default the first
     branch point), e.g. the perfect balance born at the pitchfork of the balls-together
     branch, eta = 1/2 for two balls, started along the null vector of ``[F_q, F_p]``
-    orthogonal to the branch's tangent, over the same range with the same options."""
+    orthogonal to the branch's tangent, over the same range with the same options.
+
+    ``progress``: True for a progress bar over the points (tqdm, notebook-aware), or a
+    callable ``f(done, total)`` called as points are added (``total`` the most the call
+    can make: ``max_points`` per direction)."""
     i = _event(branch, event)
     if branch.events["type"][i] != "branch_point":
         raise ParameterError("event", f"event {i} is a {branch.events['type'][i]}, "
                              "not a branch point", allowed="branch_point")
     m = branch.meta
     native, seed = _native_model(m["model"])
-    d = _native.equilibrium_switch(native, branch.parameter, m["event_x"][i],
-                                   float(branch.events[branch.parameter][i]),
-                                   m["event_tangent"][i], m["range"], m["options"], seed)
+    with Progress(progress, m["options"].max_points, "ballbal branch", "point") as bar:
+        d = _native.equilibrium_switch(native, branch.parameter, m["event_x"][i],
+                                       float(branch.events[branch.parameter][i]),
+                                       m["event_tangent"][i], m["range"], m["options"], seed,
+                                       bar.reporter())
     return _branch(d, branch.parameter, m["model"], m["range"], m["options"])
 
 
 def equilibrium_curve(branch: Branch, event: int | str, parameter2: str, *,
-                      range: tuple[float, float], options: Continuation = _DEFAULT
-                      ) -> Curve:
+                      range: tuple[float, float], options: Continuation = _DEFAULT,
+                      progress: ProgressArg = False) -> Curve:
     """The curve of the bifurcation ``event`` of ``branch`` (an event name, e.g.
     ``"fold"``: the first event of that kind along the branch, or a row of
     ``branch.events``) in (the branch's parameter, ``parameter2``), ``range`` bounding
@@ -236,7 +252,11 @@ def equilibrium_curve(branch: Branch, event: int | str, parameter2: str, *,
     saddle-node curve meets the pitchfork; for two balls at (Omega, eta) = (1, 1/2),
     in the disk's units (omega0, m0) = (1/sqrt(1 + 2 m0), e/2), where the second zero
     eigenvalue is the antisymmetric ball mode's), ``"saddle_node"`` (a pitchfork curve
-    meets the saddle-node curve)."""
+    meets the saddle-node curve).
+
+    ``progress``: True for a progress bar over the points (tqdm, notebook-aware), or a
+    callable ``f(done, total)`` called as points are added (``total`` the most the call
+    can make: ``max_points`` per direction)."""
     i = _event(branch, event)
     parameter2 = _check.string("parameter2", parameter2)
     rng = parameter_range(range)
@@ -250,9 +270,11 @@ def equilibrium_curve(branch: Branch, event: int | str, parameter2: str, *,
                              allowed="fold, hopf, or a together branch point")
     m = branch.meta
     native, seed = _native_model(m["model"])
-    d = _native.equilibrium_curve(native, etype, branch.parameter, parameter2,
-                                  m["event_x"][i], float(branch.events[branch.parameter][i]),
-                                  together, rng, options, seed)
+    with Progress(progress, 2 * options.max_points, "ballbal curve", "point") as bar:
+        d = _native.equilibrium_curve(native, etype, branch.parameter, parameter2,
+                                      m["event_x"][i],
+                                      float(branch.events[branch.parameter][i]),
+                                      together, rng, options, seed, bar.reporter())
     p1, p2 = branch.parameter, parameter2
     pts = d["points"]
     sp = d["special"]

@@ -96,14 +96,17 @@ def event_name(text: str, parameter: str = "event") -> str: ...
 def equilibrium_branch(model: Balancer | Scene, parameter: str, q: Sequence[float], kind: str,
                        range: tuple[float, float], options: Any, both: bool = False,
                        disk_units: Any = None, at: Sequence[float] | None = None,
-                       stop: Sequence[str] | None = None) -> dict[str, Any]: ...
+                       stop: Sequence[str] | None = None,
+                       progress: Callable[[int], object] | None = None) -> dict[str, Any]: ...
 def equilibrium_switch(model: Balancer | Scene, parameter: str, x: Sequence[float], p: float,
                        tangent: Sequence[float], range: tuple[float, float],
-                       options: Any, disk_units: Any = None) -> dict[str, Any]: ...
+                       options: Any, disk_units: Any = None,
+                       progress: Callable[[int], object] | None = None) -> dict[str, Any]: ...
 def equilibrium_curve(model: Balancer | Scene, kind: str, parameter: str, parameter2: str,
                       q: Sequence[float], p1: float, together: bool,
                       range: tuple[float, float], options: Any,
-                      disk_units: Any = None) -> dict[str, Any]: ...
+                      disk_units: Any = None,
+                      progress: Callable[[int], object] | None = None) -> dict[str, Any]: ...
 # (status, equilibrium dict or None) per point: "ok", "no_balance" or "not_converged"
 def balance_map(
     model: Balancer | Scene, names: list[str], points: list[list[float]],
@@ -183,7 +186,7 @@ def periodic_branch(
     continuation: Continuation, options: PeriodicOptions, min_omega: float, event_tol: float,
     both: bool = False, at: Sequence[float] | None = None, stop: Sequence[str] | None = None,
     stop_period: float | None = None, method: str = "hb",
-    collocation: Collocation | None = None,
+    collocation: Collocation | None = None, progress: Callable[[int], object] | None = None,
 ) -> dict[str, Any]: ...
 # {"kind", "together", "points": [solution dict + p1, p2, test, test_*], "special", "stop"}
 # special: [{"type", "p1", "p2", "omega", "row", "status" ("confirmed" | "rejected" |
@@ -192,5 +195,5 @@ def periodic_curve(
     model: Balancer | Scene, kind: str, parameter: str, parameter2: str,
     start: tuple[float, npt.NDArray[np.float64], list[float]], range: tuple[float, float],
     range1: tuple[float, float], continuation: Continuation, options: PeriodicOptions,
-    locate_tol: float,
+    locate_tol: float, progress: Callable[[int], object] | None = None,
 ) -> dict[str, Any]: ...

@@ -20,6 +20,7 @@ from ._branch import (
     directed,
     parameter_range,
 )
+from ._progress import Progress, ProgressArg
 from .analysis import PeriodicSolution, _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import BRANCH_DEFAULTS, COLLOCATION_DEFAULTS, Collocation, PeriodicOptions
@@ -87,6 +88,7 @@ def periodic_branch(
     stop_period: float | None = None,
     method: Literal["hb", "collocation", "auto"] = "auto",
     collocation: Collocation | None = None,
+    progress: ProgressArg = False,
 ) -> Branch:
     """Continue the periodic solution ``start`` (converged, from :func:`ballbal.periodic`)
     in the model parameter ``parameter`` (``"Omega"``, ``"eta"``, ``"zeta_b"``,
@@ -177,7 +179,10 @@ def periodic_branch(
     value, ``index``: the row after it), ``solutions`` and
     ``event_solutions`` (:class:`~ballbal.PeriodicSolution` objects with the model at
     their parameter value, row for row and event for event).
-    """
+
+    ``progress``: True for a progress bar over the points (tqdm, notebook-aware), or a
+    callable ``f(done, total)`` called as points are added (``total`` the most the call
+    can make: ``max_points`` per direction)."""
     if not isinstance(start, PeriodicSolution):
         raise ParameterTypeError("start", "must be a PeriodicSolution (from ballbal.periodic)",
                                  value=start)
@@ -204,9 +209,12 @@ def periodic_branch(
     model = start.balancer
     coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
     winding = [float(w) for w in start.winding]
-    d = _native.periodic_branch(model, parameter, (float(start.omega), coeffs, winding),
-                                (lo, hi), options, popts, min_omega, event_tol, both,
-                                at_values, stop_events, stop_period, method, colloc)
+    with Progress(progress, options.max_points * (2 if both else 1), "ballbal branch",
+                  "point") as bar:
+        d = _native.periodic_branch(model, parameter, (float(start.omega), coeffs, winding),
+                                    (lo, hi), options, popts, min_omega, event_tol, both,
+                                    at_values, stop_events, stop_period, method, colloc,
+                                    bar.reporter())
     table = pl.DataFrame([_row(parameter, p) for p in d["points"]], schema=_schema(parameter),
                          orient="row") if d["points"] else pl.DataFrame(schema=_schema(parameter))
     ev_rows = []

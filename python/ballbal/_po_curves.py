@@ -15,6 +15,7 @@ import polars as pl
 from . import _check, _native
 from ._branch import Branch, Continuation, Curve, event_row, parameter_range
 from ._po_continuation import _multipliers
+from ._progress import Progress, ProgressArg
 from .analysis import _solution
 from .exceptions import ParameterError, ParameterTypeError
 from .options import BRANCH_DEFAULTS, PeriodicOptions
@@ -40,6 +41,7 @@ def periodic_curve(
     options: Continuation | None = None,
     periodic_options: PeriodicOptions | None = None,
     locate_tol: float = 1e-8,
+    progress: ProgressArg = False,
 ) -> Curve:
     """The curve of the bifurcation ``event`` of a periodic branch (an event name, e.g.
     ``"period_doubling"``: the first event of that kind along the branch, or a row of
@@ -89,7 +91,10 @@ def periodic_curve(
     the added / the curve's own value) and ``error`` (the monodromy's estimated error);
     see docs/howto/errors.md, "Certificates of codimension-two points".
     ``meta["solutions"]``: the :class:`~ballbal.PeriodicSolution` of every row.
-    """
+
+    ``progress``: True for a progress bar over the points (tqdm, notebook-aware), or a
+    callable ``f(done, total)`` called as points are added (``total`` the most the call
+    can make: ``max_points`` per direction)."""
     if not isinstance(branch, Branch) or branch.kind != "periodic":
         raise ParameterTypeError("branch", "must be a periodic Branch (from periodic_branch)",
                                  value=branch)
@@ -119,8 +124,10 @@ def periodic_curve(
     model = start.balancer
     coeffs = np.ascontiguousarray(start.coeffs, dtype=np.float64).ravel()
     winding = [float(w) for w in start.winding]
-    d = _native.periodic_curve(model, kind, p1, p2, (float(start.omega), coeffs, winding),
-                               (lo, hi), (lo1, hi1), options, popts, locate_tol)
+    with Progress(progress, 2 * options.max_points, "ballbal curve", "point") as bar:
+        d = _native.periodic_curve(model, kind, p1, p2, (float(start.omega), coeffs, winding),
+                                   (lo, hi), (lo1, hi1), options, popts, locate_tol,
+                                   bar.reporter())
     pts = d["points"]
     flags: list[str | None] = [None] * len(pts)
     for s in d["special"]:

@@ -1,5 +1,6 @@
-"""Progress of the long Python-side loops (basins, speed sweeps, damping and accuracy
-studies), reported as :func:`ballbal.scan` reports its own: ``progress=True`` draws a
+"""Progress of the long loops (basins, speed sweeps, damping and accuracy studies on the
+Python side; continuation's branches and curves in the core, which count their points),
+reported as :func:`ballbal.scan` reports its own: ``progress=True`` draws a
 tqdm bar (``tqdm.auto``: a widget in a notebook, text in a terminal; a line on stderr
 without tqdm), a callable ``f(done, total)`` is called after each unit of work."""
 
@@ -54,6 +55,17 @@ class Progress:
             self.bar.update(n)
         if self.fn is not None:
             self.fn(self.done, self.total)
+
+    def to(self, done: int) -> None:
+        """Moves the count to ``done`` (the core reports how far it is, not by how much
+        it moved)."""
+        if done > self.done:
+            self.update(done - self.done)
+
+    def reporter(self) -> Callable[[int], None] | None:
+        """What the core's continuation loops call with their count of points: ``to``,
+        or ``None`` when nothing is shown."""
+        return self.to if self.bar is not None or self.fn is not None else None
 
     def close(self) -> None:
         if self.bar is not None:

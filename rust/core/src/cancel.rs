@@ -14,12 +14,14 @@
 
 use crate::error::{Error, Result};
 use std::cell::RefCell;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
 
-/// A shared flag asking the computations that hold it to stop.
+/// A shared flag asking the computations that hold it to stop, and a count of the units
+/// of work they report done ([`advance`]: a continuation's points), which whoever
+/// installed the token can read while the work runs (a progress bar).
 #[derive(Debug, Clone, Default)]
-pub struct Token(Arc<AtomicBool>);
+pub struct Token(Arc<AtomicBool>, Arc<AtomicUsize>);
 
 impl Token {
     pub fn new() -> Self {
@@ -37,6 +39,11 @@ impl Token {
     /// The flag itself, for APIs that take one explicitly (the parallel scan).
     pub fn flag(&self) -> &AtomicBool {
         &self.0
+    }
+
+    /// The units of work reported done so far.
+    pub fn done(&self) -> usize {
+        self.1.load(Ordering::Relaxed)
     }
 }
 
@@ -64,6 +71,16 @@ pub fn with<R>(token: Option<Token>, f: impl FnOnce() -> R) -> R {
 /// This thread's token, to hand on to work done on other threads.
 pub fn current() -> Option<Token> {
     CURRENT.with(|c| c.borrow().clone())
+}
+
+/// Reports one more unit of work done to this thread's token (nothing without one): a
+/// continuation's loops call it per point kept, so that a caller can show progress.
+pub fn advance() {
+    CURRENT.with(|c| {
+        if let Some(t) = c.borrow().as_ref() {
+            t.1.fetch_add(1, Ordering::Relaxed);
+        }
+    });
 }
 
 /// Whether this thread's token asks to stop.

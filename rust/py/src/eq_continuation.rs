@@ -5,7 +5,7 @@
 use crate::continuation::{controls, ContinuationArgs};
 use crate::convert::{dispatch, Model, ModelArgs};
 use crate::errors::{not_autonomous, CoreResult};
-use crate::run::guarded;
+use crate::run::guarded_progress;
 use crate::tables::equilibrium_dict;
 use ballbal_core::bifurcation::equilibria::{
     branch, branch_both_ways, curve, switch, CurveKind, EqBranch, EqCurve, EqOptions, EqSystem,
@@ -267,7 +267,7 @@ fn curve_dict(py: Python<'_>, c: EqCurve) -> PyResult<Bound<'_, PyDict>> {
     reason = "a #[pyfunction]'s arguments are the Python call's keywords"
 )]
 #[pyfunction]
-#[pyo3(signature = (model, parameter, q, kind, range, options, both=false, disk_units=None, at=None, stop=None))]
+#[pyo3(signature = (model, parameter, q, kind, range, options, both=false, disk_units=None, at=None, stop=None, progress=None))]
 pub fn equilibrium_branch<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -280,13 +280,15 @@ pub fn equilibrium_branch<'py>(
     disk_units: Option<DiskUnitsArgs>,
     at: Option<Vec<f64>>,
     stop: Option<Vec<String>>,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let k = kind_from(&kind).py()?;
     let mut opts = options_checked(&m, &options, range)?;
     opts.controls = controls(at, stop)?;
-    let b = guarded(
+    let b = guarded_progress(
         py,
+        progress.as_ref(),
         || dispatch!(&m, d => run_branch(d, disk_units.as_ref(), &parameter, &q, k, both, &opts)),
     )?;
     branch_dict(py, b)
@@ -298,7 +300,7 @@ pub fn equilibrium_branch<'py>(
     reason = "a #[pyfunction]'s arguments are the Python call's keywords"
 )]
 #[pyfunction]
-#[pyo3(signature = (model, parameter, x, p, tangent, range, options, disk_units=None))]
+#[pyo3(signature = (model, parameter, x, p, tangent, range, options, disk_units=None, progress=None))]
 pub fn equilibrium_switch<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -309,11 +311,13 @@ pub fn equilibrium_switch<'py>(
     range: (f64, f64),
     options: ContinuationArgs,
     disk_units: Option<DiskUnitsArgs>,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let opts = options_checked(&m, &options, range)?;
-    let b = guarded(
+    let b = guarded_progress(
         py,
+        progress.as_ref(),
         || dispatch!(&m, d => run_switch(d, disk_units.as_ref(), &parameter, &x, p, &tangent, &opts)),
     )?;
     branch_dict(py, b)
@@ -328,7 +332,7 @@ pub fn equilibrium_switch<'py>(
     reason = "a #[pyfunction]'s arguments are the Python call's keywords"
 )]
 #[pyfunction]
-#[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options, disk_units=None))]
+#[pyo3(signature = (model, kind, parameter, parameter2, q, p1, together, range, options, disk_units=None, progress=None))]
 pub fn equilibrium_curve<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -341,6 +345,7 @@ pub fn equilibrium_curve<'py>(
     range: (f64, f64),
     options: ContinuationArgs,
     disk_units: Option<DiskUnitsArgs>,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = self::model(&model)?;
     let k = match Event::parse(&kind, "event").py()? {
@@ -358,8 +363,9 @@ pub fn equilibrium_curve<'py>(
         }
     };
     let opts = options_checked(&m, &options, range)?;
-    let c = guarded(
+    let c = guarded_progress(
         py,
+        progress.as_ref(),
         || dispatch!(&m, d => run_curve(d, disk_units.as_ref(), k, (&parameter, &parameter2), (&q, p1), together, &opts)),
     )?;
     curve_dict(py, c)

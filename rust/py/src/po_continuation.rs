@@ -5,7 +5,7 @@ use crate::collocation::CollocArgs;
 use crate::continuation::{controls, ContinuationArgs};
 use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
-use crate::run::guarded;
+use crate::run::guarded_progress;
 use crate::tables::solution_dict;
 use ballbal_core::analysis::colloc_periodic::Method;
 use ballbal_core::bifurcation::po_branch::{
@@ -61,7 +61,7 @@ fn point_dict<'py>(py: Python<'py>, pt: PoPoint, n_balls: usize) -> PyResult<Bou
     reason = "a #[pyfunction]'s arguments are the Python call's keywords"
 )]
 #[pyfunction]
-#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false, at=None, stop=None, stop_period=None, method="hb", collocation=None))]
+#[pyo3(signature = (model, parameter, start, p_range, continuation, options, min_omega, event_tol, both=false, at=None, stop=None, stop_period=None, method="hb", collocation=None, progress=None))]
 pub fn periodic_branch<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -78,6 +78,7 @@ pub fn periodic_branch<'py>(
     stop_period: Option<f64>,
     method: &str,
     collocation: Option<CollocArgs>,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let method = Method::parse(method).py()?;
     let collocation = match &collocation {
@@ -117,7 +118,7 @@ pub fn periodic_branch<'py>(
         collocation,
     };
     let name = parameter.to_string();
-    let b = guarded(py, || {
+    let b = guarded_progress(py, progress.as_ref(), || {
         if both {
             dispatch!(&m, x => periodic_branch_both_ways(x, &name, &start, &opts))
         } else {

@@ -4,7 +4,7 @@
 use crate::continuation::ContinuationArgs;
 use crate::convert::{dispatch, slice, ModelArgs, PeriodicArgs};
 use crate::errors::{not_autonomous, CoreResult};
-use crate::run::guarded;
+use crate::run::guarded_progress;
 use crate::tables::solution_dict;
 use ballbal_core::bifurcation::po_curves::{
     periodic_curve as core_curve, PoCurveKind, PoCurveOptions,
@@ -29,7 +29,7 @@ use pyo3::types::PyDict;
     reason = "a #[pyfunction]'s arguments are the Python call's keywords"
 )]
 #[pyfunction]
-#[pyo3(signature = (model, kind, parameter, parameter2, start, range, range1, continuation, options, locate_tol))]
+#[pyo3(signature = (model, kind, parameter, parameter2, start, range, range1, continuation, options, locate_tol, progress=None))]
 pub fn periodic_curve<'py>(
     py: Python<'py>,
     model: ModelArgs,
@@ -42,6 +42,7 @@ pub fn periodic_curve<'py>(
     continuation: ContinuationArgs,
     options: PeriodicArgs,
     locate_tol: f64,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let always_scene = matches!(model, ModelArgs::Scene(_));
     let m = model.build(always_scene).py()?;
@@ -72,8 +73,9 @@ pub fn periodic_curve<'py>(
         locate_tol,
     };
     let names = [parameter.to_string(), parameter2.to_string()];
-    let c = guarded(
+    let c = guarded_progress(
         py,
+        progress.as_ref(),
         || dispatch!(&m, x => core_curve(x, [&names[0], &names[1]], k, &start, &opts)),
     )?;
     let out = PyDict::new(py);

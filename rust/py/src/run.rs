@@ -23,6 +23,30 @@ pub fn guarded<T: Send, F: FnOnce() -> Result<T, Error> + Send>(
     )
 }
 
+/// [`guarded`], calling `progress(done)` (a Python callable, with the GIL) whenever the
+/// count of work the core reports done ([`cancel::advance`]: a continuation's points)
+/// has grown, at most every [`POLL`] and once at the end. An error it raises cancels the
+/// work, as Ctrl-C does.
+pub fn guarded_progress<T: Send, F: FnOnce() -> Result<T, Error> + Send>(
+    py: Python<'_>,
+    progress: Option<&Bound<'_, PyAny>>,
+    f: F,
+) -> PyResult<T> {
+    let mut shown = 0usize;
+    run_ticking(
+        py,
+        |tok, _: &std::sync::mpsc::Sender<()>| cancel::with(Some(tok.clone()), f),
+        |()| Ok(()),
+        |done| match progress {
+            Some(p) if done > shown => {
+                shown = done;
+                p.call1((done,)).map(|_| ())
+            }
+            _ => Ok(()),
+        },
+    )
+}
+
 /// The one way the binding runs core work: `work` runs on a worker thread (given a
 /// cancellation token and a channel), while this thread, without the GIL, waits and
 /// checks for signals every [`POLL`] (only the main thread sees them) and hands every
@@ -30,12 +54,25 @@ pub fn guarded<T: Send, F: FnOnce() -> Result<T, Error> + Send>(
 /// `KeyboardInterrupt`), or `on_msg`'s first error, cancels the token; the core's long
 /// loops notice it within milliseconds, and that exception is raised once the worker
 /// has stopped. A panic in the work becomes `InternalError`.
-pub fn run_polled<T, M, W, H>(py: Python<'_>, work: W, mut on_msg: H) -> PyResult<T>
+pub fn run_polled<T, M, W, H>(py: Python<'_>, work: W, on_msg: H) -> PyResult<T>
 where
     T: Send,
     M: Send,
     W: FnOnce(&cancel::Token, &std::sync::mpsc::Sender<M>) -> Result<T, Error> + Send,
     H: FnMut(M) -> PyResult<()>,
+{
+    run_ticking(py, work, on_msg, |_| Ok(()))
+}
+
+/// [`run_polled`], also handing `on_tick` the token's count of work done at every poll
+/// and once when the work has ended.
+fn run_ticking<T, M, W, H, K>(py: Python<'_>, work: W, mut on_msg: H, mut on_tick: K) -> PyResult<T>
+where
+    T: Send,
+    M: Send,
+    W: FnOnce(&cancel::Token, &std::sync::mpsc::Sender<M>) -> Result<T, Error> + Send,
+    H: FnMut(M) -> PyResult<()>,
+    K: FnMut(usize) -> PyResult<()>,
 {
     use std::sync::mpsc;
     let token = cancel::Token::new();
@@ -76,7 +113,7 @@ where
                 }
                 Err(mpsc::RecvTimeoutError::Timeout) => {
                     if pending.is_none() {
-                        if let Err(e) = py.check_signals() {
+                        if let Err(e) = py.check_signals().and_then(|()| on_tick(token.done())) {
                             token.cancel();
                             pending = Some(e);
                         }
@@ -84,6 +121,9 @@ where
                 }
                 Err(mpsc::RecvTimeoutError::Disconnected) => break,
             }
+        }
+        if pending.is_none() {
+            pending = on_tick(token.done()).err();
         }
         Ok(py.detach(|| handle.join()))
     })?;

@@ -445,6 +445,7 @@ pub(super) fn collocation_tail<D: Parametric>(
         cur_p = row.point.p;
         cur_orbit = row.orbit;
         points.push(row.point);
+        crate::cancel::advance();
         if let Some(w) = why {
             stop = w;
             break;

@@ -437,6 +437,7 @@ where
         splits = 0;
         rate = rate_b;
         points.push(b);
+        crate::cancel::advance();
         if let Some(why) = stopping {
             arc.finish(why);
             break;

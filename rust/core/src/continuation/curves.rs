@@ -205,6 +205,7 @@ where
             }
         }
         points.push(hook.point(arc.problem(), &pt, &tt)?);
+        crate::cancel::advance();
         prev = Some((pt, tt));
     }
     let stop = arc.stop().cloned().unwrap_or(ArcStop::MaxPoints);
