@@ -1,5 +1,5 @@
-"""Continuation shows progress (issue 34): ``progress=`` on every branch and curve
-function counts the points as the core adds them (a bar, or a callable ``f(done,
+"""The core's long calls show progress (issue 34): ``progress=`` on every branch and
+curve function, and on groove studies, counts the points as the core adds them (a bar, or a callable ``f(done,
 total)``); the count ends at the number of rows the result holds, never goes back, and an
 error raised by the callable stops the work as Ctrl-C does."""
 
@@ -68,3 +68,13 @@ def test_progress_must_be_a_flag_or_a_callable() -> None:
     with pytest.raises(ParameterTypeError) as e:
         cont.equilibrium_branch(b, "eta1", range=(0.6, 1.4), progress="yes")  # type: ignore
     assert e.value.parameter == "progress"
+
+
+def test_a_groove_study_counts_its_points_whatever_the_threads() -> None:
+    from ballbal.bearing import Bearing, groove_study
+
+    for threads in (1, 2):
+        calls, cb = _record()
+        df = groove_study(Bearing(grid=(32, 8)), angle=[20.0, 40.0], depth_ratio=[0.5, 1.0],
+                          threads=threads, progress=cb)
+        _counted(calls, df.height, 4)

@@ -31,6 +31,7 @@ import polars as pl
 
 from . import _check
 from ._geometry import Bearing
+from ._progress import Progress, ProgressArg
 from .exceptions import ParameterError, ParameterTypeError
 
 COLUMNS = (
@@ -70,7 +71,8 @@ def _point_cells(bearing: Bearing, count: int) -> int:
 def groove_study(bearing: Bearing, *, angle: Sequence[float] = (30.0,),
                  depth_ratio: Sequence[float] = (1.0,), width_ratio: Sequence[float] = (0.5,),
                  length_ratio: Sequence[float] | None = None, count: Sequence[int] = (8,),
-                 eccentricity: float = 0.5, threads: int | None = None) -> pl.DataFrame:
+                 eccentricity: float = 0.5, threads: int | None = None,
+                 progress: ProgressArg = False) -> pl.DataFrame:
     """The cartesian product of the axes (``angle`` in degrees from the circumferential
     direction, slowest; then ``depth_ratio``, ``width_ratio``, ``length_ratio`` (default:
     the bearing's), ``count``), one row per point; see the module documentation for the
@@ -78,7 +80,10 @@ def groove_study(bearing: Bearing, *, angle: Sequence[float] = (30.0,),
     :data:`~ballbal._check.MAX_THREADS`; each holds one point's film, and all of them
     together at most :data:`~ballbal._check.MAX_STUDY_CELLS` cells. At most
     :data:`~ballbal._check.MAX_GROOVE_POINTS` points. Bad axis values raise
-    :class:`~ballbal.exceptions.ParameterError` naming the axis."""
+    :class:`~ballbal.exceptions.ParameterError` naming the axis.
+
+    ``progress``: True for a progress bar over the points (tqdm, notebook-aware), or a
+    callable ``f(done, total)``."""
     from . import _native
 
     if not isinstance(bearing, Bearing):
@@ -117,9 +122,10 @@ def groove_study(bearing: Bearing, *, angle: Sequence[float] = (30.0,),
             "threads", f"{at_once} threads would each hold a film of up to {cells} cells, "
             f"at most {_check.MAX_STUDY_CELLS} cells in all: use fewer threads or a coarser "
             "grid", allowed=f"threads * cells <= {_check.MAX_STUDY_CELLS}", value=threads)
-    cols = _native.groove_study(bearing, reals["angle"], reals["depth_ratio"],
-                                reals["width_ratio"], reals["length_ratio"], counts, ecc,
-                                n_threads)
+    with Progress(progress, points, "ballbal groove study", "point") as bar:
+        cols = _native.groove_study(bearing, reals["angle"], reals["depth_ratio"],
+                                    reals["width_ratio"], reals["length_ratio"], counts, ecc,
+                                    n_threads, bar.reporter())
     schema = {c: (pl.Int64 if c == "count" else pl.Utf8 if c == "status" else pl.Float64)
               for c in COLUMNS}
     return pl.DataFrame({c: cols[c] for c in COLUMNS}, schema=schema)

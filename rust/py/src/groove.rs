@@ -3,7 +3,7 @@
 
 use crate::bearing::BearingArgs;
 use crate::errors::CoreResult;
-use crate::run::guarded;
+use crate::run::guarded_progress;
 use ballbal_core::model::bearing::study::{groove_study as core_study, GrooveAxes};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
     reason = "a #[pyfunction]'s arguments are the Python call's keywords"
 )]
 #[pyfunction]
-#[pyo3(signature = (bearing, angle, depth_ratio, width_ratio, length_ratio, count, eccentricity, threads=None))]
+#[pyo3(signature = (bearing, angle, depth_ratio, width_ratio, length_ratio, count, eccentricity, threads=None, progress=None))]
 pub fn groove_study<'py>(
     py: Python<'py>,
     bearing: BearingArgs,
@@ -26,6 +26,7 @@ pub fn groove_study<'py>(
     count: Vec<usize>,
     eccentricity: f64,
     threads: Option<usize>,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let base = bearing.to_core().py()?;
     let axes = GrooveAxes {
@@ -35,7 +36,9 @@ pub fn groove_study<'py>(
         length_ratio,
         count,
     };
-    let rows = guarded(py, || core_study(&base, &axes, eccentricity, threads))?;
+    let rows = guarded_progress(py, progress.as_ref(), || {
+        core_study(&base, &axes, eccentricity, threads)
+    })?;
     let out = PyDict::new(py);
     let col = |f: &dyn Fn(&ballbal_core::model::bearing::study::GroovePoint) -> f64| {
         rows.iter().map(f).collect::<Vec<f64>>()

@@ -234,7 +234,9 @@ pub fn groove_study(
             .par_iter()
             .map(|&pt| {
                 cancel::with(tok.clone(), || {
-                    (!cancel::cancelled()).then(|| solve_point(base, pt, eps))
+                    let found = (!cancel::cancelled()).then(|| solve_point(base, pt, eps));
+                    cancel::advance();
+                    found
                 })
             })
             .collect()
