@@ -1,7 +1,8 @@
 """The core's long calls show progress (issue 34): ``progress=`` on every branch and
-curve function, and on groove studies, counts the points as the core adds them (a bar, or a callable ``f(done,
-total)``); the count ends at the number of rows the result holds, never goes back, and an
-error raised by the callable stops the work as Ctrl-C does."""
+curve function, and on groove studies, counts the points as the core adds them (a bar,
+or a callable ``f(done, total)``); the count ends at the number of rows the result
+holds, never goes back, and an error raised by the callable stops the work as Ctrl-C
+does."""
 
 from __future__ import annotations
 
