@@ -17,7 +17,7 @@ that its qualitative regimes appear (the choice is printed):
 * Yen's (2005) impulse ``5 W exp(-5e5 (t - 0.006)^2)`` at 500 rad/s, i.e.
   ``5 W exp(-2 (tau - 3)^2)`` along gravity, applied at the static equilibrium.
 
-Panels (seed figures 2-19): two starts converging to one equilibrium (plain bearing, as the
+Panels (the paper's figures 2-19): two starts converging to one equilibrium (plain bearing, as the
 Yen's (2005) smooth one), the impulse response against groove angle, L/D, depth and width ratio
 (orbit and tangential film force), and the three unbalance regimes.
 
@@ -94,19 +94,22 @@ def orbit(ax: plt.Axes, runs: dict[str, RotorTrajectory], title: str) -> None:
     ax.set_aspect("equal")
     ax.set_xlim(-1.05, 1.05)
     ax.set_ylim(-1.05, 1.05)
-    ax.set_title(title, fontsize=8)
-    ax.tick_params(labelsize=6)
-    ax.legend(fontsize=5, loc="upper right")
+    # the journal centre in the clearance circle, the load (x) pointing down
+    ax.set_xlabel("$y/c$", fontsize=9)
+    ax.set_ylabel("$-x/c$", fontsize=9)
+    ax.set_title(title, fontsize=10)
+    ax.tick_params(labelsize=8)
+    ax.legend(fontsize=7, loc="upper right")
 
 
 def tangential(ax: plt.Axes, runs: dict[str, RotorTrajectory], title: str) -> None:
     for label, tr in runs.items():
         ax.plot(tr.table["tau"], tr.table["tangential"], lw=0.8, label=label)
-    ax.set_xlabel("tau = w t", fontsize=7)
-    ax.set_ylabel("tangential force / F_S", fontsize=7)
-    ax.set_title(title, fontsize=8)
-    ax.tick_params(labelsize=6)
-    ax.legend(fontsize=5)
+    ax.set_xlabel(r"$\tau = \omega t$", fontsize=9)
+    ax.set_ylabel("$F_t / F_S$ (tangential film force)", fontsize=9)
+    ax.set_title(title, fontsize=10)
+    ax.tick_params(labelsize=8)
+    ax.legend(fontsize=7)
 
 
 def describe(label: str, tr: RotorTrajectory, seconds: float) -> None:
@@ -134,9 +137,12 @@ def main() -> None:
     print(f"choice: g_n = {GRAVITY}, m = {MASS}: weight {MASS * GRAVITY} F_S puts the grooved "
           f"journal at eps {math.hypot(xe, ye):.3f}, attitude {att:.1f} deg; unbalance "
           f"e_u/c = {', '.join(f'{u * GRAVITY:g}' for u in UNBALANCES)}")
-    fig, ax = plt.subplots(5, 2, figsize=(8.0, 19.0))
+    # three orbits a row, then the forces: readable where the README shows it
+    fig, ax = plt.subplots(4, 3, figsize=(13.0, 16.0))
+    ax[3, 1].remove()
+    ax[3, 2].remove()
 
-    # Seed figure 2: two starts, one equilibrium (plain bearing).
+    # The paper's figure 2: two starts, one equilibrium (plain bearing).
     plain = RotorOnBearing(Bearing(length_ratio=1.0, model="finite", grid=(64, 16)), MASS,
                            gravity=GRAVITY)
     starts = {"eps0 0.75 at 90 deg": (0.0, 0.75), "eps0 0.3 at 90 deg": (0.0, 0.3),
@@ -152,9 +158,9 @@ def main() -> None:
     print(f"two starts: final positions agree to {spread:.2e} c")
     orbit(ax[0, 0], runs, "plain bearing: starts converge (fig. 2-3)")
 
-    # Seed figures 9-15: impulse response against the groove parameters.
-    orbit_at = {"angle": (0, 1), "lam": (1, 0), "depth": (1, 1), "width": (2, 0)}
-    force_at = {"angle": (3, 0), "depth": (3, 1), "width": (2, 1)}
+    # The paper's figures 9-15: impulse response against the groove parameters.
+    orbit_at = {"angle": (0, 1), "lam": (0, 2), "depth": (1, 0), "width": (1, 1)}
+    force_at = {"angle": (2, 0), "depth": (2, 1), "width": (2, 2)}
     figs = {"angle": (9, 10), "lam": (11, 11), "depth": (12, 13), "width": (14, 15)}
     for name, values, kw in (("groove angle", ANGLES, "angle"), ("L/D", LENGTHS, "lam"),
                              ("depth ratio", DEPTHS, "depth"), ("width ratio", WIDTHS, "width")):
@@ -169,7 +175,7 @@ def main() -> None:
             tangential(ax[force_at[kw]], runs,
                        f"impulse: tangential force, {name} (fig. {figs[kw][1]})")
 
-    # Seed figures 16-19: unbalance 2.55 W, 0.255 W, 0.0255 W.
+    # The paper's figures 16-19: unbalance 2.55 W, 0.255 W, 0.0255 W.
     runs = {}
     for u in UNBALANCES:
         r = RotorOnBearing(grooved(), MASS, gravity=GRAVITY, unbalance=u * GRAVITY)
@@ -186,10 +192,10 @@ def main() -> None:
             tc = tau[up] - x[up] * (tau[up + 1] - tau[up]) / (x[up + 1] - x[up])
             print(f"  unbalance {u:g} W: orbit radius {0.5 * np.ptp(x):.4f} c, whirl/spin "
                   f"{2 * math.pi / np.mean(np.diff(tc)):.3f}")
-    orbit(ax[4, 0], runs, "mass unbalance (fig. 16-18)")
-    tangential(ax[4, 1], runs, "mass unbalance: tangential force (fig. 19)")
+    orbit(ax[1, 2], runs, "mass unbalance (fig. 16-18)")
+    tangential(ax[3, 0], runs, "mass unbalance: tangential force (fig. 19)")
     fig.tight_layout()
-    fig.savefig(png, dpi=60)
+    fig.savefig(png, dpi=80)
     print(f"total {time.perf_counter() - t_all:.1f} s; wrote {png}")
 
 
