@@ -263,13 +263,7 @@ pub(super) fn collocation_tail<D: Parametric>(
         }
         if let (Some(ps), Some(l)) = (p_star, points.last()) {
             if (ps - cur_p).abs() <= opts.event_tol {
-                events.push(PoEvent {
-                    kind: PoEventKind::InfinitePeriod,
-                    p: ps,
-                    point: l.clone(),
-                    test: l.tests.ip.unwrap_or(f64::NAN),
-                    index: start.offset + points.len(),
-                });
+                events.push(end_event(ps, l, start.offset + points.len()));
                 stop = "infinite_period".to_string();
                 break;
             }
@@ -318,13 +312,7 @@ pub(super) fn collocation_tail<D: Parametric>(
                 if let (Some(ps), Some(l)) = (p_star, points.last()) {
                     // The orbit can no longer be resolved this close to the end: the
                     // end is where the last rows put it.
-                    events.push(PoEvent {
-                        kind: PoEventKind::InfinitePeriod,
-                        p: ps,
-                        point: l.clone(),
-                        test: l.tests.ip.unwrap_or(f64::NAN),
-                        index: start.offset + points.len(),
-                    });
+                    events.push(end_event(ps, l, start.offset + points.len()));
                     stop = "infinite_period".to_string();
                 } else {
                     stop = "step_too_small".to_string();
@@ -460,4 +448,16 @@ pub(super) fn collocation_tail<D: Parametric>(
         events,
         stop,
     })
+}
+
+/// The infinite-period event at `p_star`, where the last rows' slowest speeds put the end,
+/// carried by the last row `last` (`index` the index of the row past it).
+fn end_event(p_star: f64, last: &PoPoint, index: usize) -> PoEvent {
+    PoEvent {
+        kind: PoEventKind::InfinitePeriod,
+        p: p_star,
+        point: last.clone(),
+        test: last.tests.ip.unwrap_or(f64::NAN),
+        index,
+    }
 }
