@@ -1,6 +1,8 @@
 """A rotor's start-up on a journal bearing
 ========================================
 
+Run: ``python examples/bearing_spin_up.py [OUT_DIR]`` (about 20 s on 2 cores).
+
 Yen's (2005) start-up study (fig. 3 and conclusion 1): a sudden start can whirl.
 
 The paper starts a rotor on a plain journal bearing suddenly at 500 rad/s from rest at
@@ -67,6 +69,7 @@ def late_eps(tr: RotorTrajectory) -> float:
 
 def main() -> None:
     out_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
+    os.makedirs(out_dir, exist_ok=True)
     t_all = time.perf_counter()
     m = FRACTION * stability(BEARING, (LOAD, 0.0)).critical_mass
     sudden = RotorOnBearing(BEARING, m, gravity=LOAD / m)

@@ -79,6 +79,7 @@ def figure4(ax: plt.Axes) -> None:
 
 def main() -> None:
     outdir = sys.argv[1] if len(sys.argv) > 1 else "."
+    os.makedirs(outdir, exist_ok=True)
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.5))
     figure4(axes[0])
     for ax, second, scale, label, hi in (

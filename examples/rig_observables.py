@@ -6,7 +6,7 @@ Tien's (2011) chapter 4 in the model: fixed-frame spectra of its figures
 figure 4-13 against the measured band (``ballbal.data``), the basins of attraction of
 figures 4-15 / 4-16 and a speed sweep up and down with its hysteresis.
 
-Run: python examples/rig_observables.py [out_dir]   (about a minute; small mode seconds)
+Run: python examples/rig_observables.py [out_dir]   (about 5 s; small mode less)
 """
 
 import os
@@ -107,4 +107,6 @@ if __name__ == "__main__":
     target = Path(sys.argv[1]) if len(sys.argv) > 1 else None
     if target is None and SMALL:
         target = Path(tempfile.mkdtemp())
-    main(target or Path(__file__).parent)
+    target = target or Path(__file__).parent
+    target.mkdir(parents=True, exist_ok=True)
+    main(target)

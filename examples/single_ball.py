@@ -65,6 +65,7 @@ def ordered(values):
 
 
 def main(out: Path) -> None:
+    out.mkdir(parents=True, exist_ok=True)
     sb = data.single_ball()
     etas = sb["eta"].to_list()
     print("single ball, eta from masses and radii:",

@@ -9,7 +9,7 @@ Transient studies with scenes (time simulation of non-autonomous scenes).
 2. A run-up through the resonance (Omega 0.3 -> 2.0) of the classic balancer and of a
    ball-spring balancer (the planar part of Rezaee et al.'s (2017) comparison).
 
-    python examples/transients.py [output-directory]      # about 10 s
+    python examples/transients.py [output-directory]      # about 3 s
 """
 
 from __future__ import annotations

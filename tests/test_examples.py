@@ -307,8 +307,7 @@ def test_every_example_is_checked():
 def test_example_runs_small(name, tmp_path):
     script = EXAMPLES / name
     assert script.exists(), f"{script}: set BALLBAL_REPO to the repository checkout"
-    out = tmp_path / "out"
-    out.mkdir()
+    out = tmp_path / "out"  # not made here: every example makes its output directory
     args = [str(out)]  # every example takes its output directory, the one convention
     env = {**os.environ, "BALLBAL_EXAMPLE_SMALL": "1", "MPLBACKEND": "Agg"}
     # From tmp_path, so that nothing can land in the checkout.
