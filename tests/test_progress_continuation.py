@@ -79,3 +79,12 @@ def test_a_groove_study_counts_its_points_whatever_the_threads() -> None:
         df = groove_study(Bearing(grid=(32, 8)), angle=[20.0, 40.0], depth_ratio=[0.5, 1.0],
                           threads=threads, progress=cb)
         _counted(calls, df.height, 4)
+
+
+def test_design_charts_count_their_values() -> None:
+    from ballbal.design import balanced_fraction
+
+    calls, cb = _record()
+    t = balanced_fraction(ballbal.Balancer(eta=(0.66, 0.66), zeta_b=0.2), speeds_rpm=[600, 700],
+                          natural_frequency_rpm=513, starts=4, t_end=50.0, progress=cb)
+    _counted(calls, t.table.height, 2)

@@ -19,6 +19,7 @@ import numpy as np
 import polars as pl
 
 from . import _check
+from ._progress import Progress, ProgressArg
 from ._style import Summarised
 from .balance import balance_map, balanced_state
 from .exceptions import ParameterError
@@ -107,6 +108,7 @@ def critical_speed_chart(
     other_mass: float = 0.0,
     max_rpm: float,
     spins: int = 400,
+    progress: ProgressArg = False,
 ) -> DesignChart:
     """The spin [rpm] from which the balls balance stably, against ``vary`` =
     ``"ball_mass"`` (each ball's mass [kg]) or ``"track_radius"`` [m] over ``values``
@@ -119,7 +121,10 @@ def critical_speed_chart(
     to the track, ``other_mass`` [kg] (rotor and motor base). The stability is mapped on
     ``spins`` equally spaced speeds (2 to :data:`MAX_SPINS`) from ``max_rpm / spins`` to
     ``max_rpm``; at most :data:`MAX_DESIGN_VALUES` values. Returns a
-    :class:`DesignChart` (a table and its ``.plot()``)."""
+    :class:`DesignChart` (a table and its ``.plot()``).
+
+    ``progress``: True for a progress bar over the values (tqdm, notebook-aware), or a
+    callable ``f(done, total)``."""
     if not isinstance(vary, str) or vary not in ("ball_mass", "track_radius"):
         raise ParameterError("vary", f"must be 'ball_mass' or 'track_radius', got {vary!r:.60}",
                              allowed="ball_mass, track_radius")
@@ -132,20 +137,22 @@ def critical_speed_chart(
     count = _check.integer("spins", spins, 2, MAX_SPINS)
     spin_grid = np.linspace(max_rpm / count, max_rpm, count) / _RPM  # rad/s
     rows = []
-    for v in vals:
-        mb = float(v) if vary == "ball_mass" else ball_mass
-        rt = float(v) if vary == "track_radius" else track_radius
-        b = Balancer.from_lab(disk_mass=disk_mass, eccentricity=eccentricity,
-                              ball_masses=[mb] * n, track_radius=rt, stiffness=stiffness,
-                              damping=damping, track_damping=track_damping, spin=1.0,
-                              other_mass=other_mass)
-        wn = 1.0 / b.Omega  # spin 1 rad/s is Omega = 1 / w_n
-        status, om = _lowest_stable_speed(b, spin_grid / wn)
-        crit = om * wn * _RPM if status == "ok" and om is not None else None
-        rows.append({vary: float(v), "eta": b.eta[0], "natural_frequency_rpm": wn * _RPM,
-                     "critical_speed_rpm": crit,
-                     "critical_ratio": None if crit is None else crit / (wn * _RPM),
-                     "status": status})
+    with Progress(progress, len(vals), "ballbal critical speeds", "value") as bar:
+        for v in vals:
+            mb = float(v) if vary == "ball_mass" else ball_mass
+            rt = float(v) if vary == "track_radius" else track_radius
+            b = Balancer.from_lab(disk_mass=disk_mass, eccentricity=eccentricity,
+                                  ball_masses=[mb] * n, track_radius=rt, stiffness=stiffness,
+                                  damping=damping, track_damping=track_damping, spin=1.0,
+                                  other_mass=other_mass)
+            wn = 1.0 / b.Omega  # spin 1 rad/s is Omega = 1 / w_n
+            status, om = _lowest_stable_speed(b, spin_grid / wn)
+            crit = om * wn * _RPM if status == "ok" and om is not None else None
+            rows.append({vary: float(v), "eta": b.eta[0], "natural_frequency_rpm": wn * _RPM,
+                         "critical_speed_rpm": crit,
+                         "critical_ratio": None if crit is None else crit / (wn * _RPM),
+                         "status": status})
+            bar.update()
     schema = {vary: pl.Float64, "eta": pl.Float64, "natural_frequency_rpm": pl.Float64,
               "critical_speed_rpm": pl.Float64, "critical_ratio": pl.Float64,
               "status": pl.String}
@@ -226,6 +233,7 @@ def balancing_chart(
     geometric_factor: float = 1.0,
     pattern: str = "R-R",
     Omega: Any = (1.0, 2.5, 0.01),  # noqa: N803 - the model's symbol
+    progress: ProgressArg = False,
 ) -> BalancingChart:
     """From which speed [rpm] a sweep up ends balanced, against ``vary``:
 
@@ -241,7 +249,10 @@ def balancing_chart(
     ``Omega`` into rpm. Per value: the chasing band's end
     (:func:`ballbal.calibration.stable_band_end` of ``pattern`` over the ``Omega``
     grid ``(start, stop, step)``) and the perfect balance's onset on that grid,
-    refined by bisection. At most :data:`MAX_DESIGN_VALUES` values."""
+    refined by bisection. At most :data:`MAX_DESIGN_VALUES` values.
+
+    ``progress``: True for a progress bar over the values (tqdm, notebook-aware), or a
+    callable ``f(done, total)``."""
     from .calibration import _balancer, stable_band_end
     from .oil import CENTIPOISE, track_damping
 
@@ -277,28 +288,30 @@ def balancing_chart(
         raise ParameterError("Omega", f"the grid has {count} speeds, more than {MAX_SPINS}")
     grid = o0 + step * np.arange(count)
     rows = []
-    for v in vals:
-        b = model
-        if vary == "zeta_b":
-            b = model.replace(zeta_b=float(v))
-        elif vary == "oil_viscosity":
-            assert ball_radius is not None and ball_mass is not None
-            b = model.replace(zeta_b=track_damping(
-                float(v) * CENTIPOISE, ball_radius=ball_radius, ball_mass=ball_mass,
-                natural_frequency_rpm=fn, channel_radius=channel_radius,
-                geometric_factor=geometric_factor))
-        else:
-            b = model.replace(eta=tuple([mb * rt * 1e6 / float(v)] * model.n_balls))
-        end = stable_band_end(b, pattern, Omega=Omega)
-        status, om = _lowest_stable_speed(b, grid)
-        onset = om * fn if status in ("ok", "stable_from_lowest") and om is not None else None
-        chase = None if end is None else end * fn
-        known = [s for s in (chase, onset) if s is not None]
-        top = max(known) if onset is not None else None
-        rows.append({vary: float(v), "zeta_b": float(np.mean(b.zeta_b)),
-                     "eta": float(np.mean(b.eta)), "eta_margin": float(np.sum(b.eta)) - 1.0,
-                     "chasing_end_rpm": chase, "perfect_balance_from_rpm": onset,
-                     "balanced_from_rpm": top, "status": status})
+    with Progress(progress, len(vals), "ballbal balancing chart", "value") as bar:
+        for v in vals:
+            b = model
+            if vary == "zeta_b":
+                b = model.replace(zeta_b=float(v))
+            elif vary == "oil_viscosity":
+                assert ball_radius is not None and ball_mass is not None
+                b = model.replace(zeta_b=track_damping(
+                    float(v) * CENTIPOISE, ball_radius=ball_radius, ball_mass=ball_mass,
+                    natural_frequency_rpm=fn, channel_radius=channel_radius,
+                    geometric_factor=geometric_factor))
+            else:
+                b = model.replace(eta=tuple([mb * rt * 1e6 / float(v)] * model.n_balls))
+            end = stable_band_end(b, pattern, Omega=Omega)
+            status, om = _lowest_stable_speed(b, grid)
+            onset = om * fn if status in ("ok", "stable_from_lowest") and om is not None else None
+            chase = None if end is None else end * fn
+            known = [s for s in (chase, onset) if s is not None]
+            top = max(known) if onset is not None else None
+            rows.append({vary: float(v), "zeta_b": float(np.mean(b.zeta_b)),
+                         "eta": float(np.mean(b.eta)), "eta_margin": float(np.sum(b.eta)) - 1.0,
+                         "chasing_end_rpm": chase, "perfect_balance_from_rpm": onset,
+                         "balanced_from_rpm": top, "status": status})
+            bar.update()
     schema = {vary: pl.Float64, "zeta_b": pl.Float64, "eta": pl.Float64,
               "eta_margin": pl.Float64, "chasing_end_rpm": pl.Float64,
               "perfect_balance_from_rpm": pl.Float64, "balanced_from_rpm": pl.Float64,
@@ -348,13 +361,17 @@ def balanced_fraction(
     starts: int = 200,
     seed: int = 0,
     t_end: float = 1000.0,
+    progress: ProgressArg = False,
 ) -> BalancedFraction:
     """The fraction of starts from rest (the rotor at rest in the ground frame, the two
     balls at uniformly random angles, :func:`ballbal.basins.basins` with ``samples``)
     that end at the perfect balance, per speed in ``speeds_rpm`` (at most
     :data:`MAX_DESIGN_VALUES`), with its binomial standard error. ``starts`` per speed
     (1 to :data:`MAX_STARTS_PER_SPEED`) drawn from ``seed`` (the same angles at every
-    speed); ``t_end``: time simulated per start (model units)."""
+    speed); ``t_end``: time simulated per start (model units).
+
+    ``progress``: True for a progress bar over the speeds (tqdm, notebook-aware), or a
+    callable ``f(done, total)``."""
     from .basins import ROTATING, basins
     from .calibration import _balancer
 
@@ -368,15 +385,17 @@ def balanced_fraction(
     n = _check.integer("starts", starts, 1, MAX_STARTS_PER_SPEED)
     s = _check.integer("seed", seed, 0, 2**63 - 1)
     rows = []
-    for v in sp:
-        res = basins(model.replace(Omega=float(v) / fn), samples=n, seed=s, t_end=t_end,
-                     orbits=False)
-        labels = res.table["label"]
-        k = int((labels == "perfect_balance").sum())
-        p = k / n
-        rows.append({"speed_rpm": float(v), "Omega": float(v) / fn, "starts": n,
-                     "balanced": k, "fraction": p, "std_error": math.sqrt(p * (1 - p) / n),
-                     "rotating": int(labels.is_in(list(ROTATING)).sum())})
+    with Progress(progress, len(sp), "ballbal balanced fraction", "speed") as bar:
+        for v in sp:
+            res = basins(model.replace(Omega=float(v) / fn), samples=n, seed=s, t_end=t_end,
+                         orbits=False)
+            labels = res.table["label"]
+            k = int((labels == "perfect_balance").sum())
+            p = k / n
+            rows.append({"speed_rpm": float(v), "Omega": float(v) / fn, "starts": n,
+                         "balanced": k, "fraction": p, "std_error": math.sqrt(p * (1 - p) / n),
+                         "rotating": int(labels.is_in(list(ROTATING)).sum())})
+            bar.update()
     schema = {"speed_rpm": pl.Float64, "Omega": pl.Float64, "starts": pl.Int64,
               "balanced": pl.Int64, "fraction": pl.Float64, "std_error": pl.Float64,
               "rotating": pl.Int64}
