@@ -23,24 +23,10 @@ from scipy.optimize import brentq
 from ballbal.bearing import Bearing, RotorImpulse, RotorOnBearing, simulate_rotor
 from ballbal.exceptions import ParameterError
 
-LAM = 0.5  # L/D; then F0 = mu w R L^3 / c^2 = (2 lambda)^2 F_S = F_S
+from ocvirk import LAM
+from ocvirk import film_force as short_force
+
 SHORT = Bearing(length_ratio=LAM, model="short")
-GL_X, GL_W = np.polynomial.legendre.leggauss(200)
-
-
-def short_force(x: float, y: float, vx: float, vy: float) -> np.ndarray:
-    """Ocvirk's half-Sommerfeld film force in F_S: the mean over zeta of
-    P = g (zeta^2 - lambda^2) / (2 H^3), g = 6 dH/dtheta + 12 dH/dtau, positive where
-    g < 0, i.e. on theta + chi in (pi, 2 pi) for g = R sin(theta + chi)."""
-    a, b = 6 * x - 12 * vy, -6 * y - 12 * vx
-    chi = math.atan2(b, a)
-    lo, hi = math.pi - chi, 2 * math.pi - chi
-    th = 0.5 * (lo + hi) + 0.5 * (hi - lo) * GL_X
-    w = 0.5 * (hi - lo) * GL_W
-    h = 1 - x * np.cos(th) - y * np.sin(th)
-    g = a * np.sin(th) + b * np.cos(th)
-    pbar = LAM**2 * np.maximum(-g, 0.0) / (3 * h**3)
-    return -np.array([np.sum(w * pbar * np.cos(th)), np.sum(w * pbar * np.sin(th))])
 
 
 def static_eccentricity(load: float) -> float:

@@ -18,25 +18,10 @@ from scipy.integrate import solve_ivp
 from ballbal.bearing import Bearing, RotorOnBearing, SpinUp, simulate_rotor
 from ballbal.exceptions import ParameterError
 
-LAM = 0.5
+from ocvirk import LAM
+from ocvirk import film_force as short_force
+
 SHORT = Bearing(length_ratio=LAM, model="short")
-GL_X, GL_W = np.polynomial.legendre.leggauss(200)
-
-
-def short_force(x: float, y: float, vx: float, vy: float, s: float) -> np.ndarray:
-    """Ocvirk's film in F_S at journal speed ``s w``: P = g (zeta^2 - lambda^2) / (2 H^3)
-    with g = 6 s dH/dtheta + 12 dH/dtau, positive where g < 0."""
-    a, b = 6 * s * x - 12 * vy, -6 * s * y - 12 * vx
-    if a == 0.0 and b == 0.0:
-        return np.zeros(2)
-    chi = math.atan2(b, a)
-    lo, hi = math.pi - chi, 2 * math.pi - chi
-    th = 0.5 * (lo + hi) + 0.5 * (hi - lo) * GL_X
-    w = 0.5 * (hi - lo) * GL_W
-    h = 1 - x * np.cos(th) - y * np.sin(th)
-    g = a * np.sin(th) + b * np.cos(th)
-    pbar = LAM**2 * np.maximum(-g, 0.0) / (3 * h**3)
-    return -np.array([np.sum(w * pbar * np.cos(th)), np.sum(w * pbar * np.sin(th))])
 
 
 def ramp(tau: float, start: float, duration: float) -> tuple[float, float, float]:
