@@ -16,11 +16,7 @@ pub fn guarded<T: Send, F: FnOnce() -> Result<T, Error> + Send>(
     py: Python<'_>,
     f: F,
 ) -> PyResult<T> {
-    run_polled(
-        py,
-        |tok, _: &std::sync::mpsc::Sender<()>| cancel::with(Some(tok.clone()), f),
-        |()| Ok(()),
-    )
+    guarded_progress(py, None, f)
 }
 
 /// [`guarded`], calling `progress(done)` (a Python callable, with the GIL) whenever the
